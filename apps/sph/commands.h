@@ -1,0 +1,17 @@
+#pragma once
+// The subcommands of the `sph` program: each registers its options and runs.
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace sph::app {
+
+/// Exit codes: 0 success, 1 the run failed (blow-up, I/O error during the run),
+/// 2 bad input (scene, flags, paths), 70 internal error (a bug).
+enum ExitCode { kOk = 0, kRunFailed = 1, kBadInput = 2, kInternal = 70 };
+
+/// Adds `sph run` to the app; the returned function runs it after parsing.
+std::function<int()> add_run_command(CLI::App& app);
+
+}  // namespace sph::app

@@ -1,0 +1,27 @@
+#pragma once
+// Progress reporting for `sph run`: a bar with ETA on a terminal, a plain line every 10 %
+// otherwise (logs, CI).
+
+#include <cstdint>
+#include <cstdio>
+
+#include <sph/core/timer.h>
+
+namespace sph::app {
+
+class Progress {
+ public:
+  Progress(std::int64_t total_steps, bool terminal, std::FILE* out = stderr);
+  void update(std::int64_t steps_done, std::size_t particles);
+  void finish();
+
+ private:
+  std::int64_t total_;
+  bool terminal_;
+  std::FILE* out_;
+  Stopwatch watch_;
+  double last_draw_ = -1;
+  int last_decile_ = 0;
+};
+
+}  // namespace sph::app

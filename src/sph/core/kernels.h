@@ -1,0 +1,105 @@
+#pragma once
+/// \file SPH smoothing kernels of Mueller, Charypar and Gross (2003), "Particle-Based Fluid
+/// Simulation for Interactive Applications", each with its own 2D and 3D normalization.
+///
+/// Kernels are value objects holding the support radius h; they have no static state.
+/// All take distances in metres and return values in 1/m^D (W), 1/m^(D+1) (gradient) or
+/// 1/m^(D+2) (Laplacian). Outside the support (r >= h) every function returns 0.
+///
+/// Normalizations (each kernel integrates to one over its support):
+///   poly6      W = C (h^2 - r^2)^3,       C = 315 / (64 pi h^9) in 3D,  4 / (pi h^8) in 2D
+///   spiky      W = C (h - r)^3,           C =  15 / (pi h^6)    in 3D, 10 / (pi h^5) in 2D
+///   viscosity  lap W = C (h - r),         C =  45 / (pi h^6)    in 3D, 40 / (pi h^5) in 2D
+/// The 2D viscosity kernel is the radial function with Laplacian C (h - r) that vanishes with
+/// its derivative at r = h and integrates to one (see docs/physics.md for its closed form).
+
+#include <numbers>
+
+#include <sph/core/vec.h>
+
+namespace sph {
+
+/// Poly6 kernel: used for density (paper Eq. 4).
+template <int D, std::floating_point R>
+class Poly6Kernel {
+ public:
+  explicit Poly6Kernel(R h) : h_(h), h2_(h * h) {
+    const double hd = static_cast<double>(h);
+    const double pi = std::numbers::pi;
+    norm_ = static_cast<R>(D == 3 ? 315.0 / (64.0 * pi * std::pow(hd, 9)) : 4.0 / (pi * std::pow(hd, 8)));
+  }
+  R h() const { return h_; }
+  /// W(r) from the squared distance r2 = |x_i - x_j|^2.
+  R w_r2(R r2) const {
+    if (r2 >= h2_) return R(0);
+    const R d = h2_ - r2;
+    return norm_ * d * d * d;
+  }
+  R w(R r) const { return w_r2(r * r); }
+  /// W(0): the particle's own contribution to its density.
+  R w_zero() const { return norm_ * h2_ * h2_ * h2_; }
+
+ private:
+  R h_, h2_, norm_;
+};
+
+/// Spiky kernel: its gradient drives the pressure force (paper Eq. 5).
+template <int D, std::floating_point R>
+class SpikyKernel {
+ public:
+  explicit SpikyKernel(R h) : h_(h) {
+    const double hd = static_cast<double>(h);
+    const double pi = std::numbers::pi;
+    norm_ = static_cast<R>(D == 3 ? 15.0 / (pi * std::pow(hd, 6)) : 10.0 / (pi * std::pow(hd, 5)));
+  }
+  R h() const { return h_; }
+  R w(R r) const {
+    if (r >= h_) return R(0);
+    const R d = h_ - r;
+    return norm_ * d * d * d;
+  }
+  /// Gradient of W with respect to x_i, for rij = x_i - x_j at distance r = |rij| > 0:
+  /// -3 C (h - r)^2 rij / r. Returns zero for r == 0 (coincident particles) and r >= h.
+  Vec<D, R> gradient(const Vec<D, R>& rij, R r) const {
+    if (r >= h_ || r <= R(0)) return Vec<D, R>{};
+    const R d = h_ - r;
+    return rij * (R(-3) * norm_ * d * d / r);
+  }
+
+ private:
+  R h_, norm_;
+};
+
+/// Viscosity kernel: its Laplacian drives the viscous force (paper Eq. 6).
+template <int D, std::floating_point R>
+class ViscosityKernel {
+ public:
+  explicit ViscosityKernel(R h) : h_(h) {
+    const double hd = static_cast<double>(h);
+    const double pi = std::numbers::pi;
+    lap_norm_ = static_cast<R>(D == 3 ? 45.0 / (pi * std::pow(hd, 6)) : 40.0 / (pi * std::pow(hd, 5)));
+  }
+  R h() const { return h_; }
+  /// Laplacian of W: C (h - r) for r < h.
+  R laplacian(R r) const { return r >= h_ ? R(0) : lap_norm_ * (h_ - r); }
+  /// W itself (singular at r = 0 in both dimensions; only used to check normalization).
+  R w(R r) const {
+    if (r >= h_ || r <= R(0)) return R(0);
+    const double hd = h_, rd = r;
+    const double pi = std::numbers::pi;
+    if constexpr (D == 3) {
+      const double q = rd / hd;
+      return static_cast<R>(15.0 / (2.0 * pi * hd * hd * hd) *
+                            (-q * q * q / 2.0 + q * q + 1.0 / (2.0 * q) - 1.0));
+    } else {
+      const double c = 40.0 / (pi * std::pow(hd, 5));
+      return static_cast<R>(c * (hd * rd * rd / 4.0 - rd * rd * rd / 9.0 - 5.0 * hd * hd * hd / 36.0 -
+                                 hd * hd * hd / 6.0 * std::log(rd / hd)));
+    }
+  }
+
+ private:
+  R h_, lap_norm_;
+};
+
+}  // namespace sph

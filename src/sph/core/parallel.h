@@ -1,0 +1,44 @@
+#pragma once
+/// \file The one parallel-loop abstraction (OpenMP underneath). Loops either write only to
+/// their own index, or use parallel_chunks with a chunking that does not depend on the thread
+/// count, so that results are bitwise identical for any number of threads.
+
+#include <cstddef>
+#include <utility>
+
+namespace sph {
+
+/// Sets the number of worker threads used by parallel loops (n >= 1).
+void set_num_threads(int n);
+/// The number of worker threads parallel loops use.
+int num_threads();
+
+/// Calls f(i) for i in [0, n), in parallel. f must only write data owned by index i.
+template <class F>
+void parallel_for(std::size_t n, F&& f) {
+  const auto count = static_cast<long long>(n);
+#pragma omp parallel for schedule(static)
+  for (long long i = 0; i < count; ++i) f(static_cast<std::size_t>(i));
+}
+
+/// Fixed chunk size used by parallel_chunks: chunk boundaries depend only on n.
+inline constexpr std::size_t kChunkSize = 1024;
+
+/// Number of chunks of kChunkSize that cover [0, n).
+inline std::size_t chunk_count(std::size_t n) { return (n + kChunkSize - 1) / kChunkSize; }
+
+/// Calls f(chunk, begin, end) for each chunk of [0, n) of size kChunkSize, in parallel.
+/// The chunks are the same for any thread count, so per-chunk partial results combined in
+/// chunk order give thread-count-independent results.
+template <class F>
+void parallel_chunks(std::size_t n, F&& f) {
+  const auto chunks = static_cast<long long>(chunk_count(n));
+#pragma omp parallel for schedule(dynamic, 1)
+  for (long long c = 0; c < chunks; ++c) {
+    const std::size_t begin = static_cast<std::size_t>(c) * kChunkSize;
+    const std::size_t end = begin + kChunkSize < n ? begin + kChunkSize : n;
+    f(static_cast<std::size_t>(c), begin, end);
+  }
+}
+
+}  // namespace sph

@@ -1,0 +1,82 @@
+#pragma once
+/// \file Fixed-size vector Vec<D,R> used for positions, velocities and accelerations.
+
+#include <array>
+#include <cmath>
+#include <concepts>
+#include <cstddef>
+
+namespace sph {
+
+/// A D-dimensional vector of floating-point type R. Plain value type (trivially copyable).
+template <int D, std::floating_point R>
+struct Vec {
+  static_assert(D == 2 || D == 3, "only 2D and 3D are supported");
+  std::array<R, D> c{};
+
+  constexpr R& operator[](int i) { return c[static_cast<std::size_t>(i)]; }
+  constexpr const R& operator[](int i) const { return c[static_cast<std::size_t>(i)]; }
+
+  static constexpr Vec zero() { return Vec{}; }
+  static constexpr Vec filled(R v) {
+    Vec r;
+    for (int i = 0; i < D; ++i) r[i] = v;
+    return r;
+  }
+
+  constexpr Vec& operator+=(const Vec& o) {
+    for (int i = 0; i < D; ++i) c[i] += o.c[i];
+    return *this;
+  }
+  constexpr Vec& operator-=(const Vec& o) {
+    for (int i = 0; i < D; ++i) c[i] -= o.c[i];
+    return *this;
+  }
+  constexpr Vec& operator*=(R s) {
+    for (int i = 0; i < D; ++i) c[i] *= s;
+    return *this;
+  }
+  friend constexpr Vec operator+(Vec a, const Vec& b) { return a += b; }
+  friend constexpr Vec operator-(Vec a, const Vec& b) { return a -= b; }
+  friend constexpr Vec operator*(Vec a, R s) { return a *= s; }
+  friend constexpr Vec operator*(R s, Vec a) { return a *= s; }
+  friend constexpr Vec operator-(Vec a) {
+    for (int i = 0; i < D; ++i) a.c[i] = -a.c[i];
+    return a;
+  }
+  friend constexpr bool operator==(const Vec&, const Vec&) = default;
+};
+
+template <int D, std::floating_point R>
+constexpr R dot(const Vec<D, R>& a, const Vec<D, R>& b) {
+  R s = 0;
+  for (int i = 0; i < D; ++i) s += a[i] * b[i];
+  return s;
+}
+
+template <int D, std::floating_point R>
+constexpr R norm2(const Vec<D, R>& a) {
+  return dot(a, a);
+}
+
+template <int D, std::floating_point R>
+R norm(const Vec<D, R>& a) {
+  return std::sqrt(norm2(a));
+}
+
+template <int D, std::floating_point R>
+bool all_finite(const Vec<D, R>& a) {
+  for (int i = 0; i < D; ++i)
+    if (!std::isfinite(a[i])) return false;
+  return true;
+}
+
+/// Converts between precisions (and from double scene values to the simulation's R).
+template <std::floating_point To, int D, std::floating_point From>
+constexpr Vec<D, To> vec_cast(const Vec<D, From>& v) {
+  Vec<D, To> r;
+  for (int i = 0; i < D; ++i) r[i] = static_cast<To>(v[i]);
+  return r;
+}
+
+}  // namespace sph

@@ -1,0 +1,35 @@
+#pragma once
+/// \file Files that appear whole or not at all: written under a temporary name in the same
+/// directory, flushed, then renamed over the final name.
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+
+namespace sph {
+
+class AtomicFile {
+ public:
+  /// Opens a temporary file next to `path`; throws sph::Error if it cannot be created.
+  explicit AtomicFile(std::filesystem::path path);
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  /// Removes the temporary file unless commit() succeeded.
+  ~AtomicFile();
+
+  std::ofstream& stream() { return out_; }
+  void write(std::string_view bytes) { out_.write(bytes.data(), static_cast<std::streamsize>(bytes.size())); }
+  /// Flushes, closes and renames the temporary file to the final path; throws sph::Error on failure.
+  void commit();
+
+ private:
+  std::filesystem::path path_, tmp_;
+  std::ofstream out_;
+  bool committed_ = false;
+};
+
+/// Writes `content` to `path` atomically.
+void write_file_atomic(const std::filesystem::path& path, std::string_view content);
+
+}  // namespace sph

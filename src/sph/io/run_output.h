@@ -1,0 +1,75 @@
+#pragma once
+/// \file RunOutput: everything a run writes to its output directory.
+///
+///   DIR/frames.pvd             time series for ParaView (rewritten after every frame)
+///   DIR/frames/frame_NNNNNN.vtu  particle frames (see write_vtu)
+///   DIR/stats.csv              one row per step (see kStatsColumns)
+///   DIR/summary.json           written at the end: scene, mode, steps, timings, status
+///   DIR/scene.json             the effective scene (after --set overrides)
+/// Every file appears whole or not at all.
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <sph/io/vtk.h>
+#include <sph/scene/scene_desc.h>
+#include <sph/solver/simulation.h>
+
+namespace sph {
+
+/// Header of stats.csv.
+inline constexpr const char* kStatsColumns =
+    "step,time,particles,kinetic_energy,max_speed,mean_neighbors,lists_rebuilt,pairs_stored,"
+    "t_grid,t_lists,t_density,t_forces,t_integrate,t_output";
+
+/// Facts about the run that are not in the scene.
+struct RunInfo {
+  std::string mode;        ///< neighbor mode name
+  int threads = 1;
+  std::string scene_json;  ///< effective scene text
+};
+
+/// Creates `dir` if needed and checks that files can be created in it; removes the files a
+/// previous run left there (frames, stats, summary). Throws sph::Error naming the path.
+void prepare_output_directory(const std::filesystem::path& dir);
+
+template <int D, std::floating_point R>
+class RunOutput {
+ public:
+  /// `dir` must have been prepared with prepare_output_directory.
+  RunOutput(std::filesystem::path dir, const SceneDesc& desc, RunInfo info);
+  ~RunOutput();
+
+  /// Writes frame 0 (the initial state) and scene.json.
+  void begin(const Simulation<D, R>& sim);
+  /// After each step: writes a frame if one is due (every output_every_steps steps and at the
+  /// last step), then the step's stats row. Returns the seconds spent writing.
+  double after_step(const Simulation<D, R>& sim, const StepInfo& info, bool last);
+  /// Closes stats.csv and writes summary.json with `status` ("completed" or an error message).
+  void finish(const Simulation<D, R>& sim, const std::string& status, double wall_seconds);
+
+  std::size_t frames_written() const { return pvd_.size(); }
+
+ private:
+  void write_frame(const Simulation<D, R>& sim);
+
+  std::filesystem::path dir_;
+  const SceneDesc& desc_;
+  RunInfo info_;
+  std::vector<PvdEntry> pvd_;
+  std::ofstream stats_;
+  std::filesystem::path stats_tmp_;
+  PhaseTimes totals_;
+  double output_seconds_ = 0;
+  bool finished_ = false;
+};
+
+extern template class RunOutput<2, float>;
+extern template class RunOutput<2, double>;
+extern template class RunOutput<3, float>;
+extern template class RunOutput<3, double>;
+
+}  // namespace sph

@@ -1,0 +1,64 @@
+#include <sph/neighbors/standard.h>
+
+#include <sph/core/error.h>
+#include <sph/core/timer.h>
+
+namespace sph {
+
+template <int D, std::floating_point R>
+StandardNeighbors<D, R>::StandardNeighbors(R radius) : radius_(radius) {
+  SPH_CHECK(radius > R(0), "neighbor radius must be positive");
+}
+
+template <int D, std::floating_point R>
+void StandardNeighbors<D, R>::update(const ParticleSet<D, R>& particles, R /*dt*/) {
+  Stopwatch watch;
+  grid_.build(particles.position, radius_);
+  counters_.grid_seconds = watch.lap();
+  builder_.build(grid_, particles.position, radius_, lists_);
+  counters_.lists_seconds = watch.lap();
+  counters_.lists_rebuilt = particles.size();
+  counters_.pairs_stored = lists_.entry_count();
+}
+
+template <int D, std::floating_point R>
+NeighborLists brute_force_lists(std::span<const Vec<D, R>> positions, R radius) {
+  NeighborLists out;
+  const std::size_t n = positions.size();
+  const R r2 = radius * radius;
+  out.offsets.resize(n + 1);
+  out.offsets[0] = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = 0; j < n; ++j)
+      if (j != i && norm2(positions[i] - positions[j]) < r2) out.indices.push_back(static_cast<std::uint32_t>(j));
+    out.offsets[i + 1] = out.indices.size();
+  }
+  return out;
+}
+
+template <int D, std::floating_point R>
+BruteForceNeighbors<D, R>::BruteForceNeighbors(R radius) : radius_(radius) {
+  SPH_CHECK(radius > R(0), "neighbor radius must be positive");
+}
+
+template <int D, std::floating_point R>
+void BruteForceNeighbors<D, R>::update(const ParticleSet<D, R>& particles, R /*dt*/) {
+  Stopwatch watch;
+  lists_ = brute_force_lists<D, R>(particles.position, radius_);
+  counters_.grid_seconds = 0;
+  counters_.lists_seconds = watch.lap();
+  counters_.lists_rebuilt = particles.size();
+  counters_.pairs_stored = lists_.entry_count();
+}
+
+#define SPH_INSTANTIATE(D, R)                                                              \
+  template class StandardNeighbors<D, R>;                                                  \
+  template class BruteForceNeighbors<D, R>;                                                \
+  template NeighborLists brute_force_lists<D, R>(std::span<const Vec<D, R>>, R);
+SPH_INSTANTIATE(2, float)
+SPH_INSTANTIATE(2, double)
+SPH_INSTANTIATE(3, float)
+SPH_INSTANTIATE(3, double)
+#undef SPH_INSTANTIATE
+
+}  // namespace sph

@@ -1,0 +1,47 @@
+#pragma once
+/// \file The standard strategy: rebuild the grid and every list every step (paper Section 4).
+
+#include <sph/neighbors/list_builder.h>
+#include <sph/neighbors/strategy.h>
+#include <sph/neighbors/uniform_grid.h>
+
+namespace sph {
+
+template <int D, std::floating_point R>
+class StandardNeighbors final : public NeighborStrategy<D, R> {
+ public:
+  explicit StandardNeighbors(R radius);
+  NeighborMode mode() const override { return NeighborMode::Standard; }
+  void update(const ParticleSet<D, R>& particles, R dt) override;
+  const NeighborLists& lists() const override { return lists_; }
+  const NeighborCounters& counters() const override { return counters_; }
+
+ private:
+  R radius_;
+  UniformGrid<D, R> grid_;
+  ListBuilder<D, R> builder_;
+  NeighborLists lists_;
+  NeighborCounters counters_;
+};
+
+/// The test oracle: every pair checked, O(N^2). Lists are sorted by index.
+template <int D, std::floating_point R>
+class BruteForceNeighbors final : public NeighborStrategy<D, R> {
+ public:
+  explicit BruteForceNeighbors(R radius);
+  NeighborMode mode() const override { return NeighborMode::BruteForce; }
+  void update(const ParticleSet<D, R>& particles, R dt) override;
+  const NeighborLists& lists() const override { return lists_; }
+  const NeighborCounters& counters() const override { return counters_; }
+
+ private:
+  R radius_;
+  NeighborLists lists_;
+  NeighborCounters counters_;
+};
+
+/// Brute-force lists of `positions` within `radius` (strictly closer), sorted by index.
+template <int D, std::floating_point R>
+NeighborLists brute_force_lists(std::span<const Vec<D, R>> positions, R radius);
+
+}  // namespace sph

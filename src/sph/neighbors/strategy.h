@@ -1,0 +1,55 @@
+#pragma once
+/// \file NeighborStrategy: the policy interface the solver calls once per step.
+
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include <sph/core/particle_set.h>
+#include <sph/neighbors/neighbor_lists.h>
+
+namespace sph {
+
+/// Neighbor strategies. `standard` rebuilds every list every step (paper Section 4);
+/// `adaptive` is the paper's Algorithm 2; `verlet` keeps exact lists with a skin radius.
+enum class NeighborMode { Standard, Adaptive, Verlet, BruteForce };
+
+/// "standard", "adaptive", "verlet" or "brute_force".
+std::string_view to_string(NeighborMode mode);
+/// Parses a mode name; throws sph::Error naming the accepted values otherwise.
+NeighborMode parse_neighbor_mode(std::string_view name, const std::string& where = {});
+
+/// What one update() did.
+struct NeighborCounters {
+  std::uint64_t lists_rebuilt = 0;  ///< particles whose list was rebuilt this step
+  std::uint64_t pairs_stored = 0;   ///< directed entries stored in all lists
+  double grid_seconds = 0;          ///< wall time spent building the grid
+  double lists_seconds = 0;         ///< wall time spent building lists
+};
+
+/// Options shared by the strategies (those a strategy does not use are ignored by it).
+struct NeighborOptions {
+  double radius = 0;                ///< kernel support h, m
+  int full_rebuild_period = 200;    ///< adaptive: rebuild every list each this many steps
+};
+
+/// A neighbor strategy keeps full neighbor lists of the particles current for the solver.
+template <int D, std::floating_point R>
+class NeighborStrategy {
+ public:
+  virtual ~NeighborStrategy() = default;
+  virtual NeighborMode mode() const = 0;
+  /// Called once per step, before density, with the current positions and velocities and the
+  /// step size: afterwards lists() holds, for each particle, its neighbors for this step.
+  /// Particles may have been appended since the last call (emitters); none are removed.
+  virtual void update(const ParticleSet<D, R>& particles, R dt) = 0;
+  virtual const NeighborLists& lists() const = 0;
+  /// Counters of the last update().
+  virtual const NeighborCounters& counters() const = 0;
+};
+
+/// Creates the strategy for `mode`. Throws sph::Error for a mode this build cannot run.
+template <int D, std::floating_point R>
+std::unique_ptr<NeighborStrategy<D, R>> make_neighbor_strategy(NeighborMode mode, const NeighborOptions& options);
+
+}  // namespace sph

@@ -1,0 +1,76 @@
+#include <sph/neighbors/uniform_grid.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <sph/core/error.h>
+#include <sph/core/parallel.h>
+
+namespace sph {
+
+template <int D, std::floating_point R>
+void UniformGrid<D, R>::build(std::span<const V> positions, R radius) {
+  SPH_CHECK(radius > R(0) && std::isfinite(radius), "grid radius must be positive and finite");
+  SPH_CHECK(positions.size() < std::numeric_limits<std::uint32_t>::max(), "too many points for 32-bit indices");
+  const std::size_t n = positions.size();
+
+  // Bounding box (min/max are exact, so the result does not depend on evaluation order).
+  V lo = V::filled(R(0)), hi = V::filled(R(0));
+  if (n > 0) {
+    lo = hi = positions[0];
+    for (const V& x : positions)
+      for (int d = 0; d < D; ++d) {
+        lo[d] = std::min(lo[d], x[d]);
+        hi[d] = std::max(hi[d], x[d]);
+      }
+  }
+  for (int d = 0; d < D; ++d)
+    SPH_CHECK(std::isfinite(lo[d]) && std::isfinite(hi[d]), "non-finite particle position given to the grid");
+
+  // Cell size: the radius plus a margin for rounding in the cell computation, so that two
+  // points closer than the radius never land more than one cell apart.
+  R max_abs = 0, max_extent = 0;
+  for (int d = 0; d < D; ++d) {
+    max_abs = std::max({max_abs, std::abs(lo[d]), std::abs(hi[d])});
+    max_extent = std::max(max_extent, hi[d] - lo[d]);
+  }
+  R cs = radius * (R(1) + R(1e-4)) + R(16) * std::numeric_limits<R>::epsilon() * (max_abs + max_extent);
+
+  // Cap the number of dense cells.
+  const double max_cells = static_cast<double>(kMaxCellsPerPoint * n + 4096);
+  for (;;) {
+    double cells = 1;
+    for (int d = 0; d < D; ++d) cells *= std::floor(static_cast<double>(hi[d] - lo[d]) / cs) + 1.0;
+    if (cells <= max_cells) break;
+    cs *= R(1.5);
+  }
+
+  origin_ = lo;
+  cell_size_ = cs;
+  inv_cell_ = R(1) / cs;
+  std::size_t cells = 1;
+  for (int d = 0; d < D; ++d) {
+    dims_[d] = static_cast<std::int64_t>(std::floor((hi[d] - lo[d]) * inv_cell_)) + 1;
+    cells *= static_cast<std::size_t>(dims_[d]);
+  }
+
+  // Counting sort by cell, stable in the point index.
+  cell_of_.resize(n);
+  parallel_for(n, [&](std::size_t i) { cell_of_[i] = static_cast<std::uint32_t>(linear(cell_coords(positions[i]))); });
+  cell_start_.assign(cells + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) ++cell_start_[cell_of_[i] + 1];
+  for (std::size_t c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
+  sorted_.resize(n);
+  // Scatter using a running cursor per cell (cell_start_ shifted by one, then restored).
+  for (std::size_t i = 0; i < n; ++i) sorted_[cell_start_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+  for (std::size_t c = cells; c > 0; --c) cell_start_[c] = cell_start_[c - 1];
+  cell_start_[0] = 0;
+}
+
+template class UniformGrid<2, float>;
+template class UniformGrid<2, double>;
+template class UniformGrid<3, float>;
+template class UniformGrid<3, double>;
+
+}  // namespace sph

@@ -1,0 +1,94 @@
+#pragma once
+/// \file UniformGrid: dense cells over the particles' bounding box, filled by counting sort.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <sph/core/vec.h>
+
+namespace sph {
+
+/// A uniform grid of square (cubic) cells over the bounding box of a point set, rebuilt from
+/// scratch by build(). Cells are dense (every cell in the box exists), particles are sorted by
+/// cell with a stable counting sort, so queries visit candidates in a fixed order.
+///
+/// The cell size is at least the search radius, so the neighbors of a point within the radius
+/// lie in the 3^D cells around its own. If the box would need more than `max_cells` cells (a
+/// stray particle far away), the cell size is enlarged: queries stay exact, only slower.
+template <int D, std::floating_point R>
+class UniformGrid {
+ public:
+  using V = Vec<D, R>;
+
+  /// Sorts `positions` into cells of size >= radius. radius must be > 0 and finite.
+  void build(std::span<const V> positions, R radius);
+
+  R cell_size() const { return cell_size_; }
+  std::size_t cell_count() const { return cell_start_.empty() ? 0 : cell_start_.size() - 1; }
+  const std::array<std::int64_t, D>& dims() const { return dims_; }
+
+  /// Calls f(j) for every point j (index into the built positions) in the 3^D cells around x,
+  /// in a deterministic order. Candidates may be farther than the radius: callers test distance.
+  template <class F>
+  void for_each_candidate(const V& x, F&& f) const {
+    std::array<std::int64_t, D> c = cell_coords(x);
+    std::array<std::int64_t, D> lo, hi;
+    for (int d = 0; d < D; ++d) {
+      lo[d] = c[d] > 0 ? c[d] - 1 : 0;
+      hi[d] = c[d] + 1 < dims_[d] ? c[d] + 1 : dims_[d] - 1;
+    }
+    if constexpr (D == 2) {
+      for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
+        const std::int64_t row = y * dims_[0];
+        visit_range(row + lo[0], row + hi[0], f);
+      }
+    } else {
+      for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+        for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
+          const std::int64_t row = (z * dims_[1] + y) * dims_[0];
+          visit_range(row + lo[0], row + hi[0], f);
+        }
+    }
+  }
+
+  /// Maximum number of dense cells, relative to the point count (plus a constant).
+  static constexpr std::size_t kMaxCellsPerPoint = 8;
+
+ private:
+  std::array<std::int64_t, D> cell_coords(const V& x) const {
+    std::array<std::int64_t, D> c;
+    for (int d = 0; d < D; ++d) {
+      auto k = static_cast<std::int64_t>((x[d] - origin_[d]) * inv_cell_);
+      c[d] = k < 0 ? 0 : (k >= dims_[d] ? dims_[d] - 1 : k);
+    }
+    return c;
+  }
+  std::size_t linear(const std::array<std::int64_t, D>& c) const {
+    std::int64_t l = c[D - 1];
+    for (int d = D - 2; d >= 0; --d) l = l * dims_[d] + c[d];
+    return static_cast<std::size_t>(l);
+  }
+  template <class F>
+  void visit_range(std::int64_t first_cell, std::int64_t last_cell, F& f) const {
+    // Cells of one row are contiguous in the sorted order: one loop covers the whole row.
+    const std::uint32_t b = cell_start_[static_cast<std::size_t>(first_cell)];
+    const std::uint32_t e = cell_start_[static_cast<std::size_t>(last_cell) + 1];
+    for (std::uint32_t k = b; k < e; ++k) f(sorted_[k]);
+  }
+
+  V origin_{};
+  R cell_size_ = 0;
+  R inv_cell_ = 0;
+  std::array<std::int64_t, D> dims_{};
+  std::vector<std::uint32_t> cell_start_;  // size cells + 1
+  std::vector<std::uint32_t> sorted_;      // point indices sorted by cell (stable)
+  std::vector<std::uint32_t> cell_of_;     // cell of each point
+};
+
+extern template class UniformGrid<2, float>;
+extern template class UniformGrid<2, double>;
+extern template class UniformGrid<3, float>;
+extern template class UniformGrid<3, double>;
+
+}  // namespace sph

@@ -1,0 +1,83 @@
+#include <sph/scene/builders.h>
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include <sph/core/error.h>
+
+namespace sph {
+
+namespace {
+template <int D>
+std::array<std::int64_t, D> lattice_counts(const Box<D>& b, double dx) {
+  std::array<std::int64_t, D> n;
+  for (int d = 0; d < D; ++d) n[d] = static_cast<std::int64_t>(std::floor((b.hi[d] - b.lo[d]) / dx + 1e-9));
+  return n;
+}
+}  // namespace
+
+template <int D>
+std::size_t count_block_particles(const SceneBody<D>& body) {
+  const double dx = 2.0 * body.sim.particle_radius;
+  std::size_t total = 0;
+  for (const auto& blk : body.blocks) {
+    std::size_t c = 1;
+    for (auto k : lattice_counts<D>(blk.box, dx)) c *= static_cast<std::size_t>(k);
+    total += c;
+  }
+  return total;
+}
+
+template <int D, std::floating_point R>
+ParticleSet<D, R> build_particles(const SceneBody<D>& body) {
+  const double dx = 2.0 * body.sim.particle_radius;
+  ParticleSet<D, R> ps;
+  ps.reserve(count_block_particles<D>(body));
+  for (std::size_t bi = 0; bi < body.blocks.size(); ++bi) {
+    const auto& blk = body.blocks[bi];
+    const auto n = lattice_counts<D>(blk.box, dx);
+    std::array<std::int64_t, 3> m{n[0], n[1], D == 3 ? n[D - 1] : 1};
+    for (std::int64_t k = 0; k < m[2]; ++k)
+      for (std::int64_t j = 0; j < m[1]; ++j)
+        for (std::int64_t i = 0; i < m[0]; ++i) {
+          Vec<D, double> x;
+          const std::int64_t idx[3] = {i, j, k};
+          for (int d = 0; d < D; ++d) x[d] = blk.box.lo[d] + (static_cast<double>(idx[d]) + 0.5) * dx;
+          for (std::size_t oi = 0; oi < body.sim.obstacles.size(); ++oi) {
+            const auto& o = body.sim.obstacles[oi];
+            bool in = true;
+            for (int d = 0; d < D; ++d) in = in && x[d] > o.lo[d] && x[d] < o.hi[d];
+            if (in)
+              throw Error(fmt::format("the fluid block overlaps Obstacles[{}]; move the block or the obstacle", oi),
+                          fmt::format("FluidBlocks[{}]", bi));
+          }
+          ps.add(vec_cast<R>(x), vec_cast<R>(blk.velocity), static_cast<R>(body.sim.particle_mass));
+        }
+  }
+  return ps;
+}
+
+template <int D, std::floating_point R>
+Simulation<D, R> make_simulation(const SceneDesc& desc) {
+  SPH_CHECK(desc.dimension == D, "scene dimension differs from the simulation's");
+  const SceneBody<D>& body = desc.body<D>();
+  try {
+    return Simulation<D, R>(body.sim, build_particles<D, R>(body));
+  } catch (const Error& e) {
+    throw Error(e.message(), e.where().empty() ? desc.source : desc.source + ": " + e.where());
+  }
+}
+
+template std::size_t count_block_particles<2>(const SceneBody<2>&);
+template std::size_t count_block_particles<3>(const SceneBody<3>&);
+#define SPH_INSTANTIATE(D, R)                                                     \
+  template ParticleSet<D, R> build_particles<D, R>(const SceneBody<D>&);          \
+  template Simulation<D, R> make_simulation<D, R>(const SceneDesc&);
+SPH_INSTANTIATE(2, float)
+SPH_INSTANTIATE(2, double)
+SPH_INSTANTIATE(3, float)
+SPH_INSTANTIATE(3, double)
+#undef SPH_INSTANTIATE
+
+}  // namespace sph

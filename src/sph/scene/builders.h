@@ -1,0 +1,24 @@
+#pragma once
+/// \file Builders: turn a SceneDesc into initial particles and a Simulation.
+
+#include <sph/core/particle_set.h>
+#include <sph/scene/scene_desc.h>
+#include <sph/solver/simulation.h>
+
+namespace sph {
+
+/// Fills each fluid block with particles on a lattice of spacing 2 * particleRadius, the first
+/// particle half a spacing inside the block's lower corner. Particles get ids in block order.
+/// Throws sph::Error if a block overlaps an obstacle.
+template <int D, std::floating_point R>
+ParticleSet<D, R> build_particles(const SceneBody<D>& body);
+
+/// The number of particles build_particles would create (without creating them).
+template <int D>
+std::size_t count_block_particles(const SceneBody<D>& body);
+
+/// Builds the initial particles and the simulation of a scene of dimension D.
+template <int D, std::floating_point R>
+Simulation<D, R> make_simulation(const SceneDesc& desc);
+
+}  // namespace sph

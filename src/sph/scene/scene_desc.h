@@ -1,0 +1,51 @@
+#pragma once
+/// \file SceneDesc: a scene file's content as plain structs (no JSON types), SI units.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <sph/solver/params.h>
+
+namespace sph {
+
+enum class Precision { Float, Double };
+
+/// A box of fluid filled with particles on a lattice of spacing 2 * particleRadius.
+template <int D>
+struct FluidBlockDesc {
+  Box<D> box;
+  Vec<D, double> velocity{};  ///< initial velocity, m/s
+};
+
+/// The dimension-specific part of a scene.
+template <int D>
+struct SceneBody {
+  SimulationParams<D> sim;
+  std::vector<FluidBlockDesc<D>> blocks;
+};
+
+struct SceneDesc {
+  int version = 1;
+  std::string name;         ///< short name, used for the default output directory
+  std::string description;
+  std::string source;       ///< file the scene was read from (or "<string>")
+  int dimension = 3;
+  Precision precision = Precision::Double;
+  std::int64_t steps = 0;               ///< number of time steps to run
+  std::int64_t output_every_steps = 0;  ///< write a frame every this many steps (0: none)
+  SceneBody<2> body2;  ///< filled when dimension == 2
+  SceneBody<3> body3;  ///< filled when dimension == 3
+  std::vector<std::string> warnings;    ///< non-fatal problems found while reading (e.g. dt close to a limit)
+
+  template <int D>
+  SceneBody<D>& body() {
+    if constexpr (D == 2) return body2; else return body3;
+  }
+  template <int D>
+  const SceneBody<D>& body() const {
+    if constexpr (D == 2) return body2; else return body3;
+  }
+};
+
+}  // namespace sph

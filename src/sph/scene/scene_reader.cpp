@@ -1,0 +1,467 @@
+#include <sph/scene/scene_reader.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <sph/core/error.h>
+#include <sph/solver/time_step.h>
+#include <sph/solver/wcsph.h>
+
+namespace sph {
+
+namespace {
+
+using json = nlohmann::json;
+
+/// Where values come from: the file, or --set flags for overridden key paths.
+struct Context {
+  std::string source;
+  std::set<std::string> overridden;
+
+  [[noreturn]] void fail(const std::string& path, const std::string& message) const {
+    std::string where = source;
+    for (const auto& o : overridden)
+      if (path == o || path.rfind(o + ".", 0) == 0 || path.rfind(o + "[", 0) == 0) {
+        where = source + " (--set " + o + ")";
+        break;
+      }
+    if (!path.empty()) where += ": " + path;
+    throw Error(message, where);
+  }
+};
+
+std::string describe(const json& j) {
+  std::string text = j.dump();
+  if (text.size() > 40) text = text.substr(0, 37) + "...";
+  return std::string(j.type_name()) + " " + text;
+}
+
+/// Reads the keys of one JSON object; every key it asks for is "known", and finish() rejects
+/// the others, listing the known ones.
+class ObjectReader {
+ public:
+  ObjectReader(const json& j, std::string path, const Context& ctx) : j_(j), path_(std::move(path)), ctx_(ctx) {
+    if (!j_.is_object()) ctx_.fail(path_, "expected an object { ... }, got " + describe(j_));
+  }
+
+  std::string child(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  const Context& ctx() const { return ctx_; }
+
+  const json* find(const std::string& key) {
+    known_.insert(key);
+    auto it = j_.find(key);
+    return it == j_.end() ? nullptr : &*it;
+  }
+  const json& require(const std::string& key, const std::string& what) {
+    const json* v = find(key);
+    if (!v) ctx_.fail(child(key), "missing required key; expected " + what);
+    return *v;
+  }
+
+  double number(const json& v, const std::string& key, const std::string& what) const {
+    if (!v.is_number()) ctx_.fail(child(key), "expected " + what + ", got " + describe(v));
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) ctx_.fail(child(key), "expected a finite number");
+    return x;
+  }
+  /// A number > 0 (or >= 0 if allow_zero).
+  double positive(const std::string& key, const std::string& what, std::optional<double> def = {},
+                  bool allow_zero = false) {
+    const json* v = find(key);
+    if (!v) {
+      if (def) return *def;
+      ctx_.fail(child(key), "missing required key; expected " + what);
+    }
+    const double x = number(*v, key, what);
+    if (allow_zero ? x < 0 : x <= 0) ctx_.fail(child(key), fmt::format("expected {}, got {}", what, x));
+    return x;
+  }
+  std::int64_t integer(const std::string& key, const std::string& what, std::int64_t min, std::int64_t max,
+                       std::optional<std::int64_t> def = {}) {
+    const json* v = find(key);
+    if (!v) {
+      if (def) return *def;
+      ctx_.fail(child(key), "missing required key; expected " + what);
+    }
+    if (!v->is_number_integer()) ctx_.fail(child(key), "expected " + what + ", got " + describe(*v));
+    if (v->is_number_unsigned() && v->get<std::uint64_t>() > static_cast<std::uint64_t>(max))
+      ctx_.fail(child(key), fmt::format("expected {}, got {}", what, v->get<std::uint64_t>()));
+    const auto x = v->get<std::int64_t>();
+    if (x < min || x > max) ctx_.fail(child(key), fmt::format("expected {}, got {}", what, x));
+    return x;
+  }
+  std::string string(const std::string& key, const std::string& what, std::optional<std::string> def = {}) {
+    const json* v = find(key);
+    if (!v) {
+      if (def) return *def;
+      ctx_.fail(child(key), "missing required key; expected " + what);
+    }
+    if (!v->is_string()) ctx_.fail(child(key), "expected " + what + ", got " + describe(*v));
+    return v->get<std::string>();
+  }
+  /// One of `choices` (strings).
+  std::string choice(const std::string& key, const std::vector<std::string>& choices, const std::string& def) {
+    std::string list;
+    for (const auto& c : choices) list += (list.empty() ? "\"" : ", \"") + c + "\"";
+    const std::string s = string(key, "one of " + list, def);
+    if (std::find(choices.begin(), choices.end(), s) == choices.end())
+      ctx_.fail(child(key), "unknown value \"" + s + "\"; expected one of " + list);
+    return s;
+  }
+  template <int D>
+  Vec<D, double> vec(const std::string& key, const std::string& what, std::optional<Vec<D, double>> def = {}) {
+    const json* v = find(key);
+    const std::string expect = fmt::format("{} as an array of {} numbers", what, D);
+    if (!v) {
+      if (def) return *def;
+      ctx_.fail(child(key), "missing required key; expected " + expect);
+    }
+    if (!v->is_array() || v->size() != static_cast<std::size_t>(D))
+      ctx_.fail(child(key), "expected " + expect + ", got " + describe(*v));
+    Vec<D, double> out;
+    for (int d = 0; d < D; ++d) {
+      const json& e = (*v)[static_cast<std::size_t>(d)];
+      if (!e.is_number() || !std::isfinite(e.get<double>()))
+        ctx_.fail(child(key), "expected " + expect + ", got " + describe(*v));
+      out[d] = e.get<double>();
+    }
+    return out;
+  }
+  /// An optional array of objects; calls f(reader) for each.
+  template <class F>
+  void array_of_objects(const std::string& key, F&& f) {
+    const json* v = find(key);
+    if (!v) return;
+    if (!v->is_array()) ctx_.fail(child(key), "expected an array of objects [ {...}, ... ], got " + describe(*v));
+    for (std::size_t i = 0; i < v->size(); ++i) {
+      ObjectReader r((*v)[i], fmt::format("{}[{}]", child(key), i), ctx_);
+      f(r, i);
+      r.finish();
+    }
+  }
+  /// Sub-object (optional: an absent key reads as an empty object).
+  template <class F>
+  void object(const std::string& key, F&& f) {
+    static const json empty = json::object();
+    const json* v = find(key);
+    ObjectReader r(v ? *v : empty, child(key), ctx_);
+    f(r);
+    r.finish();
+  }
+
+  void finish() const {
+    for (auto it = j_.begin(); it != j_.end(); ++it) {
+      if (known_.count(it.key())) continue;
+      std::string list;
+      for (const auto& k : known_) list += (list.empty() ? "" : ", ") + k;
+      ctx_.fail(child(it.key()), "unknown key; expected one of: " + list);
+    }
+  }
+
+ private:
+  const json& j_;
+  std::string path_;
+  const Context& ctx_;
+  std::set<std::string> known_;
+};
+
+/// Parses JSON text; syntax errors and duplicate keys name the line and column.
+json parse_json(const std::string& text, const std::string& source) {
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos)
+    throw Error("the scene file is empty; expected a JSON object (see docs/scene-format.md)", source);
+  // Duplicate keys would silently keep the last value: refuse them.
+  std::vector<std::set<std::string>> keys;
+  std::string duplicate;
+  json::parser_callback_t cb = [&](int /*depth*/, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::object_start) keys.emplace_back();
+    else if (event == json::parse_event_t::object_end) keys.pop_back();
+    else if (event == json::parse_event_t::key && !keys.empty() && duplicate.empty()) {
+      const auto k = parsed.get<std::string>();
+      if (!keys.back().insert(k).second) duplicate = k;
+    }
+    return true;
+  };
+  try {
+    json j = json::parse(text, cb, /*allow_exceptions=*/true, /*ignore_comments=*/false);
+    if (!duplicate.empty()) throw Error("key \"" + duplicate + "\" appears twice in the same object", source);
+    return j;
+  } catch (const json::parse_error& e) {
+    // e.byte is the 1-based offset of the offending character.
+    std::size_t line = 1, col = 1;
+    const std::size_t end = std::min<std::size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
+    for (std::size_t k = 0; k < end; ++k) {
+      if (text[k] == '\n') ++line, col = 1;
+      else ++col;
+    }
+    std::string what = e.what();
+    const auto pos = what.find("syntax error");
+    if (pos != std::string::npos) what = what.substr(pos);
+    throw Error("JSON syntax error: " + what, fmt::format("{}:{}:{}", source, line, col));
+  }
+}
+
+/// Applies "a.b[2].c=VALUE" overrides to the JSON document.
+void apply_overrides(json& doc, const std::vector<std::string>& overrides, Context& ctx) {
+  for (const std::string& o : overrides) {
+    const auto eq = o.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw Error("expected KEY=VALUE with KEY a key path such as Fluid.stiffness, got \"" + o + "\"", "--set");
+    const std::string key = o.substr(0, eq);
+    const std::string value_text = o.substr(eq + 1);
+    json value;
+    try {
+      value = json::parse(value_text);
+    } catch (const json::parse_error&) {
+      value = value_text;  // not JSON: a plain string such as adaptive
+    }
+    // Split the path into object keys and [index] parts.
+    std::vector<std::string> parts;
+    std::string cur;
+    for (std::size_t k = 0; k < key.size(); ++k) {
+      const char c = key[k];
+      if (c == '.' || c == '[') {
+        if (!cur.empty()) parts.push_back(cur);
+        cur.clear();
+        if (c == '[') cur = "[";
+      } else if (c == ']') {
+        parts.push_back(cur + "]");
+        cur.clear();
+      } else {
+        cur += c;
+      }
+    }
+    if (!cur.empty()) parts.push_back(cur);
+    json* node = &doc;
+    std::string path;
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      const std::string& p = parts[k];
+      const bool last = k + 1 == parts.size();
+      if (p.front() == '[') {
+        const std::string digits = p.substr(1, p.size() - 2);
+        if (!node->is_array())
+          throw Error("\"" + path + "\" is not an array, so it has no element " + p, "--set " + key);
+        std::size_t idx = 0;
+        try {
+          idx = std::stoul(digits);
+        } catch (const std::exception&) {
+          throw Error("bad array index " + p + "; expected [0], [1], ...", "--set " + key);
+        }
+        if (idx >= node->size())
+          throw Error(fmt::format("\"{}\" has {} elements; index {} does not exist", path, node->size(), idx),
+                      "--set " + key);
+        path += p;
+        node = &(*node)[idx];
+      } else {
+        if (!node->is_object())
+          throw Error("\"" + path + "\" is not an object, so it has no key \"" + p + "\"", "--set " + key);
+        path += (path.empty() ? "" : ".") + p;
+        if (!last && !node->contains(p)) (*node)[p] = json::object();
+        node = &(*node)[p];
+      }
+      (void)last;
+    }
+    if (parts.empty()) throw Error("empty key path", "--set");
+    *node = value;
+    ctx.overridden.insert(path);
+  }
+}
+
+template <int D>
+bool inside(const Vec<D, double>& x, const Box<D>& b) {
+  for (int d = 0; d < D; ++d)
+    if (x[d] < b.lo[d] || x[d] > b.hi[d]) return false;
+  return true;
+}
+
+template <int D>
+std::string vec_text(const Vec<D, double>& v) {
+  std::string s = "[";
+  for (int d = 0; d < D; ++d) s += fmt::format("{}{:g}", d ? ", " : "", v[d]);
+  return s + "]";
+}
+
+template <int D>
+Box<D> read_box(ObjectReader& r, const char* what) {
+  Box<D> b;
+  b.lo = r.vec<D>("start", std::string("the lower corner of the ") + what + ", m");
+  b.hi = r.vec<D>("end", std::string("the upper corner of the ") + what + ", m");
+  for (int d = 0; d < D; ++d)
+    if (!(b.hi[d] > b.lo[d]))
+      r.ctx().fail(r.child("end"), fmt::format("must be greater than \"start\" in every coordinate; got start {} "
+                                               "and end {}",
+                                               vec_text<D>(b.lo), vec_text<D>(b.hi)));
+  return b;
+}
+
+template <int D>
+void read_body(ObjectReader& root, SceneDesc& desc) {
+  SceneBody<D>& body = desc.body<D>();
+  SimulationParams<D>& sim = body.sim;
+  Vec<D, double> default_g{};
+  default_g[1] = -9.81;
+
+  root.object("Configuration", [&](ObjectReader& c) {
+    const std::string prec = c.choice("precision", {"double", "float"}, "double");
+    desc.precision = prec == "float" ? Precision::Float : Precision::Double;
+    sim.time_step = c.positive("timeStepSize", "a positive time step in seconds");
+    desc.steps = c.integer("numberOfSteps", "a number of steps between 1 and 1e12", 1, 1'000'000'000'000LL);
+    sim.particle_radius = c.positive("particleRadius", "a positive particle radius in metres");
+    sim.kernel_radius = c.positive("kernelRadius", "a positive kernel support radius h in metres",
+                                   4.0 * sim.particle_radius);
+    if (sim.kernel_radius <= 2.0 * sim.particle_radius)
+      c.ctx().fail(c.child("kernelRadius"),
+                   fmt::format("h = {:g} m must exceed the particle spacing 2 * particleRadius = {:g} m (typical: "
+                               "4 * particleRadius)",
+                               sim.kernel_radius, 2 * sim.particle_radius));
+    sim.gravity = c.vec<D>("gravitation", "the gravity acceleration in m/s^2", default_g);
+    sim.neighbors = parse_neighbor_mode(
+        c.choice("neighbors", {"standard", "adaptive", "verlet", "brute_force"}, "standard"), c.child("neighbors"));
+    sim.full_rebuild_period = static_cast<int>(
+        c.integer("fullRebuildPeriod", "a full-rebuild period of at least 1 step", 1, 1'000'000'000, 200));
+    desc.output_every_steps = c.integer("outputEveryNSteps", "a frame interval in steps (0: no frames)", 0,
+                                        1'000'000'000'000LL, std::max<std::int64_t>(1, desc.steps / 100));
+  });
+
+  root.object("Fluid", [&](ObjectReader& f) {
+    sim.fluid.rest_density = f.positive("density0", "a positive rest density in kg/m^" + std::to_string(D), 1000.0);
+    sim.fluid.stiffness = f.positive("stiffness", "a positive EOS stiffness k in m^2/s^2 (p = k (rho - rho0))");
+    sim.fluid.viscosity = f.positive("viscosity", "a viscosity >= 0 in Pa s", 0.0, true);
+    sim.fluid.negative_pressure =
+        f.choice("negativePressure", {"clamp", "allow"}, "clamp") == "allow" ? NegativePressure::Allow
+                                                                             : NegativePressure::Clamp;
+    const double spacing = 2.0 * sim.particle_radius;
+    sim.particle_mass = f.positive("particleMass", "a positive particle mass in kg",
+                                   lattice_mass<D>(sim.fluid.rest_density, spacing, sim.kernel_radius));
+  });
+
+  {
+    const json& cj = root.require("Container", "an object with \"start\" and \"end\" corners");
+    ObjectReader c(cj, root.child("Container"), root.ctx());
+    sim.container = read_box<D>(c, "container");
+    sim.walls.stiffness = c.positive("wallStiffness", "a positive wall spring stiffness in 1/s^2");
+    sim.walls.damping = c.positive("wallDamping", "a wall damping >= 0 in 1/s", 0.0, true);
+    c.finish();
+    for (int d = 0; d < D; ++d)
+      if (sim.container.hi[d] - sim.container.lo[d] < 4 * sim.particle_radius)
+        c.ctx().fail(c.child("end"), "the container must be at least two particle diameters wide in every direction");
+  }
+
+  const double dx = 2.0 * sim.particle_radius;
+  double total = 0;
+  root.array_of_objects("FluidBlocks", [&](ObjectReader& b, std::size_t) {
+    FluidBlockDesc<D> blk;
+    blk.box = read_box<D>(b, "fluid block");
+    blk.velocity = b.vec<D>("velocity", "the initial velocity in m/s", Vec<D, double>{});
+    if (!inside<D>(blk.box.lo, sim.container) || !inside<D>(blk.box.hi, sim.container))
+      b.ctx().fail(b.child("start"), fmt::format("the block {} .. {} is not inside the container {} .. {}",
+                                                 vec_text<D>(blk.box.lo), vec_text<D>(blk.box.hi),
+                                                 vec_text<D>(sim.container.lo), vec_text<D>(sim.container.hi)));
+    double count = 1;
+    for (int d = 0; d < D; ++d) count *= std::floor((blk.box.hi[d] - blk.box.lo[d]) / dx + 1e-9);
+    if (count < 1)
+      b.ctx().fail(b.child("end"), fmt::format("the block is thinner than one particle spacing ({:g} m) in some "
+                                               "direction, so it holds no particle",
+                                               dx));
+    total += count;
+    body.blocks.push_back(blk);
+  });
+
+  root.array_of_objects("Obstacles", [&](ObjectReader& o, std::size_t) {
+    Box<D> b = read_box<D>(o, "obstacle");
+    sim.obstacles.push_back(b);
+  });
+
+  root.array_of_objects("Emitters", [&](ObjectReader& e, std::size_t) {
+    EmitterParams<D> em;
+    em.origin = e.vec<D>("translation", "the center of the emitter nozzle in m");
+    Vec<D, double> dir = e.vec<D>("direction", "the emission direction (any non-zero length)");
+    if (norm(dir) <= 0) e.ctx().fail(e.child("direction"), "expected a non-zero direction vector");
+    em.direction = dir * (1.0 / norm(dir));
+    em.speed = e.positive("velocity", "a positive emission speed in m/s");
+    em.width = static_cast<int>(e.integer("width", "a nozzle width of 1 to 10000 particles", 1, 10000));
+    em.height = D == 3 ? static_cast<int>(e.integer("height", "a nozzle height of 1 to 10000 particles", 1, 10000))
+                       : 1;
+    em.spacing = dx;
+    em.every_steps = static_cast<int>(
+        e.integer("emitEveryNSteps", "an emission interval of at least 1 step", 1, 1'000'000'000, 16));
+    em.max_particles = e.integer("maxParticles", "a positive particle budget", 1, 4'000'000'000LL);
+    em.start_time = e.positive("emitStartTime", "a start time >= 0 in s", 0.0, true);
+    em.end_time = e.positive("emitEndTime", "an end time > 0 in s", std::numeric_limits<double>::infinity());
+    if (!inside<D>(em.origin, sim.container))
+      e.ctx().fail(e.child("translation"), fmt::format("the nozzle center {} is outside the container",
+                                                       vec_text<D>(em.origin)));
+    // Each batch must have left the nozzle before the next one is placed there.
+    const double travel = em.speed * em.every_steps * sim.time_step;
+    if (travel < dx)
+      e.ctx().fail(e.child("velocity"),
+                   fmt::format("a batch moves {:.3g} m in {} steps, less than the particle spacing {:.3g} m, so "
+                               "batches would overlap; raise velocity to at least {:.3g} m/s or emitEveryNSteps",
+                               travel, em.every_steps, dx, dx / (em.every_steps * sim.time_step)));
+    total += static_cast<double>(em.max_particles);
+    sim.emitters.push_back(em);
+  });
+
+  if (total < 1) root.ctx().fail("FluidBlocks", "the scene has no particles: add a FluidBlocks entry or an Emitters entry");
+  if (total > 2e9)
+    root.ctx().fail("FluidBlocks", fmt::format("the scene would hold {:.3g} particles; at most 2e9 are supported", total));
+
+  for (const std::string& w : check_time_step<D>(sim)) desc.warnings.push_back(w);
+}
+
+json load(const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
+          Context& ctx) {
+  json doc = parse_json(text, source);
+  if (!doc.is_object()) throw Error("expected a JSON object { ... } at the top level, got " + describe(doc), source);
+  apply_overrides(doc, overrides, ctx);
+  return doc;
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error("cannot open the scene file (does it exist and is it readable?)", path);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw Error("cannot read the scene file", path);
+  return ss.str();
+}
+
+}  // namespace
+
+SceneDesc parse_scene(const std::string& text, const std::string& source, const std::vector<std::string>& overrides) {
+  Context ctx{source, {}};
+  const json doc = load(text, source, overrides, ctx);
+  SceneDesc desc;
+  desc.source = source;
+  ObjectReader root(doc, "", ctx);
+  desc.version = static_cast<int>(root.integer("version", "the scene format version 1", 1, 1));
+  desc.name = root.string("name", "a scene name (letters, digits, - and _)", "scene");
+  if (desc.name.empty() || desc.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_") != std::string::npos)
+    ctx.fail("name", "expected a non-empty name of letters, digits, - and _, got \"" + desc.name + "\"");
+  desc.description = root.string("description", "a description", "");
+  root.string("units", "\"SI\"", "SI");
+  if (doc.contains("units") && doc["units"] != "SI") ctx.fail("units", "only \"SI\" units are supported");
+  desc.dimension = static_cast<int>(root.integer("dimension", "the dimension 2 or 3", 2, 3));
+  if (desc.dimension == 2) read_body<2>(root, desc);
+  else read_body<3>(root, desc);
+  root.finish();
+  return desc;
+}
+
+SceneDesc read_scene_file(const std::string& path, const std::vector<std::string>& overrides) {
+  return parse_scene(read_text(path), path, overrides);
+}
+
+std::string effective_scene_json(const std::string& text, const std::string& source,
+                                 const std::vector<std::string>& overrides) {
+  Context ctx{source, {}};
+  return load(text, source, overrides, ctx).dump(2);
+}
+
+}  // namespace sph

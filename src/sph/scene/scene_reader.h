@@ -1,0 +1,25 @@
+#pragma once
+/// \file Strict reader of JSON scene files (format: docs/scene-format.md).
+
+#include <string>
+#include <vector>
+
+#include <sph/scene/scene_desc.h>
+
+namespace sph {
+
+/// Reads and validates a scene file. `overrides` are "KEY.PATH=VALUE" strings (the --set flag)
+/// applied to the JSON before validation; VALUE is JSON if it parses as JSON, else a string.
+/// Throws sph::Error naming the file, line and column (syntax errors) or the key path and what
+/// is expected (unknown keys, wrong types, missing or impossible values).
+SceneDesc read_scene_file(const std::string& path, const std::vector<std::string>& overrides = {});
+
+/// Same as read_scene_file for scene text held in memory; `source` names it in messages.
+SceneDesc parse_scene(const std::string& text, const std::string& source,
+                      const std::vector<std::string>& overrides = {});
+
+/// The effective scene (after overrides) as JSON text, pretty-printed; for summaries.
+std::string effective_scene_json(const std::string& text, const std::string& source,
+                                 const std::vector<std::string>& overrides = {});
+
+}  // namespace sph

@@ -1,0 +1,76 @@
+#pragma once
+/// \file SimulationParams: everything the solver needs, as plain values in SI units.
+/// Scene files are turned into these by the scene layer; the solver never reads files.
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include <sph/core/vec.h>
+#include <sph/neighbors/strategy.h>
+
+namespace sph {
+
+/// What the equation of state does with a density below the rest density.
+enum class NegativePressure {
+  Clamp,  ///< p = max(0, k (rho - rho0)): no tension; free surfaces stay smooth (default)
+  Allow,  ///< p = k (rho - rho0) as in the paper: slight tension, clumping at free surfaces
+};
+
+/// Axis-aligned box [lo, hi], m.
+template <int D>
+struct Box {
+  Vec<D, double> lo, hi;
+};
+
+/// Weakly compressible fluid: EOS p = k (rho - rho0).
+struct FluidParams {
+  double rest_density = 1000;  ///< rho0, kg/m^D
+  double stiffness = 1000;     ///< k, m^2/s^2 (p in Pa per kg/m^3); the sound speed is sqrt(k)
+  double viscosity = 0;        ///< dynamic viscosity mu of Eq. 6, Pa s (2D: kg/s)
+  NegativePressure negative_pressure = NegativePressure::Clamp;
+};
+
+/// Damped penalty springs at the container walls and obstacle faces. They act on particles
+/// closer than one particle radius to a wall, as an acceleration along the wall normal:
+/// a_n = max(0, stiffness * penetration - damping * v_n).
+struct WallParams {
+  double stiffness = 1e5;  ///< 1/s^2 (force per unit mass per metre of penetration)
+  double damping = 100;    ///< 1/s
+};
+
+/// An emitter: a rectangular nozzle of width x height particles (height ignored in 2D) at
+/// spacing `spacing`, centered at `origin`, facing `direction`, adding one layer of particles
+/// moving at `speed` every `every_steps` steps, from `start_time` until `max_particles` were
+/// emitted or `end_time` passed.
+template <int D>
+struct EmitterParams {
+  Vec<D, double> origin{};
+  Vec<D, double> direction{};  ///< unit vector
+  double speed = 1;            ///< m/s
+  int width = 1;
+  int height = 1;
+  double spacing = 0;          ///< m
+  int every_steps = 16;
+  std::int64_t max_particles = 0;
+  double start_time = 0;
+  double end_time = std::numeric_limits<double>::infinity();
+};
+
+template <int D>
+struct SimulationParams {
+  double time_step = 1e-4;        ///< dt, s (fixed)
+  double particle_radius = 0.01;  ///< m; particles are spaced 2 radii apart initially
+  double kernel_radius = 0.04;    ///< h, m
+  double particle_mass = 0;       ///< kg (same for all particles)
+  Vec<D, double> gravity{};       ///< m/s^2
+  FluidParams fluid;
+  WallParams walls;
+  Box<D> container;               ///< closed box holding the fluid
+  std::vector<Box<D>> obstacles;  ///< static solid boxes
+  std::vector<EmitterParams<D>> emitters;
+  NeighborMode neighbors = NeighborMode::Standard;
+  int full_rebuild_period = 200;
+};
+
+}  // namespace sph

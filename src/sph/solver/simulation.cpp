@@ -1,0 +1,198 @@
+#include <sph/solver/simulation.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include <sph/core/error.h>
+#include <sph/core/parallel.h>
+#include <sph/core/timer.h>
+#include <sph/solver/wcsph.h>
+
+namespace sph {
+
+namespace {
+
+/// Two unit vectors orthogonal to dir (and to each other); in 2D only the first is used.
+template <int D>
+std::pair<Vec<D, double>, Vec<D, double>> nozzle_axes(const Vec<D, double>& dir) {
+  Vec<D, double> u{}, w{};
+  if constexpr (D == 2) {
+    u[0] = -dir[1];
+    u[1] = dir[0];
+  } else {
+    // Pick the coordinate axis least aligned with dir, then Gram-Schmidt.
+    int k = 0;
+    for (int d = 1; d < 3; ++d)
+      if (std::abs(dir[d]) < std::abs(dir[k])) k = d;
+    Vec<D, double> e{};
+    e[k] = 1;
+    u = e - dir * dot(e, dir);
+    u *= 1.0 / norm(u);
+    w[0] = dir[1] * u[2] - dir[2] * u[1];
+    w[1] = dir[2] * u[0] - dir[0] * u[2];
+    w[2] = dir[0] * u[1] - dir[1] * u[0];
+  }
+  return {u, w};
+}
+
+/// Deterministic sum over particles: fixed chunks, partial sums added in chunk order.
+template <class F>
+double chunked_sum(std::size_t n, F&& term) {
+  std::vector<double> partial(chunk_count(n), 0.0);
+  parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
+    double s = 0;
+    for (std::size_t i = b; i < e; ++i) s += term(i);
+    partial[c] = s;
+  });
+  double s = 0;
+  for (double p : partial) s += p;
+  return s;
+}
+
+}  // namespace
+
+template <int D, std::floating_point R>
+Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> particles)
+    : params_(std::move(params)), particles_(std::move(particles)), emitters_(params_.emitters.size()) {
+  NeighborOptions opt;
+  opt.radius = params_.kernel_radius;
+  opt.full_rebuild_period = params_.full_rebuild_period;
+  neighbors_ = make_neighbor_strategy<D, R>(params_.neighbors, opt);
+  double extent = 0;
+  for (int d = 0; d < D; ++d) extent = std::max(extent, params_.container.hi[d] - params_.container.lo[d]);
+  speed_limit_ = 20.0 * std::sqrt(params_.fluid.stiffness) + std::sqrt(2.0 * norm(params_.gravity) * extent);
+  std::int64_t capacity = static_cast<std::int64_t>(particles_.size());
+  for (const auto& e : params_.emitters) capacity += e.max_particles;
+  particles_.reserve(static_cast<std::size_t>(capacity));
+}
+
+template <int D, std::floating_point R>
+std::size_t Simulation<D, R>::emit() {
+  std::size_t added = 0;
+  const double t = time();
+  for (std::size_t k = 0; k < params_.emitters.size(); ++k) {
+    const EmitterParams<D>& e = params_.emitters[k];
+    EmitterState& s = emitters_[k];
+    if (s.emitted >= e.max_particles || t > e.end_time) continue;
+    if (s.next_step < 0) {
+      if (t + 0.5 * params_.time_step < e.start_time) continue;
+      s.next_step = steps_;
+    }
+    if (steps_ != s.next_step) continue;
+    s.next_step += e.every_steps;
+    const auto [u, w] = nozzle_axes<D>(e.direction);
+    const int rows = D == 3 ? e.height : 1;
+    const Vec<D, R> vel = vec_cast<R>(e.direction * e.speed);
+    for (int b = 0; b < rows && s.emitted < e.max_particles; ++b)
+      for (int a = 0; a < e.width && s.emitted < e.max_particles; ++a) {
+        Vec<D, double> x = e.origin + u * ((a - 0.5 * (e.width - 1)) * e.spacing);
+        if constexpr (D == 3) x += w * ((b - 0.5 * (e.height - 1)) * e.spacing);
+        particles_.add(vec_cast<R>(x), vel, static_cast<R>(params_.particle_mass));
+        ++s.emitted;
+        ++added;
+      }
+  }
+  return added;
+}
+
+template <int D, std::floating_point R>
+const StepInfo& Simulation<D, R>::step() {
+  StepInfo info;
+  info.step = steps_;
+  info.emitted = emit();
+
+  const R dt = static_cast<R>(params_.time_step);
+  const R h = static_cast<R>(params_.kernel_radius);
+  neighbors_->update(particles_, dt);
+  info.neighbors = neighbors_->counters();
+  info.seconds.grid = info.neighbors.grid_seconds;
+  info.seconds.lists = info.neighbors.lists_seconds;
+
+  Stopwatch watch;
+  const NeighborLists& lists = neighbors_->lists();
+  compute_density_pressure(particles_, lists, h, params_.fluid);
+  info.seconds.density = watch.lap();
+  compute_fluid_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity));
+  add_wall_accelerations(particles_, params_.container, params_.obstacles, static_cast<R>(params_.particle_radius),
+                         params_.walls);
+  info.seconds.forces = watch.lap();
+  integrate_symplectic_euler(particles_, dt);
+  ++steps_;
+  check_state();
+  info.seconds.integrate = watch.lap();
+
+  info.time = time();
+  info.particles = particles_.size();
+  info_ = info;
+  return info_;
+}
+
+template <int D, std::floating_point R>
+void Simulation<D, R>::check_state() const {
+  const std::size_t n = particles_.size();
+  const double limit2 = speed_limit_ * speed_limit_;
+  // Find the first bad particle in index order (deterministic message).
+  std::vector<std::uint8_t> bad(chunk_count(n), 0);
+  parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i)
+      if (!all_finite(particles_.position[i]) || !all_finite(particles_.velocity[i]) ||
+          static_cast<double>(norm2(particles_.velocity[i])) > limit2) {
+        bad[c] = 1;
+        return;
+      }
+  });
+  for (std::size_t c = 0; c < bad.size(); ++c) {
+    if (!bad[c]) continue;
+    for (std::size_t i = c * kChunkSize; i < std::min(n, (c + 1) * kChunkSize); ++i) {
+      const auto& x = particles_.position[i];
+      const auto& v = particles_.velocity[i];
+      std::string what;
+      if (!all_finite(x))
+        what = "position is not finite";
+      else if (!all_finite(v))
+        what = "velocity is not finite";
+      else if (static_cast<double>(norm2(v)) > limit2)
+        what = fmt::format("speed {:.4g} m/s exceeds the blow-up limit {:.4g} m/s", static_cast<double>(norm(v)),
+                           speed_limit_);
+      else
+        continue;
+      throw Error(fmt::format("simulation blew up at step {} (t = {:.6g} s): particle id {}: {}; density {:.6g}, "
+                              "pressure {:.6g}. Lower Configuration.timeStepSize or raise Fluid.viscosity",
+                              steps_ - 1, time(), particles_.id[i], what, static_cast<double>(particles_.density[i]),
+                              static_cast<double>(particles_.pressure[i])));
+    }
+  }
+}
+
+template <int D, std::floating_point R>
+double Simulation<D, R>::kinetic_energy() const {
+  return chunked_sum(particles_.size(), [&](std::size_t i) {
+    return 0.5 * static_cast<double>(particles_.mass[i]) * static_cast<double>(norm2(particles_.velocity[i]));
+  });
+}
+
+template <int D, std::floating_point R>
+double Simulation<D, R>::max_speed() const {
+  R m = 0;
+  for (const auto& v : particles_.velocity) m = std::max(m, norm2(v));
+  return std::sqrt(static_cast<double>(m));
+}
+
+template <int D, std::floating_point R>
+Vec<D, double> Simulation<D, R>::momentum() const {
+  Vec<D, double> p{};
+  for (int d = 0; d < D; ++d)
+    p[d] = chunked_sum(particles_.size(), [&](std::size_t i) {
+      return static_cast<double>(particles_.mass[i]) * static_cast<double>(particles_.velocity[i][d]);
+    });
+  return p;
+}
+
+template class Simulation<2, float>;
+template class Simulation<2, double>;
+template class Simulation<3, float>;
+template class Simulation<3, double>;
+
+}  // namespace sph

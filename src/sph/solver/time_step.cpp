@@ -1,0 +1,56 @@
+#include <sph/solver/time_step.h>
+
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include <sph/core/error.h>
+
+namespace sph {
+
+template <int D>
+std::vector<TimeStepLimit> time_step_limits(const SimulationParams<D>& p) {
+  std::vector<TimeStepLimit> out;
+  const double dt = p.time_step;
+  const double h = p.kernel_radius;
+  auto add = [&](const char* name, double warn, double refuse) {
+    out.push_back({name, dt / warn, warn, refuse});
+  };
+  const double c = std::sqrt(p.fluid.stiffness);
+  if (c > 0) add("acoustic CFL (dt <= 0.4 h / sqrt(stiffness))", 0.4 * h / c, 1.0 * h / c);
+  const double nu = p.fluid.viscosity / p.fluid.rest_density;
+  if (nu > 0) add("viscous diffusion (dt <= 0.125 h^2 rho0 / viscosity)", 0.125 * h * h / nu, 0.5 * h * h / nu);
+  if (p.walls.stiffness > 0) {
+    const double w = std::sqrt(p.walls.stiffness);
+    add("wall spring (dt <= 0.5 / sqrt(wall stiffness))", 0.5 / w, 1.5 / w);
+  }
+  if (p.walls.damping > 0) add("wall damping (dt <= 0.5 / wall damping)", 0.5 / p.walls.damping, 1.5 / p.walls.damping);
+  const double g = norm(p.gravity);
+  if (g > 0) add("gravity (dt <= 0.25 sqrt(h / |g|))", 0.25 * std::sqrt(h / g), std::sqrt(h / g));
+  return out;
+}
+
+template <int D>
+std::vector<std::string> check_time_step(const SimulationParams<D>& p) {
+  std::vector<std::string> warnings;
+  for (const auto& l : time_step_limits(p)) {
+    if (p.time_step > l.dt_refuse)
+      throw Error(fmt::format("time step {:.4g} s is unstable by the {} criterion: it must be at most {:.4g} s "
+                              "(and at most {:.4g} s to run without a warning); lower timeStepSize or the "
+                              "parameter named",
+                              p.time_step, l.name, l.dt_refuse, l.dt_warn),
+                  "Configuration.timeStepSize");
+    if (p.time_step > l.dt_warn)
+      warnings.push_back(fmt::format("time step {:.4g} s exceeds the {} limit of {:.4g} s; the run may be unstable",
+                                     p.time_step, l.name, l.dt_warn));
+  }
+  return warnings;
+}
+
+template std::vector<TimeStepLimit> time_step_limits<2>(const SimulationParams<2>&);
+template std::vector<TimeStepLimit> time_step_limits<3>(const SimulationParams<3>&);
+template std::vector<std::string> check_time_step<2>(const SimulationParams<2>&);
+template std::vector<std::string> check_time_step<3>(const SimulationParams<3>&);
+
+}  // namespace sph

@@ -1,0 +1,32 @@
+#pragma once
+/// \file Time-step checks: warn when dt is close to a stability limit, refuse it past one.
+
+#include <string>
+#include <vector>
+
+#include <sph/solver/params.h>
+
+namespace sph {
+
+/// One stability criterion evaluated for a scene.
+struct TimeStepLimit {
+  std::string name;    ///< what limits the step, e.g. "acoustic CFL"
+  double ratio;        ///< dt relative to the limit: dt / dt_limit
+  double dt_warn;      ///< largest dt that passes without a warning, s
+  double dt_refuse;    ///< dt above this is refused, s
+};
+
+/// Evaluates the stability limits of explicit WCSPH with penalty walls for these params:
+///  - acoustic CFL: dt <= 0.4 h / c (warn), 1.0 h / c (refuse), with sound speed c = sqrt(k);
+///  - viscous diffusion: dt <= 0.125 h^2 / nu (warn), 0.5 h^2 / nu (refuse), nu = mu / rho0;
+///  - wall springs: dt sqrt(k_w) <= 0.5 (warn), 1.5 (refuse); dt c_w <= 0.5 (warn), 1.5 (refuse);
+///  - gravity: dt <= 0.25 sqrt(h / |g|) (warn), 1.0 sqrt(h / |g|) (refuse).
+template <int D>
+std::vector<TimeStepLimit> time_step_limits(const SimulationParams<D>& p);
+
+/// Returns warning lines for limits exceeded; throws sph::Error naming the criterion, the
+/// largest acceptable dt and the key to change when a hard limit is exceeded.
+template <int D>
+std::vector<std::string> check_time_step(const SimulationParams<D>& p);
+
+}  // namespace sph

@@ -1,0 +1,140 @@
+#include <sph/solver/wcsph.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include <sph/core/kernels.h>
+#include <sph/core/parallel.h>
+
+namespace sph {
+
+template <int D, std::floating_point R>
+void compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid) {
+  const Poly6Kernel<D, R> poly6(h);
+  const R w0 = poly6.w_zero();
+  const R rho0 = static_cast<R>(fluid.rest_density);
+  const R k = static_cast<R>(fluid.stiffness);
+  const bool clamp = fluid.negative_pressure == NegativePressure::Clamp;
+  parallel_for(ps.size(), [&](std::size_t i) {
+    const Vec<D, R> xi = ps.position[i];
+    R rho = ps.mass[i] * w0;
+    for (std::uint32_t j : lists.of(i)) rho += ps.mass[j] * poly6.w_r2(norm2(xi - ps.position[j]));
+    ps.density[i] = rho;
+    const R p = k * (rho - rho0);
+    ps.pressure[i] = clamp ? std::max(p, R(0)) : p;
+  });
+}
+
+template <int D, std::floating_point R>
+void compute_fluid_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
+                                 const Vec<D, R>& gravity) {
+  const SpikyKernel<D, R> spiky(h);
+  const ViscosityKernel<D, R> visc(h);
+  const R mu = static_cast<R>(fluid.viscosity);
+  parallel_for(ps.size(), [&](std::size_t i) {
+    const Vec<D, R> xi = ps.position[i];
+    const Vec<D, R> vi = ps.velocity[i];
+    const R pi = ps.pressure[i];
+    Vec<D, R> f{};
+    for (std::uint32_t j : lists.of(i)) {
+      const Vec<D, R> rij = xi - ps.position[j];
+      const R r = norm(rij);
+      if (r >= h) continue;
+      const R mj_over_rhoj = ps.mass[j] / ps.density[j];
+      f += spiky.gradient(rij, r) * (-mj_over_rhoj * (pi + ps.pressure[j]) * R(0.5));
+      f += (ps.velocity[j] - vi) * (mu * mj_over_rhoj * visc.laplacian(r));
+    }
+    ps.acceleration[i] = gravity + f * (R(1) / ps.density[i]);
+  });
+}
+
+namespace {
+/// Acceleration of a penalty contact along unit axis normal sign*e_d: never attractive.
+template <std::floating_point R>
+R contact(R penetration, R normal_velocity, R ks, R kd) {
+  return std::max(R(0), ks * penetration - kd * normal_velocity);
+}
+}  // namespace
+
+template <int D, std::floating_point R>
+void add_wall_accelerations(ParticleSet<D, R>& ps, const Box<D>& container, const std::vector<Box<D>>& obstacles,
+                            R particle_radius, const WallParams& walls) {
+  const R ks = static_cast<R>(walls.stiffness);
+  const R kd = static_cast<R>(walls.damping);
+  const Vec<D, R> lo = vec_cast<R>(container.lo), hi = vec_cast<R>(container.hi);
+  std::vector<Box<D>> const& obs = obstacles;
+  parallel_for(ps.size(), [&](std::size_t i) {
+    const Vec<D, R> x = ps.position[i];
+    const Vec<D, R> v = ps.velocity[i];
+    Vec<D, R> a{};
+    // Container: particles inside the box, pushed back from each of its 2D faces.
+    for (int d = 0; d < D; ++d) {
+      const R pen_lo = lo[d] + particle_radius - x[d];
+      if (pen_lo > 0) a[d] += contact(pen_lo, v[d], ks, kd);
+      const R pen_hi = x[d] - (hi[d] - particle_radius);
+      if (pen_hi > 0) a[d] -= contact(pen_hi, -v[d], ks, kd);
+    }
+    // Obstacles: a particle inside the box grown by one radius is pushed out through the
+    // nearest face.
+    for (const Box<D>& b : obs) {
+      R best = std::numeric_limits<R>::max();
+      int best_d = -1;
+      R best_sign = 0;
+      bool inside = true;
+      for (int d = 0; d < D && inside; ++d) {
+        const R to_lo = x[d] - (static_cast<R>(b.lo[d]) - particle_radius);
+        const R to_hi = (static_cast<R>(b.hi[d]) + particle_radius) - x[d];
+        if (to_lo <= 0 || to_hi <= 0) {
+          inside = false;
+          break;
+        }
+        if (to_lo < best) best = to_lo, best_d = d, best_sign = R(-1);
+        if (to_hi < best) best = to_hi, best_d = d, best_sign = R(1);
+      }
+      if (!inside) continue;
+      a[best_d] += best_sign * contact(best, best_sign * v[best_d], ks, kd);
+    }
+    ps.acceleration[i] += a;
+  });
+}
+
+template <int D, std::floating_point R>
+void integrate_symplectic_euler(ParticleSet<D, R>& ps, R dt) {
+  parallel_for(ps.size(), [&](std::size_t i) {
+    ps.velocity[i] += ps.acceleration[i] * dt;
+    ps.position[i] += ps.velocity[i] * dt;
+  });
+}
+
+template <int D>
+double lattice_mass(double rest_density, double spacing, double h) {
+  const Poly6Kernel<D, double> poly6(h);
+  const int n = static_cast<int>(std::ceil(h / spacing)) + 1;
+  double sum = 0;
+  if constexpr (D == 2) {
+    for (int a = -n; a <= n; ++a)
+      for (int b = -n; b <= n; ++b) sum += poly6.w(spacing * std::sqrt(double(a * a + b * b)));
+  } else {
+    for (int a = -n; a <= n; ++a)
+      for (int b = -n; b <= n; ++b)
+        for (int c = -n; c <= n; ++c) sum += poly6.w(spacing * std::sqrt(double(a * a + b * b + c * c)));
+  }
+  return rest_density / sum;
+}
+
+#define SPH_INSTANTIATE(D, R)                                                                                   \
+  template void compute_density_pressure<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&); \
+  template void compute_fluid_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R,                 \
+                                                  const FluidParams&, const Vec<D, R>&);                        \
+  template void add_wall_accelerations<D, R>(ParticleSet<D, R>&, const Box<D>&, const std::vector<Box<D>>&, R,  \
+                                             const WallParams&);                                                \
+  template void integrate_symplectic_euler<D, R>(ParticleSet<D, R>&, R);
+SPH_INSTANTIATE(2, float)
+SPH_INSTANTIATE(2, double)
+SPH_INSTANTIATE(3, float)
+SPH_INSTANTIATE(3, double)
+#undef SPH_INSTANTIATE
+template double lattice_mass<2>(double, double, double);
+template double lattice_mass<3>(double, double, double);
+
+}  // namespace sph

@@ -1,0 +1,40 @@
+#pragma once
+/// \file The WCSPH operators of the paper (Section 3), as loops that gather into particle i.
+
+#include <sph/core/particle_set.h>
+#include <sph/neighbors/neighbor_lists.h>
+#include <sph/solver/params.h>
+
+namespace sph {
+
+/// Paper Eq. 4 and the EOS: rho_i = m_i W(0) + sum_j m_j W_poly6(|x_i - x_j|), then
+/// p_i = k (rho_i - rho0), clamped at 0 when negative pressure is NegativePressure::Clamp.
+template <int D, std::floating_point R>
+void compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid);
+
+/// Accelerations from pressure (Eq. 5, symmetric (p_i + p_j) / 2 rho_j form, spiky gradient),
+/// viscosity (Eq. 6 with (v_j - v_i), viscosity-kernel Laplacian) and gravity:
+///   a_i = g + (1 / rho_i) sum_j m_j [ -(p_i + p_j) / (2 rho_j) grad W_spiky(x_i - x_j)
+///                                      + mu (v_j - v_i) / rho_j lap W_visc(|x_i - x_j|) ].
+/// Dividing the force density by rho_i makes every pair term antisymmetric (m_i a_i = -m_j a_j
+/// for each pair), so total momentum is conserved when lists are symmetric.
+template <int D, std::floating_point R>
+void compute_fluid_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
+                                 const Vec<D, R>& gravity);
+
+/// Adds the damped penalty accelerations of the container walls and of the obstacles.
+/// A particle interacts with a wall plane when closer than `particle_radius` to it.
+template <int D, std::floating_point R>
+void add_wall_accelerations(ParticleSet<D, R>& ps, const Box<D>& container, const std::vector<Box<D>>& obstacles,
+                            R particle_radius, const WallParams& walls);
+
+/// Symplectic Euler: v += dt a; x += dt v.
+template <int D, std::floating_point R>
+void integrate_symplectic_euler(ParticleSet<D, R>& ps, R dt);
+
+/// Particle mass such that a particle inside a lattice of spacing dx (square in 2D, cubic in
+/// 3D) has exactly density rho0 under the poly6 sum of Eq. 4 with support h.
+template <int D>
+double lattice_mass(double rest_density, double spacing, double h);
+
+}  // namespace sph

@@ -336,6 +336,9 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
     sim.fluid.negative_pressure =
         f.choice("negativePressure", {"clamp", "allow"}, "clamp") == "allow" ? NegativePressure::Allow
                                                                              : NegativePressure::Clamp;
+    sim.fluid.pressure_force = f.choice("pressureForce", {"paper", "symmetric"}, "paper") == "symmetric"
+                                   ? PressureForce::Symmetric
+                                   : PressureForce::Paper;
     const double spacing = 2.0 * sim.particle_radius;
     sim.particle_mass = f.positive("particleMass", "a positive particle mass in kg",
                                    lattice_mass<D>(sim.fluid.rest_density, spacing, sim.kernel_radius));

@@ -23,12 +23,24 @@ struct Box {
   Vec<D, double> lo, hi;
 };
 
+/// How the pressure force is discretized.
+enum class PressureForce {
+  /// Paper Eq. 5 (Mueller et al. 2003): -sum_j m_j (p_i + p_j) / (2 rho_j) grad W_ij, divided
+  /// by rho_i. In the interior this approximates -grad(p) / 2: a tank settles at about twice
+  /// rho0 g depth (docs/physics.md). Default, as the paper's method.
+  Paper,
+  /// Monaghan's symmetric form: -sum_j m_j (p_i / rho_i^2 + p_j / rho_j^2) grad W_ij, which
+  /// approximates -grad(p) / rho: a tank settles at rho0 g depth.
+  Symmetric,
+};
+
 /// Weakly compressible fluid: EOS p = k (rho - rho0).
 struct FluidParams {
   double rest_density = 1000;  ///< rho0, kg/m^D
   double stiffness = 1000;     ///< k, m^2/s^2 (p in Pa per kg/m^3); the sound speed is sqrt(k)
   double viscosity = 0;        ///< dynamic viscosity mu of Eq. 6, Pa s (2D: kg/s)
   NegativePressure negative_pressure = NegativePressure::Clamp;
+  PressureForce pressure_force = PressureForce::Paper;
 };
 
 /// Damped penalty springs at the container walls and obstacle faces. They act on particles

@@ -66,6 +66,11 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
   std::int64_t capacity = static_cast<std::int64_t>(particles_.size());
   for (const auto& e : params_.emitters) capacity += e.max_particles;
   particles_.reserve(static_cast<std::size_t>(capacity));
+  // Density and pressure of the initial state, so that frame 0 shows real values.
+  if (!particles_.empty()) {
+    neighbors_->update(particles_, static_cast<R>(params_.time_step));
+    compute_density_pressure(particles_, neighbors_->lists(), static_cast<R>(params_.kernel_radius), params_.fluid);
+  }
 }
 
 template <int D, std::floating_point R>

@@ -31,20 +31,27 @@ void compute_fluid_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lis
   const SpikyKernel<D, R> spiky(h);
   const ViscosityKernel<D, R> visc(h);
   const R mu = static_cast<R>(fluid.viscosity);
+  const bool paper = fluid.pressure_force == PressureForce::Paper;
   parallel_for(ps.size(), [&](std::size_t i) {
     const Vec<D, R> xi = ps.position[i];
     const Vec<D, R> vi = ps.velocity[i];
-    const R pi = ps.pressure[i];
-    Vec<D, R> f{};
+    const R inv_rhoi = R(1) / ps.density[i];
+    // Pressure term P_ij, symmetric in i and j, so that each pair's contributions are equal
+    // and opposite: the paper's (p_i + p_j) / (2 rho_i rho_j), or p_i / rho_i^2 + p_j / rho_j^2.
+    const R pi_half = R(0.5) * ps.pressure[i] * inv_rhoi;
+    const R pi_sym = ps.pressure[i] * inv_rhoi * inv_rhoi;
+    Vec<D, R> a{};
     for (std::uint32_t j : lists.of(i)) {
       const Vec<D, R> rij = xi - ps.position[j];
       const R r = norm(rij);
       if (r >= h) continue;
-      const R mj_over_rhoj = ps.mass[j] / ps.density[j];
-      f += spiky.gradient(rij, r) * (-mj_over_rhoj * (pi + ps.pressure[j]) * R(0.5));
-      f += (ps.velocity[j] - vi) * (mu * mj_over_rhoj * visc.laplacian(r));
+      const R inv_rhoj = R(1) / ps.density[j];
+      const R pij = paper ? (pi_half + R(0.5) * ps.pressure[j] * inv_rhoi) * inv_rhoj
+                          : pi_sym + ps.pressure[j] * inv_rhoj * inv_rhoj;
+      a += spiky.gradient(rij, r) * (-ps.mass[j] * pij);
+      a += (ps.velocity[j] - vi) * (mu * ps.mass[j] * inv_rhoi * inv_rhoj * visc.laplacian(r));
     }
-    ps.acceleration[i] = gravity + f * (R(1) / ps.density[i]);
+    ps.acceleration[i] = gravity + a;
   });
 }
 

@@ -12,12 +12,13 @@ namespace sph {
 template <int D, std::floating_point R>
 void compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid);
 
-/// Accelerations from pressure (Eq. 5, symmetric (p_i + p_j) / 2 rho_j form, spiky gradient),
-/// viscosity (Eq. 6 with (v_j - v_i), viscosity-kernel Laplacian) and gravity:
-///   a_i = g + (1 / rho_i) sum_j m_j [ -(p_i + p_j) / (2 rho_j) grad W_spiky(x_i - x_j)
-///                                      + mu (v_j - v_i) / rho_j lap W_visc(|x_i - x_j|) ].
-/// Dividing the force density by rho_i makes every pair term antisymmetric (m_i a_i = -m_j a_j
-/// for each pair), so total momentum is conserved when lists are symmetric.
+/// Accelerations from pressure (Eq. 5, spiky gradient), viscosity (Eq. 6 with (v_j - v_i),
+/// viscosity-kernel Laplacian) and gravity:
+///   a_i = g + sum_j m_j [ -P_ij grad W_spiky(x_i - x_j) + mu (v_j - v_i) / (rho_i rho_j) lap W_visc ]
+/// with P_ij = (p_i + p_j) / (2 rho_i rho_j) (PressureForce::Paper: Eq. 5's force density
+/// divided by rho_i) or p_i / rho_i^2 + p_j / rho_j^2 (PressureForce::Symmetric).
+/// Every pair term is antisymmetric (m_i a_i = -m_j a_j), so total momentum is conserved when
+/// lists are symmetric.
 template <int D, std::floating_point R>
 void compute_fluid_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                                  const Vec<D, R>& gravity);

@@ -221,3 +221,38 @@ TEST(TimeStep, WarnsNearAndRefusesBeyondTheAcousticLimit) {
 
 }  // namespace
 }  // namespace sph
+
+namespace sph {
+namespace {
+
+TEST(Walls, ObstacleHoldsAFallingParticleAndNeverPulls) {
+  SimulationParams<2> p = water_params<2>(0.01);
+  p.gravity[1] = -9.81;
+  p.container.lo = Vec<2, double>::filled(0);
+  p.container.hi = Vec<2, double>::filled(1);
+  p.obstacles.push_back({{{0.4, 0.2}}, {{0.6, 0.3}}});
+  ParticleSet<2, double> ps;
+  ps.add({{0.5, 0.6}}, {}, p.particle_mass);   // falls onto the obstacle's top face
+  ps.add({{0.05, 0.6}}, {}, p.particle_mass);  // falls beside it, onto the container floor
+  Simulation<2, double> sim(p, std::move(ps));
+  for (int s = 0; s < 10000; ++s) sim.step();  // 2 s: both come to rest
+  const auto& P = sim.particles();
+  EXPECT_NEAR(P.position[0][1], 0.3 + p.particle_radius, 0.01);  // rests on the top face
+  EXPECT_NEAR(P.position[0][0], 0.5, 1e-9);                       // no sideways push
+  EXPECT_NEAR(P.position[1][1], p.particle_radius, 0.01);        // rests on the floor
+  EXPECT_LT(sim.max_speed(), 0.05);
+}
+
+TEST(Walls, ContactForceIsNeverAttractive) {
+  SimulationParams<2> p = water_params<2>(0.01);
+  p.container.lo = Vec<2, double>::filled(0);
+  p.container.hi = Vec<2, double>::filled(1);
+  p.walls.damping = 1e4;  // strong damping: a plain damped spring would pull a leaving particle back
+  ParticleSet<2, double> ps;
+  ps.add({{0.5, 0.005}}, {{0, 3.0}}, p.particle_mass);  // inside the contact zone, moving away
+  add_wall_accelerations(ps, p.container, p.obstacles, 0.01, p.walls);
+  EXPECT_GE(ps.acceleration[0][1], 0.0);
+}
+
+}  // namespace
+}  // namespace sph

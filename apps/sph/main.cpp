@@ -1,9 +1,11 @@
 // The `sph` command-line program: thin layer over the library (parse, call, report).
 
+#include <cctype>
 #include <cstdio>
 #include <exception>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -13,11 +15,39 @@
 
 #include "commands.h"
 
+namespace {
+
+/// The first argument that looks like an option but is known neither to `app` nor to any of
+/// its subcommands ("" if none).
+std::string first_unknown_option(CLI::App& app, int argc, char** argv) {
+  std::vector<const CLI::App*> apps{&app};
+  for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) apps.push_back(sub);
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a == "--") break;
+    if (a.size() < 2 || a[0] != '-') continue;
+    if (std::isdigit(static_cast<unsigned char>(a[1])) || a[1] == '.') continue;  // a negative number
+    if (const auto eq = a.find('='); eq != std::string::npos) a = a.substr(0, eq);
+    bool known = false;
+    for (const CLI::App* x : apps)
+      for (const CLI::Option* o : x->get_options()) {
+        for (const auto& n : o->get_lnames()) known = known || a == "--" + n;
+        for (const auto& n : o->get_snames()) known = known || a == "-" + n;
+      }
+    if (!known) return a;
+  }
+  return {};
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace sph::app;
-  CLI::App app{"sph: Smoothed Particle Hydrodynamics fluids in 2D and 3D with adaptive neighbor pairing.\n"
-               "Run a scene:   sph run scenes/paper/dam_break_2d.json -o out/dam_break_2d\n"
-               "Then open out/dam_break_2d/frames.pvd in ParaView.",
+  CLI::App app{"sph: Smoothed Particle Hydrodynamics fluids in 2D and 3D with adaptive neighbor pairing.\n\n"
+               "  sph run SCENE.json [-o DIR] [--neighbors standard|adaptive|verlet] [--steps N] [--threads N]\n"
+               "                     [--set KEY=VALUE]...     run a scene (sph run --help for details)\n\n"
+               "Example: sph run scenes/paper/dam_break_2d.json -o out/dam_break_2d\n"
+               "         then open out/dam_break_2d/frames.pvd in ParaView.",
                "sph"};
   app.set_version_flag("--version", std::string("sph ") + sph::kVersion);
   app.require_subcommand(1);
@@ -32,7 +62,12 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    fmt::print(stderr, "sph: error: {}\nRun 'sph --help' or 'sph run --help' for usage.\n", e.what());
+    // CLI11 reports a missing subcommand or argument before an unknown option: name the
+    // option the user mistyped first, since that is usually the real mistake.
+    std::string message = e.what();
+    const std::string unknown = first_unknown_option(app, argc, argv);
+    if (!unknown.empty()) message = "unknown option " + unknown;
+    fmt::print(stderr, "sph: error: {}\nRun 'sph --help' or 'sph run --help' for usage.\n", message);
     return kBadInput;
   }
 

@@ -87,6 +87,20 @@ TEST(AtomicFile, TwoOpenAtOnceForTheSameTargetUseDistinctTemporaries) {
   EXPECT_EQ(entries(dir.path()), std::vector<std::string>{"x.txt"});
 }
 
+TEST(AtomicFile, CommitOntoADirectoryThrowsSphErrorAndCleansUp) {
+  TempDir dir;
+  const fs::path target = dir / "occupied";
+  fs::create_directory(target);
+  spit(target / "inside.txt", "x");
+  {
+    AtomicFile f(target);
+    f.write("data");
+    EXPECT_THROW(f.commit(), Error);
+  }
+  EXPECT_EQ(entries(dir.path()), std::vector<std::string>{"occupied"}) << "no temporary left behind";
+  EXPECT_EQ(slurp(target / "inside.txt"), "x");
+}
+
 TEST(AtomicFile, NonExistentDirectoryThrowsSphError) {
   TempDir dir;
   const fs::path target = dir / "no" / "such" / "dir" / "f.txt";

@@ -1,6 +1,7 @@
 #pragma once
 // A fresh directory under the system temp dir, removed (recursively) at scope exit.
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>

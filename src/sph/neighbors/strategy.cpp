@@ -34,7 +34,8 @@ std::unique_ptr<NeighborStrategy<D, R>> make_neighbor_strategy(NeighborMode mode
     case NeighborMode::Adaptive:
     case NeighborMode::Verlet:
       throw Error("neighbor mode \"" + std::string(to_string(mode)) +
-                  "\" is not available yet in this version; use \"standard\" (or \"brute_force\" for tiny scenes)");
+                  "\" is not available yet in this version; use \"standard\" (or \"brute_force\" for tiny scenes)",
+                  "Configuration.neighbors");
   }
   throw Error("unknown neighbor mode");
 }

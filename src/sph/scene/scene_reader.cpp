@@ -27,8 +27,11 @@ struct Context {
 
   [[noreturn]] void fail(const std::string& path, const std::string& message) const {
     std::string where = source;
+    auto within = [](const std::string& a, const std::string& b) {  // a is b or inside b
+      return a == b || a.rfind(b + ".", 0) == 0 || a.rfind(b + "[", 0) == 0;
+    };
     for (const auto& o : overridden)
-      if (path == o || path.rfind(o + ".", 0) == 0 || path.rfind(o + "[", 0) == 0) {
+      if (within(path, o) || (!path.empty() && within(o, path))) {
         where = source + " (--set " + o + ")";
         break;
       }
@@ -38,24 +41,36 @@ struct Context {
 };
 
 std::string describe(const json& j) {
+  // Never dump containers whole: a deeply nested value would recurse without bound.
+  if (j.is_array()) return fmt::format("an array of {} element{}", j.size(), j.size() == 1 ? "" : "s");
+  if (j.is_object()) return fmt::format("an object with {} key{}", j.size(), j.size() == 1 ? "" : "s");
   std::string text = j.dump();
   if (text.size() > 40) text = text.substr(0, 37) + "...";
   return std::string(j.type_name()) + " " + text;
 }
 
-/// Reads the keys of one JSON object; every key it asks for is "known", and finish() rejects
-/// the others, listing the known ones.
+/// Reads the keys of one JSON object, whose allowed keys are declared up front.
 class ObjectReader {
  public:
-  ObjectReader(const json& j, std::string path, const Context& ctx) : j_(j), path_(std::move(path)), ctx_(ctx) {
+  /// `keys` are all the keys this object may have; any other key is reported at once, before
+  /// a missing-key error that a misspelt key would otherwise cause.
+  ObjectReader(const json& j, std::string path, const Context& ctx, const std::vector<std::string>& keys)
+      : j_(j), path_(std::move(path)), ctx_(ctx) {
     if (!j_.is_object()) ctx_.fail(path_, "expected an object { ... }, got " + describe(j_));
+    for (const auto& k : keys) allowed_.insert(k);
+    for (auto it = j_.begin(); it != j_.end(); ++it) {
+      if (allowed_.count(it.key())) continue;
+      std::string list;
+      for (const auto& k : allowed_) list += (list.empty() ? "" : ", ") + k;
+      ctx_.fail(child(it.key()), "unknown key; expected one of: " + list);
+    }
   }
 
   std::string child(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
   const Context& ctx() const { return ctx_; }
 
   const json* find(const std::string& key) {
-    known_.insert(key);
+    SPH_CHECK(allowed_.count(key), "scene key \"" + key + "\" read but not declared for " + path_);
     auto it = j_.find(key);
     return it == j_.end() ? nullptr : &*it;
   }
@@ -136,40 +151,29 @@ class ObjectReader {
   }
   /// An optional array of objects; calls f(reader) for each.
   template <class F>
-  void array_of_objects(const std::string& key, F&& f) {
+  void array_of_objects(const std::string& key, const std::vector<std::string>& keys, F&& f) {
     const json* v = find(key);
     if (!v) return;
     if (!v->is_array()) ctx_.fail(child(key), "expected an array of objects [ {...}, ... ], got " + describe(*v));
     for (std::size_t i = 0; i < v->size(); ++i) {
-      ObjectReader r((*v)[i], fmt::format("{}[{}]", child(key), i), ctx_);
+      ObjectReader r((*v)[i], fmt::format("{}[{}]", child(key), i), ctx_, keys);
       f(r, i);
-      r.finish();
     }
   }
-  /// Sub-object (optional: an absent key reads as an empty object).
+  /// A sub-object; an absent one reads as empty (its required keys are then reported missing).
   template <class F>
-  void object(const std::string& key, F&& f) {
+  void object(const std::string& key, const std::vector<std::string>& keys, F&& f) {
     static const json empty = json::object();
     const json* v = find(key);
-    ObjectReader r(v ? *v : empty, child(key), ctx_);
+    ObjectReader r(v ? *v : empty, child(key), ctx_, keys);
     f(r);
-    r.finish();
-  }
-
-  void finish() const {
-    for (auto it = j_.begin(); it != j_.end(); ++it) {
-      if (known_.count(it.key())) continue;
-      std::string list;
-      for (const auto& k : known_) list += (list.empty() ? "" : ", ") + k;
-      ctx_.fail(child(it.key()), "unknown key; expected one of: " + list);
-    }
   }
 
  private:
   const json& j_;
   std::string path_;
   const Context& ctx_;
-  std::set<std::string> known_;
+  std::set<std::string> allowed_;
 };
 
 /// Parses JSON text; syntax errors and duplicate keys name the line and column.
@@ -179,7 +183,9 @@ json parse_json(const std::string& text, const std::string& source) {
   // Duplicate keys would silently keep the last value: refuse them.
   std::vector<std::set<std::string>> keys;
   std::string duplicate;
-  json::parser_callback_t cb = [&](int /*depth*/, json::parse_event_t event, json& parsed) {
+  constexpr int kMaxDepth = 64;
+  json::parser_callback_t cb = [&](int depth, json::parse_event_t event, json& parsed) {
+    if (depth > kMaxDepth) throw Error(fmt::format("the JSON is nested more than {} levels deep", kMaxDepth), source);
     if (event == json::parse_event_t::object_start) keys.emplace_back();
     else if (event == json::parse_event_t::object_end) keys.pop_back();
     else if (event == json::parse_event_t::key && !keys.empty() && duplicate.empty()) {
@@ -204,6 +210,11 @@ json parse_json(const std::string& text, const std::string& source) {
     const auto pos = what.find("syntax error");
     if (pos != std::string::npos) what = what.substr(pos);
     throw Error("JSON syntax error: " + what, fmt::format("{}:{}:{}", source, line, col));
+  } catch (const json::exception& e) {
+    // For example a number too large for a double (1e999).
+    std::string what = e.what();
+    const auto pos = what.find("] ");
+    throw Error("invalid JSON: " + (pos == std::string::npos ? what : what.substr(pos + 2)), source);
   }
 }
 
@@ -220,6 +231,8 @@ void apply_overrides(json& doc, const std::vector<std::string>& overrides, Conte
       value = json::parse(value_text);
     } catch (const json::parse_error&) {
       value = value_text;  // not JSON: a plain string such as adaptive
+    } catch (const json::exception& e) {
+      throw Error("the value \"" + value_text + "\" is not a usable number (out of range)", "--set " + key);
     }
     // Split the path into object keys and [index] parts.
     std::vector<std::string> parts;
@@ -245,16 +258,16 @@ void apply_overrides(json& doc, const std::vector<std::string>& overrides, Conte
       const bool last = k + 1 == parts.size();
       if (p.front() == '[') {
         const std::string digits = p.substr(1, p.size() - 2);
+        if (node->is_null())
+          throw Error("\"" + path + "\" is not in the scene, so it has no element " + p, "--set " + key);
         if (!node->is_array())
           throw Error("\"" + path + "\" is not an array, so it has no element " + p, "--set " + key);
-        std::size_t idx = 0;
-        try {
-          idx = std::stoul(digits);
-        } catch (const std::exception&) {
+        if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
           throw Error("bad array index " + p + "; expected [0], [1], ...", "--set " + key);
-        }
+        const std::size_t idx = std::stoul(digits);
         if (idx >= node->size())
-          throw Error(fmt::format("\"{}\" has {} elements; index {} does not exist", path, node->size(), idx),
+          throw Error(fmt::format("\"{}\" has {} element{}; index {} does not exist", path, node->size(),
+                                  node->size() == 1 ? "" : "s", idx),
                       "--set " + key);
         path += p;
         node = &(*node)[idx];
@@ -262,7 +275,11 @@ void apply_overrides(json& doc, const std::vector<std::string>& overrides, Conte
         if (!node->is_object())
           throw Error("\"" + path + "\" is not an object, so it has no key \"" + p + "\"", "--set " + key);
         path += (path.empty() ? "" : ".") + p;
-        if (!last && !node->contains(p)) (*node)[p] = json::object();
+        if (!last && !node->contains(p)) {
+          if (parts[k + 1].front() == '[')
+            throw Error("\"" + path + "\" is not in the scene, so it has no element " + parts[k + 1], "--set " + key);
+          (*node)[p] = json::object();
+        }
         node = &(*node)[p];
       }
       (void)last;
@@ -307,7 +324,10 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
   Vec<D, double> default_g{};
   default_g[1] = -9.81;
 
-  root.object("Configuration", [&](ObjectReader& c) {
+  root.object("Configuration",
+              {"precision", "timeStepSize", "numberOfSteps", "particleRadius", "kernelRadius", "gravitation",
+               "neighbors", "fullRebuildPeriod", "outputEveryNSteps"},
+              [&](ObjectReader& c) {
     const std::string prec = c.choice("precision", {"double", "float"}, "double");
     desc.precision = prec == "float" ? Precision::Float : Precision::Double;
     sim.time_step = c.positive("timeStepSize", "a positive time step in seconds");
@@ -329,7 +349,8 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
                                         1'000'000'000'000LL, std::max<std::int64_t>(1, desc.steps / 100));
   });
 
-  root.object("Fluid", [&](ObjectReader& f) {
+  root.object("Fluid", {"density0", "stiffness", "viscosity", "negativePressure", "pressureForce", "particleMass"},
+              [&](ObjectReader& f) {
     sim.fluid.rest_density = f.positive("density0", "a positive rest density in kg/m^" + std::to_string(D), 1000.0);
     sim.fluid.stiffness = f.positive("stiffness", "a positive EOS stiffness k in m^2/s^2 (p = k (rho - rho0))");
     sim.fluid.viscosity = f.positive("viscosity", "a viscosity >= 0 in Pa s", 0.0, true);
@@ -346,11 +367,10 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
 
   {
     const json& cj = root.require("Container", "an object with \"start\" and \"end\" corners");
-    ObjectReader c(cj, root.child("Container"), root.ctx());
+    ObjectReader c(cj, root.child("Container"), root.ctx(), {"start", "end", "wallStiffness", "wallDamping"});
     sim.container = read_box<D>(c, "container");
     sim.walls.stiffness = c.positive("wallStiffness", "a positive wall spring stiffness in 1/s^2");
     sim.walls.damping = c.positive("wallDamping", "a wall damping >= 0 in 1/s", 0.0, true);
-    c.finish();
     for (int d = 0; d < D; ++d)
       if (sim.container.hi[d] - sim.container.lo[d] < 4 * sim.particle_radius)
         c.ctx().fail(c.child("end"), "the container must be at least two particle diameters wide in every direction");
@@ -358,7 +378,7 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
 
   const double dx = 2.0 * sim.particle_radius;
   double total = 0;
-  root.array_of_objects("FluidBlocks", [&](ObjectReader& b, std::size_t) {
+  root.array_of_objects("FluidBlocks", {"start", "end", "velocity"}, [&](ObjectReader& b, std::size_t) {
     FluidBlockDesc<D> blk;
     blk.box = read_box<D>(b, "fluid block");
     blk.velocity = b.vec<D>("velocity", "the initial velocity in m/s", Vec<D, double>{});
@@ -376,12 +396,15 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
     body.blocks.push_back(blk);
   });
 
-  root.array_of_objects("Obstacles", [&](ObjectReader& o, std::size_t) {
+  root.array_of_objects("Obstacles", {"start", "end"}, [&](ObjectReader& o, std::size_t) {
     Box<D> b = read_box<D>(o, "obstacle");
     sim.obstacles.push_back(b);
   });
 
-  root.array_of_objects("Emitters", [&](ObjectReader& e, std::size_t) {
+  std::vector<std::string> emitter_keys{"translation",     "direction",    "velocity",      "width",
+                                        "emitEveryNSteps", "maxParticles", "emitStartTime", "emitEndTime"};
+  if (D == 3) emitter_keys.push_back("height");  // a 2D nozzle is a line of `width` particles
+  root.array_of_objects("Emitters", emitter_keys, [&](ObjectReader& e, std::size_t) {
     EmitterParams<D> em;
     em.origin = e.vec<D>("translation", "the center of the emitter nozzle in m");
     Vec<D, double> dir = e.vec<D>("direction", "the emission direction (any non-zero length)");
@@ -415,7 +438,11 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
   if (total > 2e9)
     root.ctx().fail("FluidBlocks", fmt::format("the scene would hold {:.3g} particles; at most 2e9 are supported", total));
 
-  for (const std::string& w : check_time_step<D>(sim)) desc.warnings.push_back(w);
+  try {
+    for (const std::string& w : check_time_step<D>(sim)) desc.warnings.push_back(w);
+  } catch (const Error& e) {
+    root.ctx().fail(e.where(), e.message());
+  }
 }
 
 json load(const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
@@ -442,7 +469,9 @@ SceneDesc parse_scene(const std::string& text, const std::string& source, const 
   const json doc = load(text, source, overrides, ctx);
   SceneDesc desc;
   desc.source = source;
-  ObjectReader root(doc, "", ctx);
+  ObjectReader root(doc, "", ctx,
+                    {"version", "name", "description", "units", "dimension", "Configuration", "Fluid", "Container",
+                     "FluidBlocks", "Obstacles", "Emitters"});
   desc.version = static_cast<int>(root.integer("version", "the scene format version 1", 1, 1));
   desc.name = root.string("name", "a scene name (letters, digits, - and _)", "scene");
   if (desc.name.empty() || desc.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_") != std::string::npos)
@@ -453,7 +482,6 @@ SceneDesc parse_scene(const std::string& text, const std::string& source, const 
   desc.dimension = static_cast<int>(root.integer("dimension", "the dimension 2 or 3", 2, 3));
   if (desc.dimension == 2) read_body<2>(root, desc);
   else read_body<3>(root, desc);
-  root.finish();
   return desc;
 }
 

@@ -1,0 +1,377 @@
+// The `sph` program as a user meets it: exit codes, messages on stderr, and what it does (and
+// does not do) to the output directory. Each test runs the built binary from its own temporary
+// directory.
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
+const std::string kBadScene = SPH_SOURCE_DIR "/tests/scene/bad/typo_optional_key_viscosity.json";  // Fluid.viscosty
+
+std::string shell_quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void write_file(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto pos = text.find(what); pos != std::string::npos; pos = text.find(what, pos + what.size())) ++n;
+  return n;
+}
+
+#define EXPECT_CONTAINS(haystack, needle)                                                \
+  do {                                                                                   \
+    const std::string h_ = (haystack);                                                   \
+    const std::string n_ = (needle);                                                     \
+    EXPECT_TRUE(h_.find(n_) != std::string::npos) << "expected \"" << n_ << "\" in:\n" << h_; \
+  } while (false)
+
+struct Result {
+  int code = -1;    ///< exit status, or 128 + signal
+  std::string out;  ///< stdout
+  std::string err;  ///< stderr
+};
+
+class Cli : public testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = testing::UnitTest::GetInstance()->current_test_info();
+    root_ = fs::temp_directory_path() /
+            ("sph_cli_test_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(root_);
+    work_ = root_ / "work";
+    fs::create_directories(work_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(root_, ec);
+  }
+
+  /// Runs `sph ARGS...` in work_ (the arguments are passed verbatim, not through word splitting).
+  Result sph(const std::vector<std::string>& args) {
+    std::string cmd = "cd " + shell_quote(work_.string()) + " && " + shell_quote(SPH_BINARY);
+    for (const auto& a : args) cmd += " " + shell_quote(a);
+    const fs::path err = root_ / "stderr.txt";
+    cmd += " 2>" + shell_quote(err.string());
+    Result r;
+    FILE* p = ::popen(cmd.c_str(), "r");
+    if (!p) {
+      ADD_FAILURE() << "popen failed for " << cmd;
+      return r;
+    }
+    char buf[4096];
+    std::size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+    const int status = ::pclose(p);
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
+    r.err = read_file(err);
+    return r;
+  }
+
+  /// A completed 5-step run of the 2D dam break into work_/DIR.
+  void good_run(const std::string& dir) {
+    const Result r = sph({"run", kDamBreak, "--steps", "5", "--threads", "2", "--no-progress", "-o", dir});
+    ASSERT_EQ(r.code, 0) << r.err;
+    ASSERT_TRUE(fs::is_regular_file(work_ / dir / "summary.json")) << r.err;
+  }
+
+  fs::path root_;
+  fs::path work_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Version and help
+
+TEST_F(Cli, Version) {
+  const Result r = sph({"--version"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_CONTAINS(r.out + r.err, "sph 0.1.0");
+}
+
+TEST_F(Cli, TopLevelHelp) {
+  const Result r = sph({"--help"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_CONTAINS(r.out, "Usage: sph");
+  EXPECT_CONTAINS(r.out, "run");
+  EXPECT_CONTAINS(r.out, "--version");
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST_F(Cli, RunHelp) {
+  const Result r = sph({"run", "--help"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  for (const char* opt : {"--neighbors", "--set", "--steps", "--threads", "--output", "--no-progress"})
+    EXPECT_CONTAINS(r.out, opt);
+  EXPECT_CONTAINS(r.out, "Fluid.stiffness=2000");
+}
+
+// `sph --help` lists the subcommands only; a user looking for --neighbors or --set must know to
+// ask `sph run --help`.
+TEST_F(Cli, TopLevelHelpMentionsRunOptions) {
+  const Result r = sph({"--help"});
+  EXPECT_CONTAINS(r.out, "--neighbors");
+  EXPECT_CONTAINS(r.out, "--set");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Flags
+
+TEST_F(Cli, NoArgumentsFails) {
+  const Result r = sph({});
+  EXPECT_NE(r.code, 0);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_CONTAINS(r.err, "sph: error:");
+  EXPECT_CONTAINS(r.err, "sph --help");
+}
+
+TEST_F(Cli, RunWithoutSceneFails) {
+  const Result r = sph({"run"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_CONTAINS(r.err, "scene");
+}
+
+TEST_F(Cli, UnknownFlagGivesOneMessage) {
+  const std::vector<std::vector<std::string>> cases = {{"run", kDamBreak, "--bogus"},
+                                                             {"--bogus", "run", kDamBreak},
+                                                             {"run", kDamBreak, "-x"}};
+  for (const auto& args : cases) {
+    const Result r = sph(args);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(count(r.err, "sph: error:"), 1u) << r.err;
+    EXPECT_CONTAINS(r.err, args.back() == "-x" ? "-x" : "--bogus");
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+  EXPECT_FALSE(fs::exists(work_ / "out"));
+}
+
+// `sph --bogus` says only "A subcommand is required" and `sph run --bogus` only "scene is
+// required": the unknown flag the user typed is not named.
+TEST_F(Cli, UnknownFlagAloneIsNamed) {
+  for (const std::vector<std::string>& args : {std::vector<std::string>{"--bogus"}, {"run", "--bogus"}}) {
+    const Result r = sph(args);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_CONTAINS(r.err, "--bogus");
+  }
+}
+
+TEST_F(Cli, UnknownNeighborModeFlag) {
+  const Result r = sph({"run", kDamBreak, "--neighbors", "bogus", "-o", "o"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_CONTAINS(r.err, "--neighbors");
+  EXPECT_CONTAINS(r.err, "bogus");
+  EXPECT_EQ(count(r.err, "sph: error:"), 1u) << r.err;
+  EXPECT_FALSE(fs::exists(work_ / "o"));
+}
+
+TEST_F(Cli, NeighborModesNotAvailableYet) {
+  for (const char* mode : {"adaptive", "verlet"}) {
+    const Result r = sph({"run", kDamBreak, "--neighbors", mode, "--steps", "5", "-o", "o"});
+    EXPECT_EQ(r.code, 2) << mode;
+    EXPECT_CONTAINS(r.err, "not available yet");
+    EXPECT_CONTAINS(r.err, std::string("\"") + mode + "\"");
+    EXPECT_EQ(count(r.err, "sph: error:"), 1u) << r.err;
+    EXPECT_FALSE(fs::exists(work_ / "o")) << mode;
+  }
+}
+
+TEST_F(Cli, ZeroThreadsRefused) {
+  const Result r = sph({"run", kDamBreak, "--threads", "0", "-o", "o"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_CONTAINS(r.err, "--threads");
+  EXPECT_FALSE(fs::exists(work_ / "o"));
+}
+
+TEST_F(Cli, ZeroOrNonNumericStepsRefused) {
+  for (const char* steps : {"0", "-5", "many"}) {
+    const Result r = sph({"run", kDamBreak, "--steps", steps, "-o", "o"});
+    EXPECT_EQ(r.code, 2) << steps;
+    EXPECT_CONTAINS(r.err, "--steps");
+  }
+  EXPECT_FALSE(fs::exists(work_ / "o"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scene files
+
+TEST_F(Cli, MissingSceneFileNamesThePath) {
+  const Result r = sph({"run", "no/such/scene.json", "-o", "o"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_CONTAINS(r.err, "no/such/scene.json");
+  EXPECT_CONTAINS(r.err, "cannot open");
+  EXPECT_FALSE(fs::exists(work_ / "o"));
+}
+
+TEST_F(Cli, SceneThatIsADirectory) {
+  fs::create_directory(work_ / "scenes");
+  const Result r = sph({"run", "scenes", "-o", "o"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_CONTAINS(r.err, "scenes: is a directory");
+}
+
+TEST_F(Cli, BadSceneNamesTheKeyAndCreatesNoOutput) {
+  const Result r = sph({"run", kBadScene, "-o", "fresh/out"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_CONTAINS(r.err, "Fluid.viscosty");
+  EXPECT_CONTAINS(r.err, "unknown key");
+  EXPECT_CONTAINS(r.err, "typo_optional_key_viscosity.json");
+  EXPECT_EQ(count(r.err, "sph: error:"), 1u) << r.err;
+  EXPECT_FALSE(fs::exists(work_ / "fresh"));
+}
+
+TEST_F(Cli, SyntaxErrorNamesLineAndColumn) {
+  write_file(work_ / "broken.json", "{\n  \"version\": 1,\n  \"name\": \"x\",,\n}\n");
+  const Result r = sph({"run", "broken.json", "-o", "o"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_CONTAINS(r.err, "broken.json:3:15:");
+  EXPECT_FALSE(fs::exists(work_ / "o"));
+}
+
+TEST_F(Cli, BadSetOverrideMentionsSet) {
+  const Result r = sph({"run", kDamBreak, "--set", "Fluid.stifness=2000", "-o", "o"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_CONTAINS(r.err, "--set Fluid.stifness");
+  EXPECT_FALSE(fs::exists(work_ / "o"));
+  const Result idx = sph({"run", kDamBreak, "--set", "FluidBlocks[1].end=[0.5,0.7]", "-o", "o"});
+  EXPECT_EQ(idx.code, 2);
+  EXPECT_CONTAINS(idx.err, "--set FluidBlocks[1].end");
+  EXPECT_FALSE(fs::exists(work_ / "o"));
+}
+
+// A number that overflows a double in the scene or in --set escapes as nlohmann's out_of_range
+// exception: exit 70 (internal error) and a message with neither file nor key.
+TEST_F(Cli, NumberOverflowIsBadInput) {
+  const Result r = sph({"run", kDamBreak, "--set", "Fluid.stiffness=1e999", "-o", "o"});
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_CONTAINS(r.err, "Fluid.stiffness");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The output directory
+
+TEST_F(Cli, OutputPathIsAnExistingFile) {
+  const std::string content = "my notes, not a directory\n";
+  write_file(work_ / "notes.txt", content);
+  const Result r = sph({"run", kDamBreak, "--steps", "5", "-o", "notes.txt"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_CONTAINS(r.err, "notes.txt");
+  EXPECT_CONTAINS(r.err, "not a directory");
+  EXPECT_TRUE(fs::is_regular_file(work_ / "notes.txt"));
+  EXPECT_EQ(read_file(work_ / "notes.txt"), content);
+}
+
+TEST_F(Cli, RunWritesSummaryStatsAndFrames) {
+  const Result r = sph({"run", kDamBreak, "--steps", "5", "--threads", "2", "-o", "run1"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_CONTAINS(r.err, "sph: done: 5 steps, 3200 particles");
+  const fs::path dir = work_ / "run1";
+
+  ASSERT_TRUE(fs::is_regular_file(dir / "summary.json"));
+  const auto summary = nlohmann::json::parse(read_file(dir / "summary.json"));
+  EXPECT_EQ(summary["status"], "completed");
+  EXPECT_EQ(summary["steps"], 5);
+  EXPECT_EQ(summary["particles"], 3200);
+  EXPECT_EQ(summary["dimension"], 2);
+  EXPECT_EQ(summary["scene"], "dam_break_2d");
+
+  ASSERT_TRUE(fs::is_regular_file(dir / "stats.csv"));
+  std::istringstream stats(read_file(dir / "stats.csv"));
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(stats, line);) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 6u) << "header + 5 rows expected";
+  EXPECT_EQ(lines[0].rfind("step,time,particles,", 0), 0u) << lines[0];
+  const auto columns = count(lines[0], ",");
+  for (std::size_t i = 1; i < lines.size(); ++i) EXPECT_EQ(count(lines[i], ","), columns) << lines[i];
+
+  ASSERT_TRUE(fs::is_regular_file(dir / "frames.pvd"));
+  EXPECT_CONTAINS(read_file(dir / "frames.pvd"), "frames/frame_000000.vtu");
+  EXPECT_TRUE(fs::is_regular_file(dir / "frames" / "frame_000000.vtu"));
+  EXPECT_TRUE(fs::is_regular_file(dir / "scene.json"));
+  // No temporary or probe files are left behind.
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    EXPECT_NE(e.path().filename().string().front(), '.') << e.path();
+}
+
+TEST_F(Cli, SetOverrideReachesTheEffectiveScene) {
+  const Result r = sph({"run", kDamBreak, "--steps", "1", "--no-progress", "--set", "Fluid.stiffness=2000",
+                        "--set", "FluidBlocks[0].end=[0.2,0.4]", "-o", "o"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto scene = nlohmann::json::parse(read_file(work_ / "o" / "scene.json"));
+  EXPECT_EQ(scene["Fluid"]["stiffness"], 2000);
+  EXPECT_EQ(nlohmann::json::parse(read_file(work_ / "o" / "summary.json"))["particles"], 800);
+}
+
+TEST_F(Cli, DefaultOutputDirectoryIsOutSceneName) {
+  const Result r = sph({"run", kDamBreak, "--steps", "1", "--no-progress"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(work_ / "out" / "dam_break_2d" / "summary.json"));
+}
+
+TEST_F(Cli, RunKeepsUnrelatedUserFiles) {
+  fs::create_directories(work_ / "o" / "frames");
+  write_file(work_ / "o" / "README.txt", "keep me\n");
+  write_file(work_ / "o" / "frames" / "notes.txt", "keep me too\n");
+  good_run("o");
+  EXPECT_EQ(read_file(work_ / "o" / "README.txt"), "keep me\n");
+  EXPECT_EQ(read_file(work_ / "o" / "frames" / "notes.txt"), "keep me too\n");
+}
+
+TEST_F(Cli, SecondRunReplacesTheFirstRunsFrames) {
+  const Result first = sph({"run", kDamBreak, "--steps", "4", "--no-progress", "--set",
+                            "Configuration.outputEveryNSteps=1", "-o", "o"});
+  ASSERT_EQ(first.code, 0) << first.err;
+  EXPECT_TRUE(fs::is_regular_file(work_ / "o" / "frames" / "frame_000004.vtu"));
+  good_run("o");  // 5 steps: two frames, the initial and the last state
+  std::size_t frames = 0;
+  for (const auto& e : fs::directory_iterator(work_ / "o" / "frames")) frames += e.path().extension() == ".vtu";
+  EXPECT_EQ(frames, 2u);
+  EXPECT_EQ(nlohmann::json::parse(read_file(work_ / "o" / "summary.json"))["steps"], 5);
+}
+
+TEST_F(Cli, FailedRunLeavesEarlierOutputUntouched) {
+  good_run("o");
+  const std::string summary = read_file(work_ / "o" / "summary.json");
+  const std::string stats = read_file(work_ / "o" / "stats.csv");
+  const std::string pvd = read_file(work_ / "o" / "frames.pvd");
+
+  const Result bad = sph({"run", kBadScene, "--steps", "5", "-o", "o"});
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_CONTAINS(bad.err, "Fluid.viscosty");
+  const Result unavailable = sph({"run", kDamBreak, "--steps", "5", "--neighbors", "adaptive", "-o", "o"});
+  EXPECT_EQ(unavailable.code, 2);
+  const Result bad_set = sph({"run", kDamBreak, "--steps", "5", "--set", "Fluid.stiffness=-1", "-o", "o"});
+  EXPECT_EQ(bad_set.code, 2);
+
+  EXPECT_EQ(read_file(work_ / "o" / "summary.json"), summary);
+  EXPECT_EQ(read_file(work_ / "o" / "stats.csv"), stats);
+  EXPECT_EQ(read_file(work_ / "o" / "frames.pvd"), pvd);
+}
+
+}  // namespace

@@ -51,7 +51,10 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::string& s
              dir.string());
   Stopwatch wall;
   out.begin(sim);
-  Progress progress(desc.steps, !opt.no_progress && ::isatty(STDERR_FILENO), stderr);
+  Progress progress(desc.steps,
+                    opt.no_progress ? Progress::Mode::Off
+                                    : (::isatty(STDERR_FILENO) ? Progress::Mode::Bar : Progress::Mode::Lines),
+                    stderr);
   try {
     for (std::int64_t s = 0; s < desc.steps; ++s) {
       const StepInfo& step = sim.step();
@@ -120,7 +123,8 @@ std::function<int()> add_run_command(CLI::App& app) {
                   "Override a scene value by its key path, e.g. --set Fluid.stiffness=2000 "
                   "--set FluidBlocks[0].end=[0.5,1.0] (repeatable; VALUE is JSON or a plain string)")
       ->type_name("KEY=VALUE");
-  cmd->add_flag("--no-progress", opt->no_progress, "Do not draw the progress bar");
+  cmd->add_flag("--no-progress", opt->no_progress,
+                "No progress output (default: a bar with ETA on a terminal, a line every 10 % otherwise)");
   return [opt, cmd]() -> int {
     if (!cmd->parsed()) return kBadInput;
     return run(*opt);

@@ -14,14 +14,15 @@ std::string duration(double s) {
 }
 }  // namespace
 
-Progress::Progress(std::int64_t total_steps, bool terminal, std::FILE* out)
-    : total_(total_steps > 0 ? total_steps : 1), terminal_(terminal), out_(out) {}
+Progress::Progress(std::int64_t total_steps, Mode mode, std::FILE* out)
+    : total_(total_steps > 0 ? total_steps : 1), mode_(mode), out_(out) {}
 
 void Progress::update(std::int64_t done, std::size_t particles) {
+  if (mode_ == Mode::Off) return;
   const double t = watch_.elapsed();
   const double frac = static_cast<double>(done) / static_cast<double>(total_);
   const double eta = done > 0 ? t * (1.0 - frac) / frac : 0.0;
-  if (terminal_) {
+  if (mode_ == Mode::Bar) {
     if (t - last_draw_ < 0.1 && done < total_) return;  // redraw at most 10 times a second
     last_draw_ = t;
     constexpr int width = 30;
@@ -40,7 +41,7 @@ void Progress::update(std::int64_t done, std::size_t particles) {
 }
 
 void Progress::finish() {
-  if (terminal_) fmt::print(out_, "\n");
+  if (mode_ == Mode::Bar) fmt::print(out_, "\n");
 }
 
 }  // namespace sph::app

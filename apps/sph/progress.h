@@ -11,13 +11,14 @@ namespace sph::app {
 
 class Progress {
  public:
-  Progress(std::int64_t total_steps, bool terminal, std::FILE* out = stderr);
+  enum class Mode { Bar, Lines, Off };
+  Progress(std::int64_t total_steps, Mode mode, std::FILE* out = stderr);
   void update(std::int64_t steps_done, std::size_t particles);
   void finish();
 
  private:
   std::int64_t total_;
-  bool terminal_;
+  Mode mode_;
   std::FILE* out_;
   Stopwatch watch_;
   double last_draw_ = -1;

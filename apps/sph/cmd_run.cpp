@@ -1,9 +1,7 @@
 // `sph run SCENE.json`: runs a scene and writes frames, stats and a summary.
 
 #include <filesystem>
-#include <fstream>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -81,24 +79,13 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::string& s
   return kOk;
 }
 
-std::string read_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw Error("is a directory; expected a scene file (.json)", path);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("cannot open the scene file (does it exist and is it readable?)", path);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 int run(const RunOptions& opt) {
   std::vector<std::string> sets = opt.sets;
   if (!opt.neighbors.empty()) sets.push_back("Configuration.neighbors=\"" + opt.neighbors + "\"");
   if (opt.steps > 0) sets.push_back("Configuration.numberOfSteps=" + std::to_string(opt.steps));
   if (opt.threads > 0) set_num_threads(opt.threads);
 
-  const std::string text = read_file(opt.scene);
+  const std::string text = read_scene_text(opt.scene);
   const SceneDesc desc = parse_scene(text, opt.scene, sets);
   for (const auto& w : desc.warnings) fmt::print(stderr, "sph: warning: {}\n", w);
   const std::string scene_json = effective_scene_json(text, opt.scene, sets);

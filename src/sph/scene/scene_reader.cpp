@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <set>
@@ -453,15 +454,6 @@ json load(const std::string& text, const std::string& source, const std::vector<
   return doc;
 }
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("cannot open the scene file (does it exist and is it readable?)", path);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw Error("cannot read the scene file", path);
-  return ss.str();
-}
-
 }  // namespace
 
 SceneDesc parse_scene(const std::string& text, const std::string& source, const std::vector<std::string>& overrides) {
@@ -485,8 +477,19 @@ SceneDesc parse_scene(const std::string& text, const std::string& source, const 
   return desc;
 }
 
+std::string read_scene_text(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw Error("is a directory; expected a scene file (.json)", path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error("cannot open the scene file (does it exist and is it readable?)", path);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw Error("cannot read the scene file", path);
+  return ss.str();
+}
+
 SceneDesc read_scene_file(const std::string& path, const std::vector<std::string>& overrides) {
-  return parse_scene(read_text(path), path, overrides);
+  return parse_scene(read_scene_text(path), path, overrides);
 }
 
 std::string effective_scene_json(const std::string& text, const std::string& source,

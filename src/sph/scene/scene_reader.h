@@ -14,6 +14,10 @@ namespace sph {
 /// is expected (unknown keys, wrong types, missing or impossible values).
 SceneDesc read_scene_file(const std::string& path, const std::vector<std::string>& overrides = {});
 
+/// Reads a scene file's text; throws sph::Error naming the path if it is missing, a directory
+/// or unreadable.
+std::string read_scene_text(const std::string& path);
+
 /// Same as read_scene_file for scene text held in memory; `source` names it in messages.
 SceneDesc parse_scene(const std::string& text, const std::string& source,
                       const std::vector<std::string>& overrides = {});

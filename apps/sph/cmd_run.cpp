@@ -34,13 +34,13 @@ struct RunOptions {
 };
 
 template <int D, std::floating_point R>
-int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::string& scene_json) {
+int run_scene(const SceneDesc& desc, const RunOptions& opt) {
   // Everything that can be refused is checked before the output directory is touched.
   Simulation<D, R> sim = make_simulation<D, R>(desc);
   const std::filesystem::path dir = opt.output.empty() ? std::filesystem::path("out") / desc.name : std::filesystem::path(opt.output);
   prepare_output_directory(dir);
 
-  RunInfo info{std::string(to_string(sim.params().neighbors)), num_threads(), scene_json};
+  RunInfo info{std::string(to_string(sim.params().neighbors)), num_threads()};
   RunOutput<D, R> out(dir, desc, info);
   fmt::print(stderr, "sph: {} ({}D, {}, {} neighbors, {} thread{}): {} particles{}, {} steps of {:.4g} s -> {}\n",
              desc.name, D, std::is_same_v<R, float> ? "float" : "double", info.mode, info.threads,
@@ -85,13 +85,11 @@ int run(const RunOptions& opt) {
   if (opt.steps > 0) sets.push_back("Configuration.numberOfSteps=" + std::to_string(opt.steps));
   if (opt.threads > 0) set_num_threads(opt.threads);
 
-  const std::string text = read_scene_text(opt.scene);
-  const SceneDesc desc = parse_scene(text, opt.scene, sets);
+  const SceneDesc desc = read_scene_file(opt.scene, sets);
   for (const auto& w : desc.warnings) fmt::print(stderr, "sph: warning: {}\n", w);
-  const std::string scene_json = effective_scene_json(text, opt.scene, sets);
   const bool f = desc.precision == Precision::Float;
-  if (desc.dimension == 2) return f ? run_scene<2, float>(desc, opt, scene_json) : run_scene<2, double>(desc, opt, scene_json);
-  return f ? run_scene<3, float>(desc, opt, scene_json) : run_scene<3, double>(desc, opt, scene_json);
+  if (desc.dimension == 2) return f ? run_scene<2, float>(desc, opt) : run_scene<2, double>(desc, opt);
+  return f ? run_scene<3, float>(desc, opt) : run_scene<3, double>(desc, opt);
 }
 
 }  // namespace

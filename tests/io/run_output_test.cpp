@@ -115,7 +115,7 @@ TEST(RunOutput, WritesFramesStatsAndSummary) {
   const SceneDesc desc = small_dam_break(5, 2);
   auto sim = make_simulation<2, double>(desc);
   prepare_output_directory(dir.path());
-  RunOutput<2, double> out(dir.path(), desc, RunInfo{"standard", 1, "{}"});
+  RunOutput<2, double> out(dir.path(), desc, RunInfo{"standard", 1});
   out.begin(sim);
   for (std::int64_t s = 0; s < desc.steps; ++s) {
     const StepInfo& info = sim.step();
@@ -146,7 +146,7 @@ TEST(RunOutput, UnfinishedRunStillLeavesItsStats) {
   auto sim = make_simulation<2, double>(desc);
   prepare_output_directory(dir.path());
   {
-    RunOutput<2, double> out(dir.path(), desc, RunInfo{"standard", 1, "{}"});
+    RunOutput<2, double> out(dir.path(), desc, RunInfo{"standard", 1});
     out.begin(sim);
     for (int s = 0; s < 3; ++s) out.after_step(sim, sim.step(), false);
     EXPECT_EQ(out.frames_written(), 0u) << "outputEveryNSteps = 0 writes no frames";

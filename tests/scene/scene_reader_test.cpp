@@ -489,7 +489,7 @@ TEST(SceneReaderOverrides, MalformedOverride) {
 }
 
 TEST(SceneReaderOverrides, EffectiveSceneShowsOverrides) {
-  const std::string text = sph::effective_scene_json(valid_scene().dump(), "test.json", {"Fluid.stiffness=2000"});
+  const std::string text = sph::parse_scene(valid_scene().dump(), "test.json", {"Fluid.stiffness=2000"}).effective_json;
   EXPECT_EQ(json::parse(text)["Fluid"]["stiffness"], 2000);
 }
 

@@ -59,7 +59,7 @@ void RunOutput<D, R>::write_frame(const Simulation<D, R>& sim) {
 template <int D, std::floating_point R>
 void RunOutput<D, R>::begin(const Simulation<D, R>& sim) {
   Stopwatch w;
-  write_file_atomic(dir_ / "scene.json", info_.scene_json + "\n");
+  write_file_atomic(dir_ / "scene.json", desc_.effective_json + "\n");
   if (desc_.output_every_steps > 0) write_frame(sim);
   output_seconds_ += w.lap();
 }

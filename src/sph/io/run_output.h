@@ -29,7 +29,6 @@ inline constexpr const char* kStatsColumns =
 struct RunInfo {
   std::string mode;        ///< neighbor mode name
   int threads = 1;
-  std::string scene_json;  ///< effective scene text
 };
 
 /// Creates `dir` if needed and checks that files can be created in it; removes the files a

@@ -36,6 +36,7 @@ struct SceneDesc {
   std::int64_t output_every_steps = 0;  ///< write a frame every this many steps (0: none)
   SceneBody<2> body2;  ///< filled when dimension == 2
   SceneBody<3> body3;  ///< filled when dimension == 3
+  std::string effective_json;           ///< the scene as read, after --set overrides (pretty JSON)
   std::vector<std::string> warnings;    ///< non-fatal problems found while reading (e.g. dt close to a limit)
 
   template <int D>

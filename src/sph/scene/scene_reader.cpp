@@ -461,6 +461,7 @@ SceneDesc parse_scene(const std::string& text, const std::string& source, const 
   const json doc = load(text, source, overrides, ctx);
   SceneDesc desc;
   desc.source = source;
+  desc.effective_json = doc.dump(2);
   ObjectReader root(doc, "", ctx,
                     {"version", "name", "description", "units", "dimension", "Configuration", "Fluid", "Container",
                      "FluidBlocks", "Obstacles", "Emitters"});
@@ -490,12 +491,6 @@ std::string read_scene_text(const std::string& path) {
 
 SceneDesc read_scene_file(const std::string& path, const std::vector<std::string>& overrides) {
   return parse_scene(read_scene_text(path), path, overrides);
-}
-
-std::string effective_scene_json(const std::string& text, const std::string& source,
-                                 const std::vector<std::string>& overrides) {
-  Context ctx{source, {}};
-  return load(text, source, overrides, ctx).dump(2);
 }
 
 }  // namespace sph

@@ -22,8 +22,4 @@ std::string read_scene_text(const std::string& path);
 SceneDesc parse_scene(const std::string& text, const std::string& source,
                       const std::vector<std::string>& overrides = {});
 
-/// The effective scene (after overrides) as JSON text, pretty-printed; for summaries.
-std::string effective_scene_json(const std::string& text, const std::string& source,
-                                 const std::vector<std::string>& overrides = {});
-
 }  // namespace sph

@@ -47,10 +47,10 @@ std::size_t count(const std::string& text, const std::string& what) {
   return n;
 }
 
-#define EXPECT_CONTAINS(haystack, needle)                                                \
-  do {                                                                                   \
-    const std::string h_ = (haystack);                                                   \
-    const std::string n_ = (needle);                                                     \
+#define EXPECT_CONTAINS(haystack, needle)                                                     \
+  do {                                                                                        \
+    const std::string h_ = (haystack);                                                        \
+    const std::string n_ = (needle);                                                          \
     EXPECT_TRUE(h_.find(n_) != std::string::npos) << "expected \"" << n_ << "\" in:\n" << h_; \
   } while (false)
 
@@ -64,8 +64,7 @@ class Cli : public testing::Test {
  protected:
   void SetUp() override {
     const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-    root_ = fs::temp_directory_path() /
-            ("sph_cli_test_" + std::to_string(::getpid()) + "_" + info->name());
+    root_ = fs::temp_directory_path() / ("sph_cli_test_" + std::to_string(::getpid()) + "_" + info->name());
     fs::remove_all(root_);
     work_ = root_ / "work";
     fs::create_directories(work_);
@@ -159,9 +158,8 @@ TEST_F(Cli, RunWithoutSceneFails) {
 }
 
 TEST_F(Cli, UnknownFlagGivesOneMessage) {
-  const std::vector<std::vector<std::string>> cases = {{"run", kDamBreak, "--bogus"},
-                                                             {"--bogus", "run", kDamBreak},
-                                                             {"run", kDamBreak, "-x"}};
+  const std::vector<std::vector<std::string>> cases = {
+      {"run", kDamBreak, "--bogus"}, {"--bogus", "run", kDamBreak}, {"run", kDamBreak, "-x"}};
   for (const auto& args : cases) {
     const Result r = sph(args);
     EXPECT_EQ(r.code, 2);
@@ -191,15 +189,33 @@ TEST_F(Cli, UnknownNeighborModeFlag) {
   EXPECT_FALSE(fs::exists(work_ / "o"));
 }
 
-TEST_F(Cli, NeighborModesNotAvailableYet) {
-  for (const char* mode : {"adaptive", "verlet"}) {
-    const Result r = sph({"run", kDamBreak, "--neighbors", mode, "--steps", "5", "-o", "o"});
-    EXPECT_EQ(r.code, 2) << mode;
-    EXPECT_CONTAINS(r.err, "not available yet");
-    EXPECT_CONTAINS(r.err, std::string("\"") + mode + "\"");
-    EXPECT_EQ(count(r.err, "sph: error:"), 1u) << r.err;
-    EXPECT_FALSE(fs::exists(work_ / "o")) << mode;
+TEST_F(Cli, EveryNeighborModeRunsAndAuditFillsTheAuditColumns) {
+  for (const char* mode : {"standard", "adaptive", "verlet"}) {
+    const Result r =
+        sph({"run", kDamBreak, "--neighbors", mode, "--steps", "30", "--audit", "-o", "o", "--no-progress"});
+    ASSERT_EQ(r.code, 0) << mode << ": " << r.err;
+    const auto summary = nlohmann::json::parse(read_file(work_ / "o" / "summary.json"));
+    EXPECT_EQ(summary["neighbors"], mode);
+    ASSERT_TRUE(summary.contains("audit")) << mode;
+    if (std::string(mode) != "adaptive") {
+      EXPECT_EQ(summary["audit"]["missed_pairs"], 0) << mode;
+    }
+    std::istringstream stats(read_file(work_ / "o" / "stats.csv"));
+    std::string header, row;
+    std::getline(stats, header);
+    std::getline(stats, row);
+    // Column 10 (missed_pairs) holds a number when auditing.
+    std::vector<std::string> cells;
+    std::stringstream cs(row);
+    for (std::string c; std::getline(cs, c, ',');) cells.push_back(c);
+    ASSERT_GT(cells.size(), 11u);
+    EXPECT_FALSE(cells[9].empty()) << mode << ": " << row;
   }
+  // Without --audit the audit columns are empty and summary.json has no audit.
+  const Result r = sph({"run", kDamBreak, "--steps", "3", "-o", "o", "--no-progress"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(nlohmann::json::parse(read_file(work_ / "o" / "summary.json")).contains("audit"));
+  EXPECT_CONTAINS(read_file(work_ / "o" / "stats.csv"), ",,,");
 }
 
 TEST_F(Cli, ZeroThreadsRefused) {
@@ -320,8 +336,8 @@ TEST_F(Cli, RunWritesSummaryStatsAndFrames) {
 }
 
 TEST_F(Cli, SetOverrideReachesTheEffectiveScene) {
-  const Result r = sph({"run", kDamBreak, "--steps", "1", "--no-progress", "--set", "Fluid.stiffness=2000",
-                        "--set", "FluidBlocks[0].end=[0.2,0.4]", "-o", "o"});
+  const Result r = sph({"run", kDamBreak, "--steps", "1", "--no-progress", "--set", "Fluid.stiffness=2000", "--set",
+                        "FluidBlocks[0].end=[0.2,0.4]", "-o", "o"});
   ASSERT_EQ(r.code, 0) << r.err;
   const auto scene = nlohmann::json::parse(read_file(work_ / "o" / "scene.json"));
   EXPECT_EQ(scene["Fluid"]["stiffness"], 2000);
@@ -344,8 +360,8 @@ TEST_F(Cli, RunKeepsUnrelatedUserFiles) {
 }
 
 TEST_F(Cli, SecondRunReplacesTheFirstRunsFrames) {
-  const Result first = sph({"run", kDamBreak, "--steps", "4", "--no-progress", "--set",
-                            "Configuration.outputEveryNSteps=1", "-o", "o"});
+  const Result first =
+      sph({"run", kDamBreak, "--steps", "4", "--no-progress", "--set", "Configuration.outputEveryNSteps=1", "-o", "o"});
   ASSERT_EQ(first.code, 0) << first.err;
   EXPECT_TRUE(fs::is_regular_file(work_ / "o" / "frames" / "frame_000004.vtu"));
   good_run("o");  // 5 steps: two frames, the initial and the last state
@@ -364,8 +380,10 @@ TEST_F(Cli, FailedRunLeavesEarlierOutputUntouched) {
   const Result bad = sph({"run", kBadScene, "--steps", "5", "-o", "o"});
   EXPECT_EQ(bad.code, 2);
   EXPECT_CONTAINS(bad.err, "Fluid.viscosty");
-  const Result unavailable = sph({"run", kDamBreak, "--steps", "5", "--neighbors", "adaptive", "-o", "o"});
-  EXPECT_EQ(unavailable.code, 2);
+  const Result bad_skin = sph(
+      {"run", kDamBreak, "--steps", "5", "--neighbors", "verlet", "--set", "Configuration.verletSkin=0", "-o", "o"});
+  EXPECT_EQ(bad_skin.code, 2);
+  EXPECT_CONTAINS(bad_skin.err, "verletSkin");
   const Result bad_set = sph({"run", kDamBreak, "--steps", "5", "--set", "Fluid.stiffness=-1", "-o", "o"});
   EXPECT_EQ(bad_set.code, 2);
 

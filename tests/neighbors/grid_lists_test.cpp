@@ -58,15 +58,12 @@ class GridLists : public ::testing::Test {
   }
 };
 
-using Variants = ::testing::Types<std::pair<std::integral_constant<int, 2>, float>,
-                                  std::pair<std::integral_constant<int, 2>, double>,
-                                  std::pair<std::integral_constant<int, 3>, float>,
-                                  std::pair<std::integral_constant<int, 3>, double>>;
+using Variants = ::testing::Types<
+    std::pair<std::integral_constant<int, 2>, float>, std::pair<std::integral_constant<int, 2>, double>,
+    std::pair<std::integral_constant<int, 3>, float>, std::pair<std::integral_constant<int, 3>, double>>;
 TYPED_TEST_SUITE(GridLists, Variants);
 
-TYPED_TEST(GridLists, RandomUniform) {
-  this->expect_equal_to_brute_force(this->random_points(1500, 0, 1, 1), 0.08);
-}
+TYPED_TEST(GridLists, RandomUniform) { this->expect_equal_to_brute_force(this->random_points(1500, 0, 1, 1), 0.08); }
 
 TYPED_TEST(GridLists, NegativeCoordinates) {
   this->expect_equal_to_brute_force(this->random_points(1500, -3, -1.5, 2), 0.2);
@@ -144,12 +141,9 @@ TEST(NeighborMode, ParsesNamesAndRejectsOthers) {
   EXPECT_THROW(parse_neighbor_mode("fast"), Error);
   NeighborOptions opt;
   opt.radius = 0.1;
-  try {
-    make_neighbor_strategy<3, double>(NeighborMode::Adaptive, opt);
-    FAIL() << "adaptive mode should not be available yet";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("not available yet"), std::string::npos);
-  }
+  const NeighborMode modes[] = {NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet,
+                                NeighborMode::BruteForce};
+  for (NeighborMode m : modes) EXPECT_EQ((make_neighbor_strategy<3, double>(m, opt)->mode()), m);
 }
 
 }  // namespace

@@ -54,8 +54,9 @@ ParticleSet<D, R> blob(const SimulationParams<D>& p, int n, unsigned seed) {
 }
 
 template <int D, class R>
-void check_momentum_conserved(int n, int steps, double tol) {
+void check_momentum_conserved(int n, int steps, double tol, NeighborMode mode = NeighborMode::Standard) {
   SimulationParams<D> p = water_params<D>(0.01);
+  p.neighbors = mode;
   p.fluid.negative_pressure = NegativePressure::Allow;  // both signs of pressure exercised
   p.container.lo = Vec<D, double>::filled(-100);
   p.container.hi = Vec<D, double>::filled(100);
@@ -75,6 +76,12 @@ void check_momentum_conserved(int n, int steps, double tol) {
 TEST(Conservation, MomentumWithoutWallsOrGravity2D) { check_momentum_conserved<2, double>(20, 200, 1e-12); }
 TEST(Conservation, MomentumWithoutWallsOrGravity3D) { check_momentum_conserved<3, double>(10, 100, 1e-12); }
 TEST(Conservation, MomentumWithoutWallsOrGravity3DFloat) { check_momentum_conserved<3, float>(10, 100, 1e-5); }
+TEST(Conservation, MomentumWithVerletLists2D) {
+  check_momentum_conserved<2, double>(20, 200, 1e-12, NeighborMode::Verlet);
+}
+TEST(Conservation, MomentumWithVerletLists3D) {
+  check_momentum_conserved<3, double>(10, 100, 1e-12, NeighborMode::Verlet);
+}
 
 /// Settles a water column and returns the mean of p / (rho0 g depth) over particles more than
 /// two layers below the surface and one kernel radius away from the side walls; checks that
@@ -121,7 +128,9 @@ double settled_pressure_ratio(PressureForce form, int columns, int layers) {
     const double d = surface - P.position[i][1];
     bool interior = d > 2 * dx;
     for (int a = 0; a < D; ++a)
-      if (a != 1) interior = interior && P.position[i][a] > p.kernel_radius && P.position[i][a] < p.container.hi[a] - p.kernel_radius;
+      if (a != 1)
+        interior =
+            interior && P.position[i][a] > p.kernel_radius && P.position[i][a] < p.container.hi[a] - p.kernel_radius;
     if (!interior) continue;
     rho_dev_max = std::max(rho_dev_max, std::abs(P.density[i] / 1000.0 - 1.0));
     ratio_sum += P.pressure[i] / (1000.0 * 9.81 * d);
@@ -183,7 +192,8 @@ TEST(Emitter, AddsOneBatchEveryNStepsUntilTheLimit) {
   const auto& P = sim.particles();
   EXPECT_NEAR(P.initial_position[0][1], 0.5, 1e-12);
   double cx = 0;
-  for (int i = 0; i < 6; ++i) cx += P.initial_position[static_cast<std::size_t>(i)][0] + P.initial_position[static_cast<std::size_t>(i)][2];
+  for (int i = 0; i < 6; ++i)
+    cx += P.initial_position[static_cast<std::size_t>(i)][0] + P.initial_position[static_cast<std::size_t>(i)][2];
   EXPECT_NEAR(cx / 6, 1.0, 1e-12);
   EXPECT_EQ(P.id.back(), 39u);
 }
@@ -238,7 +248,7 @@ TEST(Walls, ObstacleHoldsAFallingParticleAndNeverPulls) {
   for (int s = 0; s < 10000; ++s) sim.step();  // 2 s: both come to rest
   const auto& P = sim.particles();
   EXPECT_NEAR(P.position[0][1], 0.3 + p.particle_radius, 0.01);  // rests on the top face
-  EXPECT_NEAR(P.position[0][0], 0.5, 1e-9);                       // no sideways push
+  EXPECT_NEAR(P.position[0][0], 0.5, 1e-9);                      // no sideways push
   EXPECT_NEAR(P.position[1][1], p.particle_radius, 0.01);        // rests on the floor
   EXPECT_LT(sim.max_speed(), 0.05);
 }

@@ -74,11 +74,20 @@ double RunOutput<D, R>::after_step(const Simulation<D, R>& sim, const StepInfo& 
   output_seconds_ += t_output;
   const double mean_neighbors =
       info.particles ? static_cast<double>(info.neighbors.pairs_stored) / static_cast<double>(info.particles) : 0.0;
-  stats_ << fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.6g},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n", info.step,
-                        info.time, info.particles, sim.kinetic_energy(), sim.max_speed(), mean_neighbors,
-                        info.neighbors.lists_rebuilt, info.neighbors.pairs_stored, info.seconds.grid,
-                        info.seconds.lists, info.seconds.density, info.seconds.forces, info.seconds.integrate,
-                        t_output);
+  const std::string audit = info.audited ? fmt::format("{},{},{:.6g}", info.audit.missed_pairs,
+                                                       info.audit.particles_missing, info.audit.max_penetration)
+                                         : std::string(",,");
+  stats_ << fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.6g},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n",
+                        info.step, info.time, info.particles, sim.kinetic_energy(), sim.max_speed(), mean_neighbors,
+                        info.neighbors.lists_rebuilt, info.neighbors.pairs_stored, info.pairs_within_h, audit,
+                        info.seconds.grid, info.seconds.lists, info.seconds.density, info.seconds.forces,
+                        info.seconds.integrate, t_output);
+  if (info.audited) {
+    audit_.missed_pairs += info.audit.missed_pairs;
+    audit_.max_penetration = std::max(audit_.max_penetration, info.audit.max_penetration);
+    audit_steps_with_misses_ += info.audit.missed_pairs > 0 ? 1 : 0;
+  }
+  totals_lists_rebuilt_ += info.neighbors.lists_rebuilt;
   if (last || (every > 0 && sim.steps_done() % every == 0)) stats_.flush();
   return t_output;
 }
@@ -107,9 +116,13 @@ void RunOutput<D, R>::finish(const Simulation<D, R>& sim, const std::string& sta
   s["particles"] = sim.particles().size();
   s["frames"] = pvd_.size();
   s["wall_seconds"] = wall_seconds;
-  s["phase_seconds"] = {{"grid", totals_.grid},           {"lists", totals_.lists},
-                        {"density", totals_.density},     {"forces", totals_.forces},
-                        {"integrate", totals_.integrate}, {"output", output_seconds_}};
+  s["phase_seconds"] = {{"grid", totals_.grid},     {"lists", totals_.lists},         {"density", totals_.density},
+                        {"forces", totals_.forces}, {"integrate", totals_.integrate}, {"output", output_seconds_}};
+  s["lists_rebuilt"] = totals_lists_rebuilt_;
+  if (sim.params().audit)
+    s["audit"] = {{"missed_pairs", audit_.missed_pairs},
+                  {"steps_with_misses", audit_steps_with_misses_},
+                  {"max_missed_penetration", audit_.max_penetration}};
   s["kinetic_energy"] = sim.kinetic_energy();
   s["max_speed"] = sim.max_speed();
   write_file_atomic(dir_ / "summary.json", s.dump(2) + "\n");

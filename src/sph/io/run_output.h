@@ -20,14 +20,15 @@
 
 namespace sph {
 
-/// Header of stats.csv.
+/// Header of stats.csv (docs/output.md explains each column). The three audit columns
+/// (missed_pairs, particles_missing, max_missed_penetration) are empty unless the run audits.
 inline constexpr const char* kStatsColumns =
-    "step,time,particles,kinetic_energy,max_speed,mean_neighbors,lists_rebuilt,pairs_stored,"
-    "t_grid,t_lists,t_density,t_forces,t_integrate,t_output";
+    "step,time,particles,kinetic_energy,max_speed,mean_neighbors,lists_rebuilt,pairs_stored,pairs_within_h,"
+    "missed_pairs,particles_missing,max_missed_penetration,t_grid,t_lists,t_density,t_forces,t_integrate,t_output";
 
 /// Facts about the run that are not in the scene.
 struct RunInfo {
-  std::string mode;        ///< neighbor mode name
+  std::string mode;  ///< neighbor mode name
   int threads = 1;
 };
 
@@ -62,6 +63,9 @@ class RunOutput {
   std::ofstream stats_;
   std::filesystem::path stats_tmp_;
   PhaseTimes totals_;
+  std::uint64_t totals_lists_rebuilt_ = 0;
+  ListAudit audit_;  // summed missed pairs, largest penetration
+  std::uint64_t audit_steps_with_misses_ = 0;
   double output_seconds_ = 0;
   bool finished_ = false;
 };

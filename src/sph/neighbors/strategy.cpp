@@ -1,16 +1,22 @@
 #include <sph/neighbors/strategy.h>
 
 #include <sph/core/error.h>
+#include <sph/neighbors/adaptive.h>
 #include <sph/neighbors/standard.h>
+#include <sph/neighbors/verlet.h>
 
 namespace sph {
 
 std::string_view to_string(NeighborMode mode) {
   switch (mode) {
-    case NeighborMode::Standard: return "standard";
-    case NeighborMode::Adaptive: return "adaptive";
-    case NeighborMode::Verlet: return "verlet";
-    case NeighborMode::BruteForce: return "brute_force";
+    case NeighborMode::Standard:
+      return "standard";
+    case NeighborMode::Adaptive:
+      return "adaptive";
+    case NeighborMode::Verlet:
+      return "verlet";
+    case NeighborMode::BruteForce:
+      return "brute_force";
   }
   return "unknown";
 }
@@ -29,20 +35,28 @@ template <int D, std::floating_point R>
 std::unique_ptr<NeighborStrategy<D, R>> make_neighbor_strategy(NeighborMode mode, const NeighborOptions& options) {
   const R radius = static_cast<R>(options.radius);
   switch (mode) {
-    case NeighborMode::Standard: return std::make_unique<StandardNeighbors<D, R>>(radius);
-    case NeighborMode::BruteForce: return std::make_unique<BruteForceNeighbors<D, R>>(radius);
+    case NeighborMode::Standard:
+      return std::make_unique<StandardNeighbors<D, R>>(radius);
+    case NeighborMode::BruteForce:
+      return std::make_unique<BruteForceNeighbors<D, R>>(radius);
     case NeighborMode::Adaptive:
-    case NeighborMode::Verlet:
-      throw Error("neighbor mode \"" + std::string(to_string(mode)) +
-                  "\" is not available yet in this version; use \"standard\" (or \"brute_force\" for tiny scenes)",
-                  "Configuration.neighbors");
+      return std::make_unique<AdaptiveNeighbors<D, R>>(radius, options.full_rebuild_period);
+    case NeighborMode::Verlet: {
+      const R skin =
+          static_cast<R>(options.verlet_skin > 0 ? options.verlet_skin : kDefaultSkinFraction * options.radius);
+      return std::make_unique<VerletNeighbors<D, R>>(radius, skin);
+    }
   }
   throw Error("unknown neighbor mode");
 }
 
-template std::unique_ptr<NeighborStrategy<2, float>> make_neighbor_strategy<2, float>(NeighborMode, const NeighborOptions&);
-template std::unique_ptr<NeighborStrategy<2, double>> make_neighbor_strategy<2, double>(NeighborMode, const NeighborOptions&);
-template std::unique_ptr<NeighborStrategy<3, float>> make_neighbor_strategy<3, float>(NeighborMode, const NeighborOptions&);
-template std::unique_ptr<NeighborStrategy<3, double>> make_neighbor_strategy<3, double>(NeighborMode, const NeighborOptions&);
+template std::unique_ptr<NeighborStrategy<2, float>> make_neighbor_strategy<2, float>(NeighborMode,
+                                                                                      const NeighborOptions&);
+template std::unique_ptr<NeighborStrategy<2, double>> make_neighbor_strategy<2, double>(NeighborMode,
+                                                                                        const NeighborOptions&);
+template std::unique_ptr<NeighborStrategy<3, float>> make_neighbor_strategy<3, float>(NeighborMode,
+                                                                                      const NeighborOptions&);
+template std::unique_ptr<NeighborStrategy<3, double>> make_neighbor_strategy<3, double>(NeighborMode,
+                                                                                        const NeighborOptions&);
 
 }  // namespace sph

@@ -29,9 +29,13 @@ struct NeighborCounters {
 
 /// Options shared by the strategies (those a strategy does not use are ignored by it).
 struct NeighborOptions {
-  double radius = 0;                ///< kernel support h, m
-  int full_rebuild_period = 200;    ///< adaptive: rebuild every list each this many steps
+  double radius = 0;              ///< kernel support h, m
+  int full_rebuild_period = 200;  ///< adaptive: rebuild every list each this many steps
+  double verlet_skin = 0;         ///< verlet: lists hold pairs closer than h + skin, m; 0: default
 };
+
+/// Default verlet skin as a fraction of h (docs/paper-reproduction.md shows how it was chosen).
+inline constexpr double kDefaultSkinFraction = 0.2;
 
 /// A neighbor strategy keeps full neighbor lists of the particles current for the solver.
 template <int D, std::floating_point R>
@@ -46,6 +50,12 @@ class NeighborStrategy {
   virtual const NeighborLists& lists() const = 0;
   /// Counters of the last update().
   virtual const NeighborCounters& counters() const = 0;
+
+  /// Flags, one per particle, that the solver's density pass sets for both particles of every
+  /// listed pair whose predicted distance |x_i - x_j + dt (u_i - u_j)| exceeds h (paper
+  /// Eq. 7). The strategy reads and clears them in its next update(). Empty for strategies
+  /// that do not ask for the test (the solver then skips it).
+  virtual std::span<std::uint8_t> pair_exit_flags() { return {}; }
 };
 
 /// Creates the strategy for `mode`. Throws sph::Error for a mode this build cannot run.

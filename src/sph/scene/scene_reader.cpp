@@ -327,7 +327,7 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
 
   root.object("Configuration",
               {"precision", "timeStepSize", "numberOfSteps", "particleRadius", "kernelRadius", "gravitation",
-               "neighbors", "fullRebuildPeriod", "outputEveryNSteps"},
+               "neighbors", "fullRebuildPeriod", "verletSkin", "outputEveryNSteps"},
               [&](ObjectReader& c) {
     const std::string prec = c.choice("precision", {"double", "float"}, "double");
     desc.precision = prec == "float" ? Precision::Float : Precision::Double;
@@ -346,6 +346,13 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
         c.choice("neighbors", {"standard", "adaptive", "verlet", "brute_force"}, "standard"), c.child("neighbors"));
     sim.full_rebuild_period = static_cast<int>(
         c.integer("fullRebuildPeriod", "a full-rebuild period of at least 1 step", 1, 1'000'000'000, 200));
+    sim.verlet_skin = c.positive("verletSkin", "a positive verlet skin in metres (default 0.2 h)",
+                                 kDefaultSkinFraction * sim.kernel_radius);
+    if (sim.verlet_skin > 2.0 * sim.kernel_radius)
+      c.ctx().fail(c.child("verletSkin"),
+                   fmt::format("a skin of {:g} m is more than twice h = {:g} m: lists would hold over 27 times the "
+                               "pairs needed in 3D; expected a skin between 0.05 h and 0.5 h",
+                               sim.verlet_skin, sim.kernel_radius));
     desc.output_every_steps = c.integer("outputEveryNSteps", "a frame interval in steps (0: no frames)", 0,
                                         1'000'000'000'000LL, std::max<std::int64_t>(1, desc.steps / 100));
   });

@@ -62,7 +62,7 @@ struct EmitterParams {
   double speed = 1;            ///< m/s
   int width = 1;
   int height = 1;
-  double spacing = 0;          ///< m
+  double spacing = 0;  ///< m
   int every_steps = 16;
   std::int64_t max_particles = 0;
   double start_time = 0;
@@ -82,7 +82,11 @@ struct SimulationParams {
   std::vector<Box<D>> obstacles;  ///< static solid boxes
   std::vector<EmitterParams<D>> emitters;
   NeighborMode neighbors = NeighborMode::Standard;
-  int full_rebuild_period = 200;
+  int full_rebuild_period = 200;  ///< adaptive mode
+  double verlet_skin = 0;         ///< verlet mode: skin, m; 0 means kDefaultSkinFraction * h
+  /// Audit the lists every step against exact lists (StepInfo::audit); costs about one
+  /// standard list build per step.
+  bool audit = false;
 };
 
 }  // namespace sph

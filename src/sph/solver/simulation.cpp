@@ -59,17 +59,21 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
   NeighborOptions opt;
   opt.radius = params_.kernel_radius;
   opt.full_rebuild_period = params_.full_rebuild_period;
+  opt.verlet_skin = params_.verlet_skin;
   neighbors_ = make_neighbor_strategy<D, R>(params_.neighbors, opt);
+  if (params_.audit) auditor_ = std::make_unique<ListAuditor<D, R>>();
   double extent = 0;
   for (int d = 0; d < D; ++d) extent = std::max(extent, params_.container.hi[d] - params_.container.lo[d]);
   speed_limit_ = 20.0 * std::sqrt(params_.fluid.stiffness) + std::sqrt(2.0 * norm(params_.gravity) * extent);
   std::int64_t capacity = static_cast<std::int64_t>(particles_.size());
   for (const auto& e : params_.emitters) capacity += e.max_particles;
   particles_.reserve(static_cast<std::size_t>(capacity));
-  // Density and pressure of the initial state, so that frame 0 shows real values.
+  // Density and pressure of the initial state, so that frame 0 shows real values. Exact lists
+  // from a throwaway standard strategy: the run's own strategy starts at step 0.
   if (!particles_.empty()) {
-    neighbors_->update(particles_, static_cast<R>(params_.time_step));
-    compute_density_pressure(particles_, neighbors_->lists(), static_cast<R>(params_.kernel_radius), params_.fluid);
+    auto exact = make_neighbor_strategy<D, R>(NeighborMode::Standard, opt);
+    exact->update(particles_, static_cast<R>(params_.time_step));
+    compute_density_pressure(particles_, exact->lists(), static_cast<R>(params_.kernel_radius), params_.fluid);
   }
 }
 
@@ -114,10 +118,15 @@ const StepInfo& Simulation<D, R>::step() {
   info.neighbors = neighbors_->counters();
   info.seconds.grid = info.neighbors.grid_seconds;
   info.seconds.lists = info.neighbors.lists_seconds;
+  const NeighborLists& lists = neighbors_->lists();
+  if (auditor_) {
+    info.audited = true;
+    info.audit = auditor_->audit(particles_.position, lists, h);
+  }
 
   Stopwatch watch;
-  const NeighborLists& lists = neighbors_->lists();
-  compute_density_pressure(particles_, lists, h, params_.fluid);
+  info.pairs_within_h =
+      compute_density_pressure(particles_, lists, h, params_.fluid, neighbors_->pair_exit_flags(), dt);
   info.seconds.density = watch.lap();
   compute_fluid_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity));
   add_wall_accelerations(particles_, params_.container, params_.obstacles, static_cast<R>(params_.particle_radius),
@@ -163,10 +172,11 @@ void Simulation<D, R>::check_state() const {
                            speed_limit_);
       else
         continue;
-      throw Error(fmt::format("simulation blew up at step {} (t = {:.6g} s): particle id {}: {}; density {:.6g}, "
-                              "pressure {:.6g}. Lower Configuration.timeStepSize or raise Fluid.viscosity",
-                              steps_ - 1, time(), particles_.id[i], what, static_cast<double>(particles_.density[i]),
-                              static_cast<double>(particles_.pressure[i])));
+      throw Error(
+          fmt::format("simulation blew up at step {} (t = {:.6g} s): particle id {}: {}; density {:.6g}, "
+                      "pressure {:.6g}. Lower Configuration.timeStepSize or raise Fluid.viscosity",
+                      steps_ - 1, time(), particles_.id[i], what, static_cast<double>(particles_.density[i]),
+                      static_cast<double>(particles_.pressure[i])));
     }
   }
 }
@@ -193,6 +203,28 @@ Vec<D, double> Simulation<D, R>::momentum() const {
       return static_cast<double>(particles_.mass[i]) * static_cast<double>(particles_.velocity[i][d]);
     });
   return p;
+}
+
+template <int D, std::floating_point R>
+void Simulation<D, R>::perturb_positions(std::size_t first, double amplitude, std::uint64_t seed) {
+  for (std::size_t i = first; i < particles_.size(); ++i) {
+    // SplitMix64 on (seed, id): a fixed sequence per particle, independent of its index.
+    std::uint64_t state = seed ^ (particles_.id[i] * 0x9E3779B97F4A7C15ull);
+    const auto next = [&state] {
+      std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+      z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+      z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+      return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53 * 2.0 - 1.0;  // [-1, 1)
+    };
+    Vec<D, double> dir{};
+    double len2 = 0;
+    do {
+      for (int d = 0; d < D; ++d) dir[d] = next();
+      len2 = norm2(dir);
+    } while (len2 > 1.0 || len2 < 1e-6);
+    dir *= amplitude / std::sqrt(len2);
+    particles_.position[i] += vec_cast<R>(dir);
+  }
 }
 
 template class Simulation<2, float>;

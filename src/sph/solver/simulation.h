@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <sph/core/particle_set.h>
+#include <sph/neighbors/audit.h>
 #include <sph/neighbors/strategy.h>
 #include <sph/solver/params.h>
 
@@ -22,12 +23,15 @@ struct PhaseTimes {
 
 /// What one step did.
 struct StepInfo {
-  std::int64_t step = 0;         ///< index of the step just taken (0-based)
-  double time = 0;               ///< simulated time after the step, s
+  std::int64_t step = 0;  ///< index of the step just taken (0-based)
+  double time = 0;        ///< simulated time after the step, s
   std::size_t particles = 0;
-  std::size_t emitted = 0;       ///< particles added by emitters at the start of this step
+  std::size_t emitted = 0;  ///< particles added by emitters at the start of this step
   NeighborCounters neighbors;
-  PhaseTimes seconds;
+  std::uint64_t pairs_within_h = 0;  ///< listed (directed) pairs closer than h this step
+  bool audited = false;              ///< SimulationParams::audit was on: `audit` is filled
+  ListAudit audit;                   ///< pairs within h that the lists missed this step
+  PhaseTimes seconds;                ///< (the audit's own time is in none of the phases)
 };
 
 /// Progress of one emitter (part of the simulation state).
@@ -39,7 +43,7 @@ struct EmitterState {
 /// A running simulation. Each step():
 ///   1. emitters add their batch (if due),
 ///   2. the neighbor strategy updates the lists (grid + lists phases),
-///   3. density and pressure (Eq. 4, EOS),
+///   3. density and pressure (Eq. 4, EOS), with the Eq. 7 test if the strategy asks for it,
 ///   4. pressure, viscous, gravity and wall accelerations (Eq. 5, 6),
 ///   5. symplectic Euler integration, then a check that every value is finite.
 template <int D, std::floating_point R>
@@ -71,6 +75,12 @@ class Simulation {
   /// Total linear momentum, kg m/s. Deterministic for any thread count.
   Vec<D, double> momentum() const;
 
+  /// Displaces the particles of index >= `first` by a pseudo-random vector of length
+  /// `amplitude` (m) each, drawn from the particle's id and `seed` only (so the same particle
+  /// gets the same displacement whatever its index). Used to measure how fast two runs that
+  /// differ by round-off drift apart (the chaos floor of `sph compare`).
+  void perturb_positions(std::size_t first, double amplitude, std::uint64_t seed);
+
  private:
   std::size_t emit();
   void check_state() const;
@@ -78,6 +88,7 @@ class Simulation {
   SimulationParams<D> params_;
   ParticleSet<D, R> particles_;
   std::unique_ptr<NeighborStrategy<D, R>> neighbors_;
+  std::unique_ptr<ListAuditor<D, R>> auditor_;
   std::vector<EmitterState> emitters_;
   std::int64_t steps_ = 0;
   double speed_limit_ = 0;

@@ -14,9 +14,7 @@ std::vector<TimeStepLimit> time_step_limits(const SimulationParams<D>& p) {
   std::vector<TimeStepLimit> out;
   const double dt = p.time_step;
   const double h = p.kernel_radius;
-  auto add = [&](const char* name, double warn, double refuse) {
-    out.push_back({name, dt / warn, warn, refuse});
-  };
+  auto add = [&](const char* name, double warn, double refuse) { out.push_back({name, dt / warn, warn, refuse}); };
   const double c = std::sqrt(p.fluid.stiffness);
   if (c > 0) add("acoustic CFL (dt <= 0.4 h / sqrt(stiffness))", 0.4 * h / c, 1.0 * h / c);
   const double nu = p.fluid.viscosity / p.fluid.rest_density;

@@ -1,28 +1,68 @@
 #include <sph/solver/wcsph.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
+#include <sph/core/error.h>
 #include <sph/core/kernels.h>
 #include <sph/core/parallel.h>
 
 namespace sph {
 
-template <int D, std::floating_point R>
-void compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid) {
+namespace {
+template <bool kExitTest, int D, std::floating_point R>
+std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
+                           std::span<std::uint8_t> flags, R dt) {
   const Poly6Kernel<D, R> poly6(h);
   const R w0 = poly6.w_zero();
+  const R h2 = h * h;
   const R rho0 = static_cast<R>(fluid.rest_density);
   const R k = static_cast<R>(fluid.stiffness);
   const bool clamp = fluid.negative_pressure == NegativePressure::Clamp;
-  parallel_for(ps.size(), [&](std::size_t i) {
-    const Vec<D, R> xi = ps.position[i];
-    R rho = ps.mass[i] * w0;
-    for (std::uint32_t j : lists.of(i)) rho += ps.mass[j] * poly6.w_r2(norm2(xi - ps.position[j]));
-    ps.density[i] = rho;
-    const R p = k * (rho - rho0);
-    ps.pressure[i] = clamp ? std::max(p, R(0)) : p;
+  const auto set_flag = [&](std::size_t q) {
+    std::atomic_ref<std::uint8_t>(flags[q]).store(1, std::memory_order_relaxed);
+  };
+  std::vector<std::uint64_t> within(chunk_count(ps.size()), 0);
+  parallel_chunks(ps.size(), [&](std::size_t c, std::size_t b, std::size_t e) {
+    std::uint64_t count = 0;
+    for (std::size_t i = b; i < e; ++i) {
+      const Vec<D, R> xi = ps.position[i];
+      R rho = ps.mass[i] * w0;
+      bool flag_i = false;
+      for (std::uint32_t j : lists.of(i)) {
+        const Vec<D, R> rij = xi - ps.position[j];
+        const R r2 = norm2(rij);
+        rho += ps.mass[j] * poly6.w_r2(r2);
+        count += r2 < h2 ? 1 : 0;
+        if constexpr (kExitTest) {
+          // Paper Eq. 7: the pair's distance after the step, predicted with today's velocities.
+          if (norm2(rij + (ps.velocity[i] - ps.velocity[j]) * dt) > h2) {
+            flag_i = true;
+            set_flag(j);
+          }
+        }
+      }
+      if constexpr (kExitTest)
+        if (flag_i) set_flag(i);
+      ps.density[i] = rho;
+      const R p = k * (rho - rho0);
+      ps.pressure[i] = clamp ? std::max(p, R(0)) : p;
+    }
+    within[c] = count;
   });
+  std::uint64_t total = 0;
+  for (std::uint64_t w : within) total += w;
+  return total;
+}
+}  // namespace
+
+template <int D, std::floating_point R>
+std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
+                                       std::span<std::uint8_t> exit_flags, R dt) {
+  if (exit_flags.empty()) return density_pass<false>(ps, lists, h, fluid, exit_flags, dt);
+  SPH_CHECK(exit_flags.size() == ps.size(), "one exit flag per particle");
+  return density_pass<true>(ps, lists, h, fluid, exit_flags, dt);
 }
 
 template <int D, std::floating_point R>
@@ -129,12 +169,13 @@ double lattice_mass(double rest_density, double spacing, double h) {
   return rest_density / sum;
 }
 
-#define SPH_INSTANTIATE(D, R)                                                                                   \
-  template void compute_density_pressure<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&); \
-  template void compute_fluid_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R,                 \
-                                                  const FluidParams&, const Vec<D, R>&);                        \
-  template void add_wall_accelerations<D, R>(ParticleSet<D, R>&, const Box<D>&, const std::vector<Box<D>>&, R,  \
-                                             const WallParams&);                                                \
+#define SPH_INSTANTIATE(D, R)                                                                                      \
+  template std::uint64_t compute_density_pressure<D, R>(ParticleSet<D, R>&, const NeighborLists&, R,               \
+                                                        const FluidParams&, std::span<std::uint8_t>, R);           \
+  template void compute_fluid_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&, \
+                                                  const Vec<D, R>&);                                               \
+  template void add_wall_accelerations<D, R>(ParticleSet<D, R>&, const Box<D>&, const std::vector<Box<D>>&, R,     \
+                                             const WallParams&);                                                   \
   template void integrate_symplectic_euler<D, R>(ParticleSet<D, R>&, R);
 SPH_INSTANTIATE(2, float)
 SPH_INSTANTIATE(2, double)

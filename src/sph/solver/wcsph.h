@@ -9,8 +9,17 @@ namespace sph {
 
 /// Paper Eq. 4 and the EOS: rho_i = m_i W(0) + sum_j m_j W_poly6(|x_i - x_j|), then
 /// p_i = k (rho_i - rho0), clamped at 0 when negative pressure is NegativePressure::Clamp.
+/// Listed pairs at or beyond h contribute nothing.
+///
+/// If `exit_flags` is not empty (one per particle), the same pass also evaluates paper Eq. 7
+/// for every listed pair, |x_i - x_j + dt (u_i - u_j)|^2 > h^2, and sets exit_flags[i] and
+/// exit_flags[j] to 1 when it holds (flags are only ever set, never cleared, so concurrent
+/// setting is race-free and the result is the same for any thread count).
+///
+/// Returns the number of listed (directed) pairs closer than h.
 template <int D, std::floating_point R>
-void compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid);
+std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
+                                       std::span<std::uint8_t> exit_flags = {}, R dt = 0);
 
 /// Accelerations from pressure (Eq. 5, spiky gradient), viscosity (Eq. 6 with (v_j - v_i),
 /// viscosity-kernel Laplacian) and gravity:

@@ -1,0 +1,58 @@
+#include <sph/neighbors/verlet.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include <sph/core/error.h>
+#include <sph/core/parallel.h>
+#include <sph/core/timer.h>
+
+namespace sph {
+
+template <int D, std::floating_point R>
+VerletNeighbors<D, R>::VerletNeighbors(R radius, R skin) : radius_(radius), skin_(skin) {
+  SPH_CHECK(radius > R(0), "neighbor radius must be positive");
+  SPH_CHECK(skin > R(0), "verlet skin must be positive");
+}
+
+template <int D, std::floating_point R>
+void VerletNeighbors<D, R>::update(const ParticleSet<D, R>& particles, R /*dt*/) {
+  Stopwatch watch;
+  const std::size_t n = particles.size();
+  bool rebuild = n != built_at_.size() || lists_.particle_count() != n;
+  if (!rebuild) {
+    // Largest squared displacement since the last build (a max: the same for any thread count).
+    chunk_max_.assign(chunk_count(n), R(0));
+    parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
+      R m = 0;
+      for (std::size_t i = b; i < e; ++i) m = std::max(m, norm2(particles.position[i] - built_at_[i]));
+      chunk_max_[c] = m;
+    });
+    R m2 = 0;
+    for (R m : chunk_max_) m2 = std::max(m2, m);
+    max_disp_ = std::sqrt(m2);
+    // Rebuild once a particle may have moved skin / 2 (a hair early, so that rounding in the
+    // distance computations can never let a pair within h slip).
+    const R trigger = R(0.5) * skin_ * R(0.999);
+    rebuild = !(m2 <= trigger * trigger);  // also rebuilds on NaN
+  }
+  counters_ = {};
+  if (rebuild) {
+    const R r = radius_ + skin_;
+    grid_.build(particles.position, r);
+    counters_.grid_seconds = watch.lap();
+    builder_.build(grid_, particles.position, r, lists_);
+    built_at_.assign(particles.position.begin(), particles.position.end());
+    max_disp_ = 0;
+    counters_.lists_rebuilt = n;
+  }
+  counters_.lists_seconds = watch.lap();
+  counters_.pairs_stored = lists_.entry_count();
+}
+
+template class VerletNeighbors<2, float>;
+template class VerletNeighbors<2, double>;
+template class VerletNeighbors<3, float>;
+template class VerletNeighbors<3, double>;
+
+}  // namespace sph

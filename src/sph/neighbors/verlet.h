@@ -1,0 +1,44 @@
+#pragma once
+/// \file The verlet strategy: exact lists with a skin, the molecular-dynamics standard.
+
+#include <sph/neighbors/list_builder.h>
+#include <sph/neighbors/strategy.h>
+#include <sph/neighbors/uniform_grid.h>
+
+namespace sph {
+
+/// Verlet (skin) lists. Lists hold every pair closer than h + skin at the last build and are
+/// reused until some particle has moved more than skin / 2 since then, or particles were
+/// added; then everything is rebuilt. Two particles closer than h now were closer than
+/// h + skin at the last build (each moved at most skin / 2), so no pair within h is ever
+/// missed. The solver ignores listed pairs beyond h (the kernels vanish there).
+template <int D, std::floating_point R>
+class VerletNeighbors final : public NeighborStrategy<D, R> {
+ public:
+  VerletNeighbors(R radius, R skin);
+  NeighborMode mode() const override { return NeighborMode::Verlet; }
+  void update(const ParticleSet<D, R>& particles, R dt) override;
+  const NeighborLists& lists() const override { return lists_; }
+  const NeighborCounters& counters() const override { return counters_; }
+
+  R skin() const { return skin_; }
+  /// Largest displacement of a particle since the last build, as measured by the last update().
+  R max_displacement() const { return max_disp_; }
+
+ private:
+  R radius_, skin_;
+  R max_disp_ = 0;
+  std::vector<Vec<D, R>> built_at_;  // positions at the last build
+  std::vector<R> chunk_max_;
+  UniformGrid<D, R> grid_;
+  ListBuilder<D, R> builder_;
+  NeighborLists lists_;
+  NeighborCounters counters_;
+};
+
+extern template class VerletNeighbors<2, float>;
+extern template class VerletNeighbors<2, double>;
+extern template class VerletNeighbors<3, float>;
+extern template class VerletNeighbors<3, double>;
+
+}  // namespace sph

@@ -1,0 +1,218 @@
+// The adaptive strategy (Algorithm 2) rebuilds exactly the flagged lists, the verlet strategy
+// never misses a pair within h and rebuilds when a particle moved half the skin, and the
+// auditor counts missed pairs and their penetration.
+
+#include <algorithm>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include <sph/core/parallel.h>
+#include <sph/neighbors/adaptive.h>
+#include <sph/neighbors/audit.h>
+#include <sph/neighbors/standard.h>
+#include <sph/neighbors/verlet.h>
+
+namespace sph {
+namespace {
+
+using V3 = Vec<3, double>;
+
+std::vector<std::uint32_t> sorted(std::span<const std::uint32_t> s) {
+  std::vector<std::uint32_t> v(s.begin(), s.end());
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+ParticleSet<3, double> random_particles(std::size_t n, double extent, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0, extent);
+  ParticleSet<3, double> ps;
+  for (std::size_t i = 0; i < n; ++i) ps.add(V3{u(rng), u(rng), u(rng)}, V3{}, 1.0);
+  return ps;
+}
+
+void jitter(ParticleSet<3, double>& ps, double amount, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-amount, amount);
+  for (auto& x : ps.position) x += V3{u(rng), u(rng), u(rng)};
+}
+
+struct ThreadCount {
+  int saved = num_threads();
+  ~ThreadCount() { set_num_threads(saved); }
+};
+
+constexpr double kH = 0.1;
+
+TEST(Adaptive, FirstUpdateBuildsEveryListExactly) {
+  auto ps = random_particles(3000, 1.0, 1);
+  AdaptiveNeighbors<3, double> a(kH, 200);
+  a.update(ps, 0.01);
+  const NeighborLists bf = brute_force_lists<3, double>(ps.position, kH);
+  EXPECT_EQ(a.counters().lists_rebuilt, ps.size());
+  ASSERT_EQ(a.lists().entry_count(), bf.entry_count());
+  for (std::size_t i = 0; i < ps.size(); ++i) ASSERT_EQ(sorted(a.lists().of(i)), sorted(bf.of(i)));
+  ASSERT_EQ(a.pair_exit_flags().size(), ps.size());
+  EXPECT_TRUE(std::all_of(a.pair_exit_flags().begin(), a.pair_exit_flags().end(), [](auto f) { return f == 0; }));
+}
+
+TEST(Adaptive, RebuildsOnlyFlaggedListsAndKeepsTheOthers) {
+  auto ps = random_particles(3000, 1.0, 2);
+  AdaptiveNeighbors<3, double> a(kH, 200);
+  a.update(ps, 0.01);
+  const NeighborLists before = a.lists();
+
+  // Nothing flagged: the particles moved, but no list changes and nothing is rebuilt.
+  jitter(ps, 0.02, 3);
+  a.update(ps, 0.01);
+  EXPECT_EQ(a.counters().lists_rebuilt, 0u);
+  EXPECT_EQ(a.lists().offsets, before.offsets);
+  EXPECT_EQ(a.lists().indices, before.indices);
+
+  // Flag a few: exactly their lists are rebuilt, at the current positions.
+  const std::vector<std::size_t> flagged{0, 17, 1023, 1024, 2999};
+  for (std::size_t i : flagged) a.pair_exit_flags()[i] = 1;
+  a.update(ps, 0.01);
+  EXPECT_EQ(a.counters().lists_rebuilt, flagged.size());
+  const NeighborLists now = brute_force_lists<3, double>(ps.position, kH);
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    const bool is_flagged = std::find(flagged.begin(), flagged.end(), i) != flagged.end();
+    if (is_flagged) {
+      EXPECT_EQ(sorted(a.lists().of(i)), sorted(now.of(i))) << "flagged particle " << i;
+      changed += sorted(before.of(i)) != sorted(now.of(i));
+    } else {
+      ASSERT_EQ(sorted(a.lists().of(i)), sorted(before.of(i))) << "unflagged particle " << i << " changed";
+    }
+  }
+  EXPECT_GT(changed, 0u) << "the jitter should have changed some flagged lists (else the test proves nothing)";
+  EXPECT_TRUE(std::all_of(a.pair_exit_flags().begin(), a.pair_exit_flags().end(), [](auto f) { return f == 0; }))
+      << "flags are cleared by the update that consumed them";
+}
+
+TEST(Adaptive, AppendedParticlesGetListsAndFullRebuildComesOnSchedule) {
+  auto ps = random_particles(500, 0.5, 4);
+  AdaptiveNeighbors<3, double> a(kH, 3);
+  a.update(ps, 0.01);  // update 0: full
+  for (int k = 0; k < 20; ++k) ps.add(V3{0.25 + 0.001 * k, 0.25, 0.25}, V3{}, 1.0);
+  a.update(ps, 0.01);  // update 1: only the 20 new particles
+  EXPECT_EQ(a.counters().lists_rebuilt, 20u);
+  ASSERT_EQ(a.lists().particle_count(), ps.size());
+  const NeighborLists bf = brute_force_lists<3, double>(ps.position, kH);
+  for (std::size_t i = 500; i < ps.size(); ++i) EXPECT_EQ(sorted(a.lists().of(i)), sorted(bf.of(i)));
+  a.update(ps, 0.01);  // update 2: nothing flagged
+  EXPECT_EQ(a.counters().lists_rebuilt, 0u);
+  jitter(ps, 0.01, 5);
+  a.update(ps, 0.01);  // update 3: the period's full rebuild
+  EXPECT_EQ(a.counters().lists_rebuilt, ps.size());
+  const NeighborLists bf2 = brute_force_lists<3, double>(ps.position, kH);
+  for (std::size_t i = 0; i < ps.size(); ++i) ASSERT_EQ(sorted(a.lists().of(i)), sorted(bf2.of(i)));
+}
+
+TEST(Adaptive, PartialRebuildIsIdenticalForAnyThreadCount) {
+  ThreadCount restore;
+  NeighborLists result[2];
+  for (int t : {1, 2}) {
+    set_num_threads(t);
+    auto ps = random_particles(5000, 1.0, 6);
+    AdaptiveNeighbors<3, double> a(kH, 200);
+    a.update(ps, 0.01);
+    jitter(ps, 0.02, 7);
+    for (std::size_t i = 0; i < ps.size(); i += 7) a.pair_exit_flags()[i] = 1;
+    a.update(ps, 0.01);
+    result[t - 1] = a.lists();
+  }
+  EXPECT_EQ(result[0].offsets, result[1].offsets);
+  EXPECT_EQ(result[0].indices, result[1].indices);
+}
+
+TEST(Verlet, NeverMissesAPairWithinHAndRebuildsAtHalfTheSkin) {
+  auto ps = random_particles(2000, 1.0, 8);
+  const double skin = 0.02;
+  VerletNeighbors<3, double> v(kH, skin);
+  ListAuditor<3, double> auditor;
+  v.update(ps, 0.01);
+  EXPECT_EQ(v.counters().lists_rebuilt, ps.size());
+  // Lists hold exactly the pairs within h + skin.
+  const NeighborLists wide = brute_force_lists<3, double>(ps.position, kH + skin);
+  for (std::size_t i = 0; i < ps.size(); ++i) ASSERT_EQ(sorted(v.lists().of(i)), sorted(wide.of(i)));
+
+  // Random small moves: rebuilds happen only after someone moved skin / 2, and nothing within
+  // h is ever missed in between.
+  int rebuilds = 0, reuses = 0;
+  std::vector<V3> built = ps.position;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-0.002, 0.002);
+  for (int step = 0; step < 40; ++step) {
+    for (auto& x : ps.position) x += V3{u(rng), u(rng), u(rng)};
+    double max_move = 0;
+    for (std::size_t i = 0; i < ps.size(); ++i) max_move = std::max(max_move, norm(ps.position[i] - built[i]));
+    v.update(ps, 0.01);
+    if (v.counters().lists_rebuilt > 0) {
+      ++rebuilds;
+      EXPECT_GT(max_move, 0.4999 * skin) << "rebuilt before any particle moved skin / 2";
+      built = ps.position;
+    } else {
+      ++reuses;
+      EXPECT_LE(max_move, 0.5 * skin);
+    }
+    const ListAudit audit = auditor.audit(ps.position, v.lists(), kH);
+    ASSERT_EQ(audit.missed_pairs, 0u) << "step " << step;
+  }
+  EXPECT_GT(rebuilds, 0);
+  EXPECT_GT(reuses, rebuilds) << "the skin should let most steps reuse the lists";
+}
+
+TEST(Verlet, RebuildsWhenParticlesAreAdded) {
+  auto ps = random_particles(300, 0.5, 10);
+  VerletNeighbors<3, double> v(kH, 0.02);
+  v.update(ps, 0.01);
+  v.update(ps, 0.01);
+  EXPECT_EQ(v.counters().lists_rebuilt, 0u);
+  ps.add(V3{0.25, 0.25, 0.25}, V3{}, 1.0);
+  v.update(ps, 0.01);
+  EXPECT_EQ(v.counters().lists_rebuilt, ps.size());
+  EXPECT_EQ(v.lists().particle_count(), ps.size());
+}
+
+TEST(Audit, CountsMissedPairsAndTheirPenetration) {
+  ParticleSet<3, double> ps;
+  ps.add(V3{0, 0, 0}, V3{}, 1.0);
+  ps.add(V3{0.03, 0, 0}, V3{}, 1.0);  // 0.3 h from particle 0
+  ps.add(V3{0, 0.08, 0}, V3{}, 1.0);  // 0.8 h from particle 0
+  ps.add(V3{1, 1, 1}, V3{}, 1.0);     // alone
+  ListAuditor<3, double> auditor;
+  const NeighborLists exact = brute_force_lists<3, double>(ps.position, kH);
+  EXPECT_EQ(auditor.audit(ps.position, exact, kH).missed_pairs, 0u);
+
+  // Particle 0 lists only particle 2; particle 1 lists nothing; particle 2 lists 0.
+  NeighborLists lists;
+  lists.offsets = {0, 1, 1, 2, 2};
+  lists.indices = {2, 0};
+  const ListAudit a = auditor.audit(ps.position, lists, kH);
+  // Missed: 0->1 and 1->0 (r = 0.3 h, penetration 0.7), 2->1? |(0,0.08)-(0.03,0)| = 0.0854 < h: 2->1 and 1->2.
+  EXPECT_EQ(a.missed_pairs, 4u);
+  EXPECT_EQ(a.particles_missing, 3u);
+  EXPECT_NEAR(a.max_penetration, 0.7, 1e-12);
+}
+
+TEST(Audit, FindsWhatAdaptiveListsMissWhenParticlesApproach) {
+  // Two particles out of range, approaching: no listed pair leaves, so nothing is flagged and
+  // the adaptive lists keep missing the pair until the full rebuild.
+  ParticleSet<3, double> ps;
+  ps.add(V3{0, 0, 0}, V3{}, 1.0);
+  ps.add(V3{0.15, 0, 0}, V3{}, 1.0);
+  AdaptiveNeighbors<3, double> a(kH, 200);
+  ListAuditor<3, double> auditor;
+  a.update(ps, 0.01);
+  EXPECT_EQ(a.lists().entry_count(), 0u);
+  ps.position[1][0] = 0.05;
+  a.update(ps, 0.01);
+  const ListAudit audit = auditor.audit(ps.position, a.lists(), kH);
+  EXPECT_EQ(audit.missed_pairs, 2u);
+  EXPECT_NEAR(audit.max_penetration, 0.5, 1e-12);
+}
+
+}  // namespace
+}  // namespace sph

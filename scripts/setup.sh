@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   nlohmann-json3-dev libcli11-dev libfmt-dev libomp-dev
-  libgtest-dev libgmock-dev
+  libgtest-dev libgmock-dev libpng-dev
   python3 python3-vtk9 python3-numpy
 )
 

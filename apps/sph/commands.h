@@ -13,5 +13,7 @@ enum ExitCode { kOk = 0, kRunFailed = 1, kBadInput = 2, kInternal = 70 };
 
 /// Adds `sph run` to the app; the returned function runs it after parsing.
 std::function<int()> add_run_command(CLI::App& app);
+/// Adds `sph compare`.
+std::function<int()> add_compare_command(CLI::App& app);
 
 }  // namespace sph::app

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <sph/core/error.h>
 #include <sph/core/version.h>
@@ -43,15 +43,19 @@ std::string first_unknown_option(CLI::App& app, int argc, char** argv) {
 
 int main(int argc, char** argv) {
   using namespace sph::app;
-  CLI::App app{"sph: Smoothed Particle Hydrodynamics fluids in 2D and 3D with adaptive neighbor pairing.\n\n"
-               "  sph run SCENE.json [-o DIR] [--neighbors standard|adaptive|verlet] [--steps N] [--threads N]\n"
-               "                     [--set KEY=VALUE]...     run a scene (sph run --help for details)\n\n"
-               "Example: sph run scenes/paper/dam_break_2d.json -o out/dam_break_2d\n"
-               "         then open out/dam_break_2d/frames.pvd in ParaView.",
-               "sph"};
+  CLI::App app{
+      "sph: Smoothed Particle Hydrodynamics fluids in 2D and 3D with adaptive neighbor pairing.\n\n"
+      "  sph run SCENE.json [-o DIR] [--neighbors standard|adaptive|verlet] [--steps N] [--threads N]\n"
+      "                     [--set KEY=VALUE]...     run a scene (sph run --help for details)\n"
+      "  sph compare SCENE.json [-o DIR] [--modes standard,adaptive,verlet] [--steps N]\n"
+      "                     compare the neighbor modes: speed, accuracy, missed pairs, images\n\n"
+      "Example: sph run scenes/paper/dam_break_2d.json -o out/dam_break_2d\n"
+      "         then open out/dam_break_2d/frames.pvd in ParaView.",
+      "sph"};
   app.set_version_flag("--version", std::string("sph ") + sph::kVersion);
   app.require_subcommand(1);
-  std::function<int()> run = add_run_command(app);
+  std::function<int()> run_cmd = add_run_command(app);
+  std::function<int()> compare_cmd = add_compare_command(app);
 
   try {
     app.parse(argc, argv);
@@ -72,7 +76,7 @@ int main(int argc, char** argv) {
   }
 
   try {
-    return run();
+    return app.got_subcommand("compare") ? compare_cmd() : run_cmd();
   } catch (const sph::Error& e) {
     fmt::print(stderr, "sph: error: {}\n", e.what());
     return kBadInput;

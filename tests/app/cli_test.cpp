@@ -218,6 +218,28 @@ TEST_F(Cli, EveryNeighborModeRunsAndAuditFillsTheAuditColumns) {
   EXPECT_CONTAINS(read_file(work_ / "o" / "stats.csv"), ",,,");
 }
 
+TEST_F(Cli, CompareWritesTheReportAndRefusesBadModes) {
+  const Result ok = sph({"compare", kDamBreak, "--steps", "20", "--modes", "adaptive", "--frames", "1", "--set",
+                         "FluidBlocks[0].end=[0.2,0.4]", "-o", "cmp", "--no-progress"});
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_CONTAINS(ok.err, "report");
+  EXPECT_TRUE(fs::is_regular_file(work_ / "cmp" / "report.md"));
+  EXPECT_TRUE(fs::is_regular_file(work_ / "cmp" / "frame_000020.png"));
+  EXPECT_CONTAINS(read_file(work_ / "cmp" / "phases.csv"), "standard (perturbed)");
+
+  for (const char* modes : {"standard,bogus", "adaptive,adaptive", "brute_force", ","}) {
+    const Result r = sph({"compare", kDamBreak, "--modes", modes, "-o", "bad"});
+    EXPECT_EQ(r.code, 2) << modes;
+    EXPECT_CONTAINS(r.err, "--modes");
+    EXPECT_EQ(count(r.err, "sph: error:"), 1u) << r.err;
+    EXPECT_FALSE(fs::exists(work_ / "bad")) << modes;
+  }
+  const Result missing = sph({"compare", "no_such_scene.json", "-o", "bad"});
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_CONTAINS(missing.err, "no_such_scene.json");
+  EXPECT_FALSE(fs::exists(work_ / "bad"));
+}
+
 TEST_F(Cli, ZeroThreadsRefused) {
   const Result r = sph({"run", kDamBreak, "--threads", "0", "-o", "o"});
   EXPECT_EQ(r.code, 2);

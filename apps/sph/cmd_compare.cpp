@@ -1,0 +1,155 @@
+// `sph compare SCENE.json -o DIR`: runs the neighbor modes on one scene and reports speed,
+// accuracy against the standard run and the chaos floor, missed pairs, and images.
+
+#include <filesystem>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include <sph/analysis/compare.h>
+#include <sph/core/error.h>
+#include <sph/core/parallel.h>
+#include <sph/core/timer.h>
+#include <sph/io/atomic_file.h>
+#include <sph/scene/scene_reader.h>
+
+#include "commands.h"
+
+namespace sph::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CompareCliOptions {
+  std::string scene;
+  std::string output;
+  std::string modes = "standard,adaptive,verlet";
+  std::int64_t steps = 0;
+  int threads = 0;
+  int frames = 3;
+  double perturbation = 1e-9;
+  std::vector<std::string> sets;
+  bool no_audit = false;
+  bool no_progress = false;
+};
+
+std::vector<NeighborMode> parse_modes(const std::string& list) {
+  std::vector<NeighborMode> modes;
+  std::stringstream ss(list);
+  for (std::string item; std::getline(ss, item, ',');) {
+    if (item.empty())
+      throw Error("empty mode name in \"" + list + "\"; expected e.g. standard,adaptive,verlet", "--modes");
+    const NeighborMode m = parse_neighbor_mode(item, "--modes");
+    if (m == NeighborMode::BruteForce)
+      throw Error("brute_force is the test oracle, too slow to compare; expected standard, adaptive or verlet",
+                  "--modes");
+    if (std::find(modes.begin(), modes.end(), m) != modes.end())
+      throw Error("mode \"" + item + "\" is listed twice", "--modes");
+    modes.push_back(m);
+  }
+  if (modes.empty()) throw Error("no mode given; expected e.g. standard,adaptive,verlet", "--modes");
+  return modes;
+}
+
+/// Creates `dir`, checks it is writable and removes what an earlier comparison left there.
+void prepare_compare_directory(const fs::path& dir) {
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw Error("exists and is not a directory; expected a directory for the comparison's output", dir.string());
+  fs::create_directories(dir, ec);
+  if (ec) throw Error("cannot create the output directory: " + ec.message(), dir.string());
+  { AtomicFile probe(dir / ".write-test"); }
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string f = entry.path().filename().string();
+    const bool frame = f.rfind("frame_", 0) == 0 && entry.path().extension() == ".png";
+    if (frame) fs::remove(entry.path(), ec);
+  }
+}
+
+int compare(const CompareCliOptions& opt) {
+  CompareOptions co;
+  co.modes = parse_modes(opt.modes);
+  co.steps = opt.steps;
+  co.frames = opt.frames;
+  co.perturbation = opt.perturbation;
+  co.audit = !opt.no_audit;
+  if (opt.threads > 0) set_num_threads(opt.threads);
+
+  std::vector<std::string> sets = opt.sets;
+  if (opt.steps > 0) sets.push_back("Configuration.numberOfSteps=" + std::to_string(opt.steps));
+  const SceneDesc desc = read_scene_file(opt.scene, sets);
+  for (const auto& w : desc.warnings) fmt::print(stderr, "sph: warning: {}\n", w);
+  const fs::path dir = opt.output.empty() ? fs::path("out") / (desc.name + "_compare") : fs::path(opt.output);
+  prepare_compare_directory(dir);
+
+  fmt::print(stderr, "sph: compare {} ({}D, {} steps, {} thread{}) -> {}\n", desc.name, desc.dimension, desc.steps,
+             num_threads(), num_threads() == 1 ? "" : "s", dir.string());
+  Stopwatch wall;
+  const CompareProgress progress = [&](const std::string& label, int index, int count, std::int64_t done,
+                                       std::int64_t total) {
+    if (opt.no_progress) return;
+    if (done == total)
+      fmt::print(stderr, "sph: [{}/{}] {}: done\n", index + 1, count, label);
+    else if (done * 4 % total < 4 * total / 20 + 1 && done * 4 >= total &&
+             done * 4 / total != (done - total / 20) * 4 / total)
+      fmt::print(stderr, "sph: [{}/{}] {}: {} %\n", index + 1, count, label, 100 * done / total);
+  };
+  const CompareResult result = run_comparison(desc, co, progress);
+  write_comparison(dir, result);
+
+  // A one-screen summary: speed ratios and the final divergence.
+  fmt::print(stderr, "sph: compared in {:.1f} s:\n", wall.elapsed());
+  const double ref = result.runs[0].totals.total();
+  for (std::size_t k = 0; k < result.runs.size(); ++k) {
+    const RunRecord& r = result.runs[k];
+    const double t = r.totals.total();
+    std::string line = fmt::format("  {:<22} {:8.3f} s  {:5.2f}x", r.label, t, t > 0 ? ref / t : 0.0);
+    if (k > 0 && !result.divergence[k].empty())
+      line += fmt::format("  RMS divergence at end {:.3g} h", result.divergence[k].back().rms);
+    std::uint64_t missed = 0;
+    for (const auto& s : r.steps) missed += s.missed_pairs;
+    if (co.audit) line += fmt::format("  missed pairs {}", missed);
+    if (!r.failure.empty()) line += "  FAILED: " + r.failure;
+    fmt::print(stderr, "{}\n", line);
+  }
+  fmt::print(stderr, "  report: {}\n", (dir / "report.md").string());
+  for (const RunRecord& r : result.runs)
+    if (!r.failure.empty()) return kRunFailed;
+  return kOk;
+}
+
+}  // namespace
+
+std::function<int()> add_compare_command(CLI::App& app) {
+  auto opt = std::make_shared<CompareCliOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "compare", "Run the neighbor modes on one scene and write a report: speed, divergence, missed pairs, images");
+  cmd->add_option("scene", opt->scene, "Scene file (JSON; see docs/scene-format.md)")->required();
+  cmd->add_option("-o,--output", opt->output, "Output directory (default: out/<scene name>_compare)");
+  cmd->add_option("--modes", opt->modes, "Comma-separated modes to run (standard is always run: it is the reference)")
+      ->default_str("standard,adaptive,verlet");
+  cmd->add_option("--steps", opt->steps, "Number of steps, overriding Configuration.numberOfSteps")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1'000'000'000}));
+  cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
+  cmd->add_option("--frames", opt->frames, "Side-by-side images at this many evenly spaced steps")
+      ->check(CLI::Range(1, 100))
+      ->default_str("3");
+  cmd->add_option("--perturbation", opt->perturbation,
+                  "Chaos floor: a second standard run with particles displaced by this fraction of h (0: none)")
+      ->check(CLI::Range(0.0, 0.1))
+      ->default_str("1e-9");
+  cmd->add_option("--set", opt->sets, "Override a scene value by its key path (repeatable), as in sph run")
+      ->type_name("KEY=VALUE");
+  cmd->add_flag("--no-audit", opt->no_audit, "Do not audit the lists for missed pairs (the audit is never timed)");
+  cmd->add_flag("--no-progress", opt->no_progress, "No progress lines");
+  return [opt, cmd]() -> int {
+    if (!cmd->parsed()) return kBadInput;
+    return compare(*opt);
+  };
+}
+
+}  // namespace sph::app

@@ -1,0 +1,227 @@
+#include <sph/render/particles.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include <sph/core/error.h>
+
+namespace sph {
+
+namespace {
+
+using Vec3 = std::array<double, 3>;
+
+constexpr Rgb kBoxColor{150, 150, 150};
+constexpr Rgb kDefaultParticle{0, 114, 178};
+
+double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/// Unit vector towards the light in camera space (x right, y up, z towards the viewer):
+/// from the upper left, somewhat in front.
+const Vec3 kLight = [] {
+  const Vec3 l{-1.0, 1.0, 1.4};
+  const double n = std::sqrt(dot(l, l));
+  return Vec3{l[0] / n, l[1] / n, l[2] / n};
+}();
+constexpr double kAmbient = 0.32;
+constexpr double kDiffuse = 0.78;
+
+std::uint8_t channel(float v) { return static_cast<std::uint8_t>(std::min(v + 0.5f, 255.0f)); }
+
+/// A sphere-shaded disc: per pixel the sphere normal under the pixel center gives a Lambert term;
+/// the rim is anti-aliased by coverage. This is the hot loop of render_particles.
+void shaded_disc(Image& img, double cx, double cy, double r, Rgb c) {
+  const double reach = r + 0.5;
+  const int ya = detail::floor_clamped(cy - reach, 0, img.height());
+  const int yb = detail::ceil_clamped(cy + reach, -1, img.height() - 1);
+  const float inv_r = static_cast<float>(1.0 / r);
+  const float inner2 = static_cast<float>(std::max(0.0, r - 0.5) * std::max(0.0, r - 0.5));  // full coverage
+  const float lx = static_cast<float>(kLight[0]), ly = static_cast<float>(kLight[1]),
+              lz = static_cast<float>(kLight[2]);
+  const float cr = c.r, cg = c.g, cb = c.b;
+  for (int y = ya; y <= yb; ++y) {
+    const double ey = y + 0.5 - cy;
+    if (std::abs(ey) >= reach) continue;
+    const double w = std::sqrt(reach * reach - ey * ey);
+    const int xa = detail::floor_clamped(cx - w, 0, img.width());
+    const int xb = detail::ceil_clamped(cx + w, -1, img.width() - 1);
+    const std::span<Rgb> row = img.row(y);
+    const float fy = static_cast<float>(ey);
+    const float ny = -fy * inv_r;
+    for (int x = xa; x <= xb; ++x) {
+      const float fx = static_cast<float>(x + 0.5 - cx);
+      const float d2 = fx * fx + fy * fy;
+      float nx = fx * inv_r, nyy = ny;
+      const float rho2 = nx * nx + nyy * nyy;
+      float nz = 0.0f;
+      if (rho2 < 1.0f) {
+        nz = std::sqrt(1.0f - rho2);
+      } else {
+        const float k = 1.0f / std::sqrt(rho2);
+        nx *= k;
+        nyy *= k;
+      }
+      const float shade =
+          static_cast<float>(kAmbient) + static_cast<float>(kDiffuse) * std::max(0.0f, nx * lx + nyy * ly + nz * lz);
+      const Rgb s{channel(cr * shade), channel(cg * shade), channel(cb * shade)};
+      if (d2 <= inner2) {
+        row[x] = s;
+      } else {
+        const double coverage = reach - std::sqrt(static_cast<double>(d2));
+        if (coverage > 0.0) row[x] = mix(row[x], s, coverage);
+      }
+    }
+  }
+}
+
+struct Drawn {
+  double x, y, depth;
+  std::size_t index;
+};
+
+}  // namespace
+
+ParticleView default_particle_view(int dim, int width, int height) {
+  ParticleView v;
+  v.width = width;
+  v.height = height;
+  if (dim == 3) {
+    v.azimuth_deg = 30.0;
+    v.elevation_deg = 20.0;
+  }
+  return v;
+}
+
+ParticleCamera::ParticleCamera(int dim, const Vec3& box_lo, const Vec3& box_hi, double radius, const ParticleView& view)
+    : dim_(dim) {
+  SPH_CHECK(dim == 2 || dim == 3, "dimension must be 2 or 3");
+  if (view.width < 1 || view.height < 1 || view.width > 16384 || view.height > 16384)
+    throw Error(fmt::format("image size {} x {} is out of range (1 to 16384 pixels a side)", view.width, view.height));
+  if (!std::isfinite(view.azimuth_deg) || !std::isfinite(view.elevation_deg))
+    throw Error("camera angles must be finite numbers");
+  if (!std::isfinite(radius) || radius < 0.0)
+    throw Error(fmt::format("particle radius must be a finite number >= 0 (got {})", radius));
+  for (int a = 0; a < dim; ++a)
+    if (!std::isfinite(box_lo[a]) || !std::isfinite(box_hi[a]) || box_lo[a] > box_hi[a])
+      throw Error(fmt::format("the box must have finite corners with lo <= hi (axis {}: {} .. {})", "xyz"[a], box_lo[a],
+                              box_hi[a]));
+
+  if (dim == 3) {
+    const double az = view.azimuth_deg * std::numbers::pi / 180.0;
+    const double el = view.elevation_deg * std::numbers::pi / 180.0;
+    axes_[0] = {std::cos(az), 0.0, -std::sin(az)};                                          // right
+    axes_[1] = {-std::sin(az) * std::sin(el), std::cos(el), -std::cos(az) * std::sin(el)};  // up
+    axes_[2] = {std::sin(az) * std::cos(el), std::sin(el), std::cos(az) * std::cos(el)};    // to viewer
+  } else {
+    axes_ = {{{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}}};
+  }
+  for (int a = 0; a < 3; ++a) center_[a] = a < dim ? 0.5 * (box_lo[a] + box_hi[a]) : 0.0;
+
+  // Screen-space extent of the box corners, grown by the radius.
+  double ux = 0.0, uy = 0.0;  // half extents
+  const int corners = dim == 3 ? 8 : 4;
+  for (int k = 0; k < corners; ++k) {
+    Vec3 p{};
+    for (int a = 0; a < dim; ++a) p[a] = ((k >> a) & 1 ? box_hi[a] : box_lo[a]) - center_[a];
+    ux = std::max(ux, std::abs(dot(p, axes_[0])));
+    uy = std::max(uy, std::abs(dot(p, axes_[1])));
+  }
+  ux += radius;
+  uy += radius;
+  if (ux <= 0.0 && uy <= 0.0) ux = uy = 1.0;  // a point: any scale will do
+  const double margin = std::max(2.0, 0.04 * std::min(view.width, view.height));
+  const double avail_x = std::max(1.0, view.width - 2.0 * margin), avail_y = std::max(1.0, view.height - 2.0 * margin);
+  scale_ = std::min(ux > 0.0 ? avail_x / (2.0 * ux) : HUGE_VAL, uy > 0.0 ? avail_y / (2.0 * uy) : HUGE_VAL);
+  cx_ = 0.5 * view.width;
+  cy_ = 0.5 * view.height;
+}
+
+std::array<double, 3> ParticleCamera::project(const Vec3& p) const {
+  Vec3 q{p[0] - center_[0], p[1] - center_[1], dim_ == 3 ? p[2] - center_[2] : 0.0};
+  return {cx_ + dot(q, axes_[0]) * scale_, cy_ - dot(q, axes_[1]) * scale_, dim_ == 3 ? dot(q, axes_[2]) : 0.0};
+}
+
+Image render_particles(std::span<const double> xyz, int dim, std::span<const Rgb> colors, double radius,
+                       const Vec3& box_lo, const Vec3& box_hi, const ParticleView& view) {
+  SPH_CHECK(dim == 2 || dim == 3, "dimension must be 2 or 3");
+  SPH_CHECK(xyz.size() % static_cast<std::size_t>(dim) == 0, "xyz must hold dim coordinates per particle");
+  const std::size_t n = xyz.size() / static_cast<std::size_t>(dim);
+  SPH_CHECK(colors.size() <= 1 || colors.size() == n, "colors must hold 0, 1 or one color per particle");
+  const ParticleCamera cam(dim, box_lo, box_hi, radius, view);
+  Image img(view.width, view.height, view.background);
+
+  // Box edges: corners k and k ^ (1 << a) differ along axis a.
+  struct Edge {
+    std::array<double, 3> p0, p1;
+    bool front;
+  };
+  std::vector<Edge> edges;
+  const int corners = dim == 3 ? 8 : 4;
+  auto corner = [&](int k) {
+    Vec3 p{};
+    for (int a = 0; a < dim; ++a) p[a] = (k >> a) & 1 ? box_hi[a] : box_lo[a];
+    return p;
+  };
+  for (int k = 0; k < corners; ++k)
+    for (int a = 0; a < dim; ++a) {
+      const int j = k ^ (1 << a);
+      if (j < k) continue;
+      bool front = true;  // 2D: the outline goes over the particles
+      if (dim == 3) {
+        // The edge bounds the two faces normal to the other two axes, on the corner's sides;
+        // it is in front if either face turns towards the camera.
+        front = false;
+        for (int b = 0; b < 3; ++b) {
+          if (b == a) continue;
+          const double sign = (k >> b) & 1 ? 1.0 : -1.0;
+          if (sign * cam.axes()[2][b] > 1e-9) front = true;
+        }
+      }
+      edges.push_back({cam.project(corner(k)), cam.project(corner(j)), front});
+    }
+  auto draw_edges = [&](bool front) {
+    for (const Edge& e : edges)
+      if (e.front == front) img.draw_line(e.p0[0], e.p0[1], e.p1[0], e.p1[1], kBoxColor, 1.0);
+  };
+  draw_edges(false);
+
+  // Project, skip non-finite positions, order far to near (3D).
+  std::vector<Drawn> drawn;
+  drawn.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec3 p{};
+    bool finite = true;
+    for (int a = 0; a < dim; ++a) {
+      p[a] = xyz[i * dim + a];
+      finite = finite && std::isfinite(p[a]);
+    }
+    if (!finite) continue;
+    const auto s = cam.project(p);
+    drawn.push_back({s[0], s[1], s[2], i});
+  }
+  if (dim == 3)
+    std::sort(drawn.begin(), drawn.end(), [](const Drawn& a, const Drawn& b) {
+      return a.depth != b.depth ? a.depth < b.depth : a.index < b.index;
+    });
+
+  const double r = radius * cam.pixels_per_unit();
+  for (const Drawn& d : drawn) {
+    const Rgb c = colors.empty() ? kDefaultParticle : colors.size() == 1 ? colors[0] : colors[d.index];
+    if (r < 1.0)  // smaller than a pixel: still one whole pixel, shaded as a sphere's center
+      img.set(detail::floor_clamped(d.x, -1, img.width()), detail::floor_clamped(d.y, -1, img.height()),
+              view.shaded ? scaled(c, kAmbient + kDiffuse * kLight[2]) : c);
+    else if (view.shaded)
+      shaded_disc(img, d.x, d.y, r, c);
+    else
+      img.fill_disc(d.x, d.y, r, c);
+  }
+
+  draw_edges(true);
+  return img;
+}
+
+}  // namespace sph

@@ -1,0 +1,65 @@
+#pragma once
+/// \file Images of particles: each particle a disc (optionally shaded as a sphere) seen by an
+/// orthographic camera fitted to the container box, which is drawn as a thin outline.
+
+#include <array>
+#include <span>
+
+#include <sph/render/image.h>
+
+namespace sph {
+
+/// What the camera sees and how particles look.
+struct ParticleView {
+  int width = 800, height = 600;  ///< image size in pixels
+  /// Orthographic camera for 3D (2D ignores them): the camera starts on the +z side looking
+  /// towards -z (x right, y up), turns by `azimuth_deg` about the world y axis (positive shows
+  /// more of the +x side), then rises by `elevation_deg` (positive looks down onto the top).
+  double azimuth_deg = 0, elevation_deg = 0;
+  Rgb background{255, 255, 255};
+  bool shaded = true;  ///< sphere shading (Lambert, light from the upper left, plus ambient)
+};
+
+/// A 3D camera that shows depth well (azimuth 30, elevation 20) for dim 3, the plain view for
+/// dim 2; width x height pixels.
+ParticleView default_particle_view(int dim, int width = 800, int height = 600);
+
+/// The mapping from world coordinates to pixel coordinates used by render_particles: the box
+/// (grown by the particle radius) fills the image with a small margin, aspect ratio preserved.
+class ParticleCamera {
+ public:
+  /// Throws sph::Error for a bad view (size outside 1..16384, non-finite angles), a box with
+  /// non-finite corners or lo > hi, or a negative or non-finite radius. Precondition: dim is 2 or 3.
+  ParticleCamera(int dim, const std::array<double, 3>& box_lo, const std::array<double, 3>& box_hi, double radius,
+                 const ParticleView& view);
+
+  /// Pixel coordinates (x right, y down; pixel centers at +0.5) and depth (larger is nearer the
+  /// camera; 0 in 2D) of a world point. In 2D, p[2] is ignored.
+  std::array<double, 3> project(const std::array<double, 3>& p) const;
+  /// Pixels per world unit.
+  double pixels_per_unit() const { return scale_; }
+  /// Camera-space unit vectors in world coordinates: right, up, towards the viewer.
+  const std::array<std::array<double, 3>, 3>& axes() const { return axes_; }
+
+ private:
+  int dim_;
+  std::array<std::array<double, 3>, 3> axes_{};
+  std::array<double, 3> center_{};
+  double scale_ = 1.0;
+  double cx_ = 0.0, cy_ = 0.0;  ///< pixel position of the box center
+};
+
+/// Renders particles. `xyz` holds `dim` coordinates per particle (dim 2 or 3; y is up). `colors`
+/// holds one color per particle, or a single color for all (an empty span draws them all blue).
+/// `radius` is the particle radius in world units (drawn at least 1 pixel wide). The box
+/// [box_lo, box_hi] (z ignored in 2D) fits the view and is drawn as a thin gray outline: a
+/// rectangle in 2D, its 12 projected edges in 3D (edges of faces turned to the camera are drawn
+/// over the particles, the others behind them). In 3D particles are drawn far to near (painter's
+/// algorithm; equal depths in index order), in 2D in index order. Particles with a non-finite
+/// coordinate are skipped. Throws sph::Error as ParticleCamera does. Preconditions: dim is 2 or 3,
+/// xyz.size() is a multiple of dim, colors.size() is 0, 1 or the particle count.
+Image render_particles(std::span<const double> xyz, int dim, std::span<const Rgb> colors, double radius,
+                       const std::array<double, 3>& box_lo, const std::array<double, 3>& box_hi,
+                       const ParticleView& view);
+
+}  // namespace sph

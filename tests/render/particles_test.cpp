@@ -1,0 +1,237 @@
+// Particle images: placement in the fitted view, the box outline, depth order, and the edge cases
+// (no particles, NaN positions, bad arguments).
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <sph/core/error.h>
+#include <sph/render/particles.h>
+
+namespace sph {
+namespace {
+
+constexpr Rgb kWhite{255, 255, 255};
+constexpr Rgb kRed{255, 0, 0};
+constexpr Rgb kBlue{0, 0, 255};
+using A3 = std::array<double, 3>;
+
+ParticleView flat_view(int w = 400, int h = 300) {
+  ParticleView v;
+  v.width = w;
+  v.height = h;
+  v.shaded = false;
+  return v;
+}
+
+bool is_gray(Rgb c) { return c.r == c.g && c.g == c.b; }
+
+struct Box {
+  int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;
+};
+
+/// Bounding box of the pixels for which pred(pixel) holds.
+template <typename Pred>
+Box bbox(const Image& img, Pred pred) {
+  Box b;
+  for (int y = 0; y < img.height(); ++y)
+    for (int x = 0; x < img.width(); ++x)
+      if (pred(img.at(x, y))) {
+        b.x0 = std::min(b.x0, x);
+        b.y0 = std::min(b.y0, y);
+        b.x1 = std::max(b.x1, x);
+        b.y1 = std::max(b.y1, y);
+      }
+  return b;
+}
+
+TEST(Particles, ParticleAtTheBoxCenterColorsTheImageCenter2D) {
+  const std::vector<double> xyz = {0.5, 0.5};
+  const std::vector<Rgb> colors = {kRed};
+  const Image img = render_particles(xyz, 2, colors, 0.05, A3{0, 0, 0}, A3{1, 1, 0}, flat_view());
+  EXPECT_EQ(img.at(200, 150), kRed);
+  EXPECT_EQ(img.at(199, 149), kRed);
+  // Red only around the center: radius 0.05 of a ~0.92 * 300 px tall box is ~14 px.
+  const Box b = bbox(img, [](Rgb c) { return c == kRed; });
+  EXPECT_GE(b.x0, 200 - 16);
+  EXPECT_LE(b.x1, 200 + 16);
+  EXPECT_GE(b.y0, 150 - 16);
+  EXPECT_LE(b.y1, 150 + 16);
+  EXPECT_GE(b.x1 - b.x0, 20);  // and it has the projected size, not one pixel
+}
+
+TEST(Particles, ParticleAtTheBoxCenterColorsTheImageCenter3D) {
+  ParticleView view = flat_view();
+  view.azimuth_deg = 30;
+  view.elevation_deg = 20;
+  const std::vector<double> xyz = {1, 2, 3};
+  const std::vector<Rgb> colors = {kRed};
+  const Image img = render_particles(xyz, 3, colors, 0.1, A3{0, 1, 2}, A3{2, 3, 4}, view);
+  EXPECT_EQ(img.at(200, 150), kRed);
+}
+
+TEST(Particles, CornerParticleColorsThatCorner2D) {
+  const std::vector<double> xyz = {0.05, 0.05};  // bottom left (y is up)
+  const std::vector<Rgb> colors = {kRed};
+  const Image img = render_particles(xyz, 2, colors, 0.05, A3{0, 0, 0}, A3{1, 1, 0}, flat_view());
+  const Box b = bbox(img, [](Rgb c) { return c == kRed; });
+  ASSERT_GE(b.x1, 0);
+  // The box spans ~276 px square centered at (200, 150): its bottom-left corner is near (62, 288).
+  EXPECT_LT(b.x1, 200 - 100);
+  EXPECT_GT(b.y0, 150 + 100);
+  EXPECT_NEAR(0.5 * (b.x0 + b.x1), 200 - 0.45 / 1.1 * 276, 3);
+  EXPECT_NEAR(0.5 * (b.y0 + b.y1), 150 + 0.45 / 1.1 * 276, 3);
+}
+
+TEST(Particles, NearestCornerOfA3DBoxAppearsUpperRightFromTheDefaultCamera) {
+  // From azimuth 30, elevation 20 the camera sees the box from +x, +y, +z: the box_hi corner is
+  // right of and above the center, and nearest to the camera.
+  const std::vector<double> xyz = {0.95, 0.95, 0.95, 0.05, 0.05, 0.05};
+  const std::vector<Rgb> colors = {kRed, kBlue};
+  const Image img = render_particles(xyz, 3, colors, 0.05, A3{0, 0, 0}, A3{1, 1, 1}, [] {
+    ParticleView v = default_particle_view(3, 400, 300);
+    v.shaded = false;
+    return v;
+  }());
+  const Box red = bbox(img, [](Rgb c) { return c == kRed; });
+  const Box blue = bbox(img, [](Rgb c) { return c == kBlue; });
+  ASSERT_GE(red.x1, 0);
+  ASSERT_GE(blue.x1, 0);
+  EXPECT_GT(red.x0, 200);
+  EXPECT_LT(red.y1, 150);
+  EXPECT_LT(blue.x1, 200);
+  EXPECT_GT(blue.y0, 150);
+}
+
+TEST(Particles, NothingIsDrawnOutsideTheBoxProjection) {
+  // A wide 2D box in a square image: particles fill it, up to one radius from its walls.
+  const double r = 0.02;
+  std::vector<double> xyz;
+  for (double y = r; y <= 1 - r + 1e-12; y += 0.01)
+    for (double x = r; x <= 2 - r + 1e-12; x += 0.01) {
+      xyz.push_back(x);
+      xyz.push_back(y);
+    }
+  const std::vector<Rgb> colors = {kRed};
+  ParticleView view = flat_view(400, 400);
+  view.shaded = true;
+  const Image img = render_particles(xyz, 2, colors, r, A3{0, 0, 0}, A3{2, 1, 0}, view);
+  const ParticleCamera cam(2, A3{0, 0, 0}, A3{2, 1, 0}, r, view);
+  const A3 lo = cam.project(A3{0, 0, 0}), hi = cam.project(A3{2, 1, 0});
+  const Box ink = bbox(img, [](Rgb c) { return c != kWhite; });
+  EXPECT_GE(ink.x0, std::floor(lo[0]) - 1);
+  EXPECT_LE(ink.x1, std::ceil(hi[0]) + 1);
+  EXPECT_GE(ink.y0, std::floor(hi[1]) - 1);  // y is up: the top of the box is hi
+  EXPECT_LE(ink.y1, std::ceil(lo[1]) + 1);
+  // Independent of the camera: the 2:1 box in a square image leaves the top and bottom quarters empty.
+  EXPECT_GT(ink.y0, 400 / 4);
+  EXPECT_LT(ink.y1, 400 * 3 / 4);
+  EXPECT_GT(ink.x1 - ink.x0, 300);
+}
+
+TEST(Particles, NearParticleCoversFarOneWhateverTheIndexOrder) {
+  ParticleView view = flat_view();  // azimuth 0, elevation 0: looking along -z
+  const std::vector<Rgb> colors = {kRed, kBlue};
+  const A3 lo{-1, -1, -1}, hi{1, 1, 1};
+  const std::vector<double> red_near_first = {0, 0, 0.5, 0, 0, -0.5};
+  const std::vector<double> red_far_first = {0, 0, -0.5, 0, 0, 0.5};
+  EXPECT_EQ(render_particles(red_near_first, 3, colors, 0.2, lo, hi, view).at(200, 150), kRed);
+  EXPECT_EQ(render_particles(red_far_first, 3, colors, 0.2, lo, hi, view).at(200, 150), kBlue);
+  // Turned around (azimuth 180), the other one is in front.
+  view.azimuth_deg = 180;
+  EXPECT_EQ(render_particles(red_near_first, 3, colors, 0.2, lo, hi, view).at(200, 150), kBlue);
+  // Looking down from above (elevation 90), the higher one is in front.
+  view.azimuth_deg = 0;
+  view.elevation_deg = 90;
+  const std::vector<double> red_high = {0, 0.5, 0, 0, -0.5, 0};
+  EXPECT_EQ(render_particles(red_high, 3, colors, 0.2, lo, hi, view).at(200, 150), kRed);
+}
+
+TEST(Particles, EqualDepthsDrawInIndexOrder) {
+  const std::vector<double> xyz = {0, 0, 0, 0, 0, 0};
+  const std::vector<Rgb> colors = {kRed, kBlue};
+  const Image img = render_particles(xyz, 3, colors, 0.2, A3{-1, -1, -1}, A3{1, 1, 1}, flat_view());
+  EXPECT_EQ(img.at(200, 150), kBlue);  // the later one on top
+}
+
+TEST(Particles, NoParticlesGiveBackgroundAndTheBoxOnly) {
+  for (int dim : {2, 3}) {
+    ParticleView view = default_particle_view(dim, 320, 240);
+    view.background = Rgb{255, 255, 255};
+    const Image img = render_particles({}, dim, {}, 0.1, A3{0, 0, 0}, A3{1, 1, 1}, view);
+    int gray = 0;
+    for (const Rgb& p : img.pixels()) {
+      ASSERT_TRUE(is_gray(p)) << "dim " << dim;
+      gray += p != kWhite;
+    }
+    EXPECT_GT(gray, 4 * 150) << "the box outline is missing, dim " << dim;
+  }
+}
+
+TEST(Particles, BoxEdgesIn3DIncludeTheSilhouette) {
+  // A cube seen from az 30, el 20: the outline spans its projected corners.
+  ParticleView view = default_particle_view(3, 400, 300);
+  const Image img = render_particles({}, 3, {}, 0.0, A3{0, 0, 0}, A3{1, 1, 1}, view);
+  const ParticleCamera cam(3, A3{0, 0, 0}, A3{1, 1, 1}, 0.0, view);
+  double xmin = 1e9, xmax = -1e9;
+  for (int k = 0; k < 8; ++k) {
+    const A3 p = cam.project(A3{double(k & 1), double((k >> 1) & 1), double((k >> 2) & 1)});
+    xmin = std::min(xmin, p[0]);
+    xmax = std::max(xmax, p[0]);
+  }
+  const Box ink = bbox(img, [](Rgb c) { return c != kWhite; });
+  EXPECT_NEAR(ink.x0, xmin, 2.0);
+  EXPECT_NEAR(ink.x1, xmax, 2.0);
+  // The view is fitted: here the projected cube is taller than wide for the 4:3 image, so it fills
+  // the height but for the margins.
+  EXPECT_GT(ink.y1 - ink.y0, 300 * 0.85);
+  EXPECT_GT(xmax - xmin, 200);
+}
+
+TEST(Particles, NonFiniteAndFarAwayPositionsDrawNothing) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::vector<Rgb> colors = {kRed, kBlue, kBlue, kBlue};  // far away: off the image
+  const std::vector<double> with_bad = {0.3, 0.4, 0.6, nan, inf, 0.5, 1e300, -1e300};
+  const std::vector<double> good = {0.3, 0.4};
+  const std::vector<Rgb> one = {kRed};
+  const A3 lo{0, 0, 0}, hi{1, 1, 0};
+  EXPECT_EQ(render_particles(with_bad, 2, colors, 0.05, lo, hi, flat_view()),
+            render_particles(good, 2, one, 0.05, lo, hi, flat_view()));
+}
+
+TEST(Particles, ShadingIsBrighterTowardsTheLightAndTinyParticlesStillShow) {
+  ParticleView view = flat_view();
+  view.shaded = true;
+  const std::vector<double> xyz = {0.5, 0.5};
+  const std::vector<Rgb> colors = {Rgb{200, 200, 200}};
+  const Image img = render_particles(xyz, 2, colors, 0.2, A3{0, 0, 0}, A3{1, 1, 0}, view);
+  const double r = 0.2 / 1.4 * 276;  // projected radius
+  const Rgb upper_left = img.at(static_cast<int>(200 - 0.5 * r), static_cast<int>(150 - 0.5 * r));
+  const Rgb lower_right = img.at(static_cast<int>(200 + 0.5 * r), static_cast<int>(150 + 0.5 * r));
+  EXPECT_GT(upper_left.r, lower_right.r + 60);
+  // A particle far smaller than a pixel still inks its pixel.
+  view.shaded = false;
+  const std::vector<Rgb> red = {kRed};
+  const Image tiny = render_particles(xyz, 2, red, 1e-6, A3{0, 0, 0}, A3{1, 1, 0}, view);
+  EXPECT_EQ(tiny.at(200, 150), kRed);
+}
+
+TEST(Particles, BadArgumentsThrow) {
+  const std::vector<double> xyz = {0.5, 0.5};
+  const A3 lo{0, 0, 0}, hi{1, 1, 0};
+  EXPECT_THROW(render_particles(xyz, 2, {}, -1.0, lo, hi, flat_view()), Error);
+  EXPECT_THROW(render_particles(xyz, 2, {}, std::nan(""), lo, hi, flat_view()), Error);
+  EXPECT_THROW(render_particles(xyz, 2, {}, 0.1, hi, lo, flat_view()), Error);
+  EXPECT_THROW(render_particles(xyz, 2, {}, 0.1, lo, hi, flat_view(0, 10)), Error);
+  // Programming errors are checks, not user errors.
+  EXPECT_THROW(render_particles(xyz, 3, {}, 0.1, lo, hi, flat_view()), std::logic_error);
+  const std::vector<Rgb> three = {kRed, kRed, kRed};
+  EXPECT_THROW(render_particles(xyz, 2, three, 0.1, lo, hi, flat_view()), std::logic_error);
+}
+
+}  // namespace
+}  // namespace sph

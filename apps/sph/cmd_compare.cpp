@@ -103,7 +103,7 @@ int compare(const CompareCliOptions& opt) {
 
   // A one-screen summary: speed ratios and the final divergence.
   fmt::print(stderr, "sph: compared in {:.1f} s:\n", wall.elapsed());
-  const double ref = result.runs[0].totals.total();
+  const double ref = standard_seconds(result);
   for (std::size_t k = 0; k < result.runs.size(); ++k) {
     const RunRecord& r = result.runs[k];
     const double t = r.totals.total();

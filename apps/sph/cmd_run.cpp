@@ -1,5 +1,6 @@
 // `sph run SCENE.json`: runs a scene and writes frames, stats and a summary.
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -55,9 +56,14 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt) {
       desc.steps,
       opt.no_progress ? Progress::Mode::Off : (::isatty(STDERR_FILENO) ? Progress::Mode::Bar : Progress::Mode::Lines),
       stderr);
+  std::uint64_t missed = 0, steps_with_misses = 0;
+  double deepest = 0;
   try {
     for (std::int64_t s = 0; s < desc.steps; ++s) {
       const StepInfo& step = sim.step();
+      missed += step.audit.missed_pairs;
+      steps_with_misses += step.audit.missed_pairs > 0 ? 1 : 0;
+      deepest = std::max(deepest, step.audit.max_penetration);
       out.after_step(sim, step, s + 1 == desc.steps);
       progress.update(s + 1, step.particles);
     }
@@ -78,6 +84,11 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt) {
              "  {}/summary.json totals\n",
              desc.steps, sim.particles().size(), seconds, 1e3 * seconds / static_cast<double>(desc.steps),
              out.frames_written(), dir.string(), dir.string(), dir.string());
+  if (opt.audit)
+    fmt::print(stderr,
+               "sph: audit: {} pairs within h were missing from the lists, in {} of {} steps; the deepest miss "
+               "was (h - r) / h = {:.3g}\n",
+               missed, steps_with_misses, desc.steps, deepest);
   return kOk;
 }
 

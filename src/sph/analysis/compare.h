@@ -81,6 +81,10 @@ struct CompareResult {
   std::vector<std::vector<Divergence>> divergence;
 };
 
+/// The standard algorithm's total step seconds: the mean over the standard runs (the reference
+/// and the perturbed one do the same work), so that the order of the runs biases no ratio.
+double standard_seconds(const CompareResult& result);
+
 /// Called as runs progress: (run label, run index, run count, steps done, steps).
 using CompareProgress = std::function<void(const std::string&, int, int, std::int64_t, std::int64_t)>;
 

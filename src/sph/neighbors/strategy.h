@@ -35,7 +35,7 @@ struct NeighborOptions {
 };
 
 /// Default verlet skin as a fraction of h (docs/paper-reproduction.md shows how it was chosen).
-inline constexpr double kDefaultSkinFraction = 0.2;
+inline constexpr double kDefaultSkinFraction = 0.1;
 
 /// A neighbor strategy keeps full neighbor lists of the particles current for the solver.
 template <int D, std::floating_point R>

@@ -346,7 +346,7 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
         c.choice("neighbors", {"standard", "adaptive", "verlet", "brute_force"}, "standard"), c.child("neighbors"));
     sim.full_rebuild_period = static_cast<int>(
         c.integer("fullRebuildPeriod", "a full-rebuild period of at least 1 step", 1, 1'000'000'000, 200));
-    sim.verlet_skin = c.positive("verletSkin", "a positive verlet skin in metres (default 0.2 h)",
+    sim.verlet_skin = c.positive("verletSkin", "a positive verlet skin in metres (default 0.1 h)",
                                  kDefaultSkinFraction * sim.kernel_radius);
     if (sim.verlet_skin > 2.0 * sim.kernel_radius)
       c.ctx().fail(c.child("verletSkin"),

@@ -65,8 +65,9 @@ void prepare_compare_directory(const fs::path& dir) {
   { AtomicFile probe(dir / ".write-test"); }
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
     const std::string f = entry.path().filename().string();
+    // Files whose set depends on the options: images of other steps, the audit's plot.
     const bool frame = f.rfind("frame_", 0) == 0 && entry.path().extension() == ".png";
-    if (frame) fs::remove(entry.path(), ec);
+    if (frame || f == "missed_pairs.png") fs::remove(entry.path(), ec);
   }
 }
 
@@ -89,14 +90,20 @@ int compare(const CompareCliOptions& opt) {
   fmt::print(stderr, "sph: compare {} ({}D, {} steps, {} thread{}) -> {}\n", desc.name, desc.dimension, desc.steps,
              num_threads(), num_threads() == 1 ? "" : "s", dir.string());
   Stopwatch wall;
+  // A line per quarter of each run.
+  int run_shown = -1;
+  std::int64_t quarters_shown = 0;
   const CompareProgress progress = [&](const std::string& label, int index, int count, std::int64_t done,
                                        std::int64_t total) {
     if (opt.no_progress) return;
+    if (index != run_shown) run_shown = index, quarters_shown = 0;
+    const std::int64_t quarters = 4 * done / total;
+    if (quarters <= quarters_shown) return;
+    quarters_shown = quarters;
     if (done == total)
       fmt::print(stderr, "sph: [{}/{}] {}: done\n", index + 1, count, label);
-    else if (done * 4 % total < 4 * total / 20 + 1 && done * 4 >= total &&
-             done * 4 / total != (done - total / 20) * 4 / total)
-      fmt::print(stderr, "sph: [{}/{}] {}: {} %\n", index + 1, count, label, 100 * done / total);
+    else
+      fmt::print(stderr, "sph: [{}/{}] {}: {} %\n", index + 1, count, label, 25 * quarters);
   };
   const CompareResult result = run_comparison(desc, co, progress);
   write_comparison(dir, result);
@@ -110,9 +117,7 @@ int compare(const CompareCliOptions& opt) {
     std::string line = fmt::format("  {:<22} {:8.3f} s  {:5.2f}x", r.label, t, t > 0 ? ref / t : 0.0);
     if (k > 0 && !result.divergence[k].empty())
       line += fmt::format("  RMS divergence at end {:.3g} h", result.divergence[k].back().rms);
-    std::uint64_t missed = 0;
-    for (const auto& s : r.steps) missed += s.missed_pairs;
-    if (co.audit) line += fmt::format("  missed pairs {}", missed);
+    if (co.audit) line += fmt::format("  missed pairs {}", r.missed_pairs());
     if (!r.failure.empty()) line += "  FAILED: " + r.failure;
     fmt::print(stderr, "{}\n", line);
   }

@@ -56,14 +56,9 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt) {
       desc.steps,
       opt.no_progress ? Progress::Mode::Off : (::isatty(STDERR_FILENO) ? Progress::Mode::Bar : Progress::Mode::Lines),
       stderr);
-  std::uint64_t missed = 0, steps_with_misses = 0;
-  double deepest = 0;
   try {
     for (std::int64_t s = 0; s < desc.steps; ++s) {
       const StepInfo& step = sim.step();
-      missed += step.audit.missed_pairs;
-      steps_with_misses += step.audit.missed_pairs > 0 ? 1 : 0;
-      deepest = std::max(deepest, step.audit.max_penetration);
       out.after_step(sim, step, s + 1 == desc.steps);
       progress.update(s + 1, step.particles);
     }
@@ -88,7 +83,8 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt) {
     fmt::print(stderr,
                "sph: audit: {} pairs within h were missing from the lists, in {} of {} steps; the deepest miss "
                "was (h - r) / h = {:.3g}\n",
-               missed, steps_with_misses, desc.steps, deepest);
+               out.audit_totals().missed_pairs, out.audit_steps_with_misses(), desc.steps,
+               out.audit_totals().max_penetration);
   return kOk;
 }
 

@@ -141,6 +141,16 @@ TEST_F(Compare, ModesCanBeChosenAndTheChaosRunSwitchedOff) {
   for (const auto& s : res.runs[1].steps) EXPECT_EQ(s.missed_pairs, 0u);
   write_comparison(dir_, res);
   EXPECT_TRUE(fs::is_regular_file(dir_ / "frame_000010.png"));
+  // Without the audit there are no missed-pair figures, rather than zeros that look measured.
+  const auto files = comparison_files(res);
+  EXPECT_EQ(std::count(files.begin(), files.end(), "missed_pairs.png"), 0);
+  EXPECT_FALSE(fs::exists(dir_ / "missed_pairs.png"));
+  EXPECT_NE(read_file(dir_ / "report.md").find("--no-audit"), std::string::npos);
+  std::istringstream phases(read_file(dir_ / "phases.csv"));
+  std::string header, row;
+  std::getline(phases, header);
+  std::getline(phases, row);
+  EXPECT_NE(row.find(",,\""), std::string::npos) << "missed_pairs cell should be empty: " << row;
 }
 
 }  // namespace

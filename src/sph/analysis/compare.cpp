@@ -164,6 +164,7 @@ CompareResult run_all(const SceneDesc& desc, const CompareOptions& opt, const Co
   res.perturbation = opt.perturbation;
   for (int d = 0; d < D; ++d) res.box_lo[d] = p.container.lo[d], res.box_hi[d] = p.container.hi[d];
   res.has_emitters = !p.emitters.empty();
+  res.audited = opt.audit;
   res.steps = opt.steps > 0 ? opt.steps : desc.steps;
   res.image_steps = image_steps(res.steps, std::max(1, opt.frames));
 
@@ -248,8 +249,7 @@ Rgb run_color(std::size_t k, const RunRecord& r) {
 }
 
 Image plot_per_step(const CompareResult& res, const std::string& title, const std::string& y_label, bool log_y,
-                    const std::function<double(const RunRecord&, std::size_t)>& value, bool skip_perturbed,
-                    const std::function<bool(const RunRecord&)>& include = {}) {
+                    const std::function<double(const RunRecord&, std::size_t)>& value, bool skip_perturbed) {
   PlotSpec spec;
   spec.title = title;
   spec.x_label = "step";
@@ -258,7 +258,6 @@ Image plot_per_step(const CompareResult& res, const std::string& title, const st
   for (std::size_t k = 0; k < res.runs.size(); ++k) {
     const RunRecord& r = res.runs[k];
     if (skip_perturbed && r.perturbed) continue;
-    if (include && !include(r)) continue;
     Series s;
     s.name = r.label;
     s.color = run_color(k, r);
@@ -295,22 +294,26 @@ Image divergence_plot(const CompareResult& res) {
   return render_plot(spec);
 }
 
+/// The snapshot of `r` taken for the image at `step`, or null (the run failed before it).
+const Snapshot* image_snapshot(const RunRecord& r, std::int64_t step) {
+  for (const Snapshot& s : r.samples)
+    if (s.step == step && !s.velocity.empty()) return &s;
+  return nullptr;
+}
+
 /// Side-by-side images of the non-perturbed runs at one image step.
 Image frame_image(const CompareResult& res, std::int64_t step, double mass) {
   std::vector<Image> panels;
   std::vector<std::string> captions;
   const ParticleView view =
       default_particle_view(res.dimension, res.dimension == 2 ? 640 : 560, res.dimension == 2 ? 420 : 520);
-  // Color scale: kinetic energy (2D, like the paper's Fig. 2) from 0 to the largest value in the
-  // reference; initial position (3D without emitters, like Fig. 3); emission order otherwise.
+  // Color scale: kinetic energy (2D, like the paper's Fig. 2) from 0 to the largest value in any
+  // of the runs shown; initial position (3D without emitters, like Fig. 3); emission order otherwise.
   const bool by_energy = res.dimension == 2;
   const bool by_initial = !by_energy && !res.has_emitters;
   double ke_max = 0;
   for (const RunRecord& r : res.runs) {
-    if (r.perturbed) continue;
-    const Snapshot* snap = nullptr;
-    for (const Snapshot& s : r.samples)
-      if (s.step == step && !s.velocity.empty()) snap = &s;
+    const Snapshot* snap = r.perturbed ? nullptr : image_snapshot(r, step);
     if (!snap) continue;
     for (const auto& v : snap->velocity)
       if (!std::isnan(v[0])) ke_max = std::max(ke_max, 0.5 * mass * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
@@ -318,9 +321,7 @@ Image frame_image(const CompareResult& res, std::int64_t step, double mass) {
   if (ke_max <= 0) ke_max = 1;
   for (const RunRecord& r : res.runs) {
     if (r.perturbed) continue;
-    const Snapshot* snap = nullptr;
-    for (const Snapshot& s : r.samples)
-      if (s.step == step && !s.velocity.empty()) snap = &s;
+    const Snapshot* snap = image_snapshot(r, step);
     std::vector<double> xyz;
     std::vector<Rgb> colors;
     if (snap) {
@@ -432,7 +433,9 @@ std::string report_md(const CompareResult& res, const std::vector<std::string>& 
   }
 
   md += "\n## Missed pairs\n\n";
-  if (!res.runs.empty() && res.runs[0].steps.size() > 0 && res.runs.size() > 0) {
+  if (!res.audited) {
+    md += "Not measured: the comparison ran with --no-audit.\n";
+  } else {
     md += "![missed pairs](missed_pairs.png)\n\n";
     md +=
         "The audit compares each step's lists with exact lists. A missed pair is a pair closer than h that a\n"
@@ -496,7 +499,8 @@ CompareResult run_comparison(const SceneDesc& desc, const CompareOptions& option
 
 std::vector<std::string> comparison_files(const CompareResult& result) {
   std::vector<std::string> f{"report.md",     "timing.csv", "phases.csv",     "divergence.csv", "energy.csv",
-                             "neighbors.csv", "timing.png", "divergence.png", "energy.png",     "missed_pairs.png"};
+                             "neighbors.csv", "timing.png", "divergence.png", "energy.png"};
+  if (result.audited) f.push_back("missed_pairs.png");
   for (std::int64_t s : result.image_steps) f.push_back(frame_file(s));
   return f;
 }
@@ -524,12 +528,16 @@ void write_comparison(const std::filesystem::path& dir, const CompareResult& res
                     per_step_csv(res,
                                  {"particles", "lists_rebuilt", "pairs_stored", "pairs_within_h", "missed_pairs",
                                   "max_missed_penetration"},
-                                 [](const RunRecord& r, std::size_t s) {
+                                 [&res](const RunRecord& r, std::size_t s) {
                                    const StepRecord& x = r.steps[s];
+                                   // Without the audit the missed-pair cells are empty, not 0.
                                    return std::vector<std::string>{
-                                       std::to_string(x.particles),    std::to_string(x.lists_rebuilt),
-                                       std::to_string(x.pairs_stored), std::to_string(x.pairs_within_h),
-                                       std::to_string(x.missed_pairs), fmt::format("{:.6g}", x.max_missed_penetration)};
+                                       std::to_string(x.particles),
+                                       std::to_string(x.lists_rebuilt),
+                                       std::to_string(x.pairs_stored),
+                                       std::to_string(x.pairs_within_h),
+                                       res.audited ? std::to_string(x.missed_pairs) : std::string(),
+                                       res.audited ? fmt::format("{:.6g}", x.max_missed_penetration) : std::string()};
                                  }));
   {
     std::string out =
@@ -538,8 +546,7 @@ void write_comparison(const std::filesystem::path& dir, const CompareResult& res
     const double ref = standard_seconds(res);
     for (const auto& r : res.runs) {
       const double t = r.totals.total();
-      std::uint64_t missed = 0;
-      for (const auto& s : r.steps) missed += s.missed_pairs;
+      const std::uint64_t missed = r.missed_pairs();
       std::string failure = r.failure;
       std::replace(failure.begin(), failure.end(), '"', '\'');
       out += fmt::format(
@@ -547,7 +554,7 @@ void write_comparison(const std::filesystem::path& dir, const CompareResult& res
           r.steps.size(), r.totals.grid, r.totals.lists, r.totals.density, r.totals.forces, r.totals.integrate, t,
           r.steps.empty() ? 0.0 : 1e3 * t / static_cast<double>(r.steps.size()), t > 0 ? ref / t : kNaN,
           mean_of(r.steps, &StepRecord::lists_rebuilt), mean_of(r.steps, &StepRecord::pairs_stored),
-          mean_of(r.steps, &StepRecord::pairs_within_h), missed, failure);
+          mean_of(r.steps, &StepRecord::pairs_within_h), res.audited ? std::to_string(missed) : std::string(), failure);
     }
     write_file_atomic(dir / "phases.csv", out);
   }
@@ -594,10 +601,12 @@ void write_comparison(const std::filesystem::path& dir, const CompareResult& res
             plot_per_step(
                 res, "Kinetic energy", res.dimension == 2 ? "J/m" : "J", false,
                 [](const RunRecord& r, std::size_t i) { return r.steps[i].kinetic_energy; }, false));
-  write_png(dir / "missed_pairs.png",
-            plot_per_step(
-                res, "Pairs within h missing from the lists (audit)", "missed pairs per step", false,
-                [](const RunRecord& r, std::size_t i) { return static_cast<double>(r.steps[i].missed_pairs); }, true));
+  if (res.audited)
+    write_png(
+        dir / "missed_pairs.png",
+        plot_per_step(
+            res, "Pairs within h missing from the lists (audit)", "missed pairs per step", false,
+            [](const RunRecord& r, std::size_t i) { return static_cast<double>(r.steps[i].missed_pairs); }, true));
   // Frames.
   for (std::int64_t s : res.image_steps) write_png(dir / frame_file(s), frame_image(res, s, res.particle_mass));
   write_file_atomic(dir / "report.md", report_md(res, comparison_files(res)));

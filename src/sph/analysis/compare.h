@@ -34,7 +34,7 @@ struct StepRecord {
   double seconds = 0;         ///< wall seconds of the step's phases (audit excluded)
   double kinetic_energy = 0;  ///< J (J/m in 2D)
   std::uint64_t particles = 0, lists_rebuilt = 0, pairs_stored = 0, pairs_within_h = 0;
-  std::uint64_t missed_pairs = 0;  ///< audit (0 without audit)
+  std::uint64_t missed_pairs = 0;  ///< audit (0 without audit: see CompareResult::audited)
   double max_missed_penetration = 0;
 };
 
@@ -56,6 +56,13 @@ struct RunRecord {
   std::vector<Snapshot> samples;
   PhaseTimes totals;
   std::string failure;  ///< the error message if the run blew up ("" otherwise)
+
+  /// Missed pairs summed over the steps (0 without audit).
+  std::uint64_t missed_pairs() const {
+    std::uint64_t n = 0;
+    for (const StepRecord& s : steps) n += s.missed_pairs;
+    return n;
+  }
 };
 
 /// Divergence of one run from the reference at one sampled step, in units of h, over the
@@ -74,6 +81,7 @@ struct CompareResult {
   double h = 0, dt = 0, particle_radius = 0, particle_mass = 0, perturbation = 0;
   std::array<double, 3> box_lo{}, box_hi{};
   bool has_emitters = false;
+  bool audited = false;  ///< missed-pair figures exist (CompareOptions::audit)
   std::int64_t steps = 0;
   std::vector<std::int64_t> image_steps;
   std::vector<RunRecord> runs;  ///< runs[0] is the standard reference

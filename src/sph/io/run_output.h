@@ -20,7 +20,7 @@
 
 namespace sph {
 
-/// Header of stats.csv (docs/output.md explains each column). The three audit columns
+/// Header of stats.csv (README.md, "What a run writes", explains each column). The three audit columns
 /// (missed_pairs, particles_missing, max_missed_penetration) are empty unless the run audits.
 inline constexpr const char* kStatsColumns =
     "step,time,particles,kinetic_energy,max_speed,mean_neighbors,lists_rebuilt,pairs_stored,pairs_within_h,"
@@ -52,6 +52,11 @@ class RunOutput {
   void finish(const Simulation<D, R>& sim, const std::string& status, double wall_seconds);
 
   std::size_t frames_written() const { return pvd_.size(); }
+  /// Audit totals over the steps so far: missed pairs summed, deepest penetration (zero
+  /// without auditing).
+  const ListAudit& audit_totals() const { return audit_; }
+  /// Audited steps with at least one missed pair.
+  std::uint64_t audit_steps_with_misses() const { return audit_steps_with_misses_; }
 
  private:
   void write_frame(const Simulation<D, R>& sim);

@@ -21,6 +21,14 @@ std::uint32_t ListBuilder<D, R>::gather(const UniformGrid<D, R>& grid, std::span
 }
 
 template <int D, std::floating_point R>
+void ListBuilder<D, R>::set_offsets(std::size_t n, NeighborLists& out) const {
+  out.offsets.resize(n + 1);
+  out.offsets[0] = 0;
+  for (std::size_t i = 0; i < n; ++i) out.offsets[i + 1] = out.offsets[i] + counts_[i];
+  out.indices.resize(out.offsets[n]);
+}
+
+template <int D, std::floating_point R>
 void ListBuilder<D, R>::build(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> positions, R radius,
                               NeighborLists& out) {
   const std::size_t n = positions.size();
@@ -37,10 +45,7 @@ void ListBuilder<D, R>::build(const UniformGrid<D, R>& grid, std::span<const Vec
   });
 
   // Offsets by prefix sum, then copy each chunk's buffer to its place.
-  out.offsets.resize(n + 1);
-  out.offsets[0] = 0;
-  for (std::size_t i = 0; i < n; ++i) out.offsets[i + 1] = out.offsets[i] + counts_[i];
-  out.indices.resize(out.offsets[n]);
+  set_offsets(n, out);
   parallel_for(chunks, [&](std::size_t c) {
     const auto& buf = chunk_indices_[c];
     if (!buf.empty())
@@ -73,10 +78,7 @@ void ListBuilder<D, R>::rebuild_some(const UniformGrid<D, R>& grid, std::span<co
 
   // Pass 2: merge old and new lists into the scratch storage, then swap it in.
   NeighborLists& out = scratch_;
-  out.offsets.resize(n + 1);
-  out.offsets[0] = 0;
-  for (std::size_t i = 0; i < n; ++i) out.offsets[i + 1] = out.offsets[i] + counts_[i];
-  out.indices.resize(out.offsets[n]);
+  set_offsets(n, out);
   parallel_chunks(n, [&](std::size_t c, std::size_t begin, std::size_t end) {
     const std::uint32_t* fresh = chunk_indices_[c].data();
     for (std::size_t i = begin; i < end; ++i) {

@@ -26,6 +26,8 @@ class ListBuilder {
 
  private:
   /// Gathers the list of particle i into buf and returns its length.
+  /// Sets out.offsets from counts_ (prefix sum) and sizes out.indices to match.
+  void set_offsets(std::size_t n, NeighborLists& out) const;
   static std::uint32_t gather(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> positions, R r2, std::size_t i,
                               std::vector<std::uint32_t>& buf);
 

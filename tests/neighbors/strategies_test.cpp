@@ -67,8 +67,7 @@ TEST(Adaptive, RebuildsOnlyFlaggedListsAndKeepsTheOthers) {
   jitter(ps, 0.02, 3);
   a.update(ps, 0.01);
   EXPECT_EQ(a.counters().lists_rebuilt, 0u);
-  EXPECT_EQ(a.lists().offsets, before.offsets);
-  EXPECT_EQ(a.lists().indices, before.indices);
+  EXPECT_EQ(a.lists(), before);
 
   // Flag a few: exactly their lists are rebuilt, at the current positions.
   const std::vector<std::size_t> flagged{0, 17, 1023, 1024, 2999};
@@ -123,8 +122,7 @@ TEST(Adaptive, PartialRebuildIsIdenticalForAnyThreadCount) {
     a.update(ps, 0.01);
     result[t - 1] = a.lists();
   }
-  EXPECT_EQ(result[0].offsets, result[1].offsets);
-  EXPECT_EQ(result[0].indices, result[1].indices);
+  EXPECT_EQ(result[0], result[1]);
 }
 
 TEST(Verlet, NeverMissesAPairWithinHAndRebuildsAtHalfTheSkin) {
@@ -187,9 +185,7 @@ TEST(Audit, CountsMissedPairsAndTheirPenetration) {
   EXPECT_EQ(auditor.audit(ps.position, exact, kH).missed_pairs, 0u);
 
   // Particle 0 lists only particle 2; particle 1 lists nothing; particle 2 lists 0.
-  NeighborLists lists;
-  lists.offsets = {0, 1, 1, 2, 2};
-  lists.indices = {2, 0};
+  const NeighborLists lists = NeighborLists::from({{2}, {}, {0}, {}});
   const ListAudit a = auditor.audit(ps.position, lists, kH);
   // Missed: 0->1 and 1->0 (r = 0.3 h, penetration 0.7), 2->1? |(0,0.08)-(0.03,0)| = 0.0854 < h: 2->1 and 1->2.
   EXPECT_EQ(a.missed_pairs, 4u);

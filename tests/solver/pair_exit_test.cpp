@@ -26,10 +26,8 @@ TEST(PairExitTest, FlagsBothParticlesOfExactlyThePairsPredictedToLeave) {
   ps.add(V2{10, 10}, V2{0, 0}, 1.0);    // 6: listed by 7 only (asymmetric lists)
   ps.add(V2{10.5, 10}, V2{5, 0}, 1.0);  // 7: predicted 0.5 + 1.0 = 1.5 > h
   // Lists as an adaptive run may have them: 1 does not list 0 back, 6 does not list 7.
-  NeighborLists lists;
-  //               0       1   2     3   4     5     6   7
-  lists.offsets = {0, 2, 2, 3, 3, 4, 5, 5, 6};
-  lists.indices = {1, 2, /*1: none*/ 0, /*3*/ 5, 4, /*6*/ 6};
+  //                                         0       1   2    3   4    5    6   7
+  const NeighborLists lists = NeighborLists::from({{1, 2}, {}, {0}, {}, {5}, {4}, {}, {6}});
   ASSERT_EQ(lists.particle_count(), ps.size());
   std::vector<std::uint8_t> flags(ps.size(), 0);
   FluidParams fluid;
@@ -52,10 +50,8 @@ TEST(PairExitTest, ListedPairsBeyondHAddNoDensity) {
   ParticleSet<2, double> ps;
   ps.add(V2{0, 0}, V2{}, 1.0);
   ps.add(V2{1.2, 0}, V2{}, 1.0);
-  NeighborLists with, without;
-  with.offsets = {0, 1, 2};
-  with.indices = {1, 0};
-  without.offsets = {0, 0, 0};
+  const NeighborLists with = NeighborLists::from({{1}, {0}});
+  const NeighborLists without = NeighborLists::from({{}, {}});
   FluidParams fluid;
   fluid.stiffness = 1;
   EXPECT_EQ((compute_density_pressure<2, double>(ps, with, 1.0, fluid)), 0u);

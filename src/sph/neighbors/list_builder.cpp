@@ -3,29 +3,152 @@
 #include <algorithm>
 #include <cstring>
 
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+#include <immintrin.h>
+#define SPH_HAVE_AVX512 1
+#else
+#define SPH_HAVE_AVX512 0
+#endif
+
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 
 namespace sph {
 
+namespace {
+
+/// The candidate ranges of one cell, cached while consecutive particles share the cell.
 template <int D, std::floating_point R>
-std::uint32_t ListBuilder<D, R>::gather(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> positions, R r2,
-                                        std::size_t i, std::vector<std::uint32_t>& buf) {
-  const Vec<D, R> xi = positions[i];
-  const std::size_t before = buf.size();
-  grid.for_each_candidate(xi, [&](std::uint32_t j) {
-    if (j == i) return;
-    if (norm2(xi - positions[j]) < r2) buf.push_back(j);
-  });
-  return static_cast<std::uint32_t>(buf.size() - before);
+struct Stencil {
+  static constexpr int kMax = UniformGrid<D, R>::kMaxRanges;
+  std::uint32_t cell = ~0u;
+  int count = 0;
+  std::uint32_t begin[kMax], end[kMax];
+  std::uint32_t candidates = 0;
+
+  void update(const UniformGrid<D, R>& grid, std::uint32_t c) {
+    if (c == cell) return;
+    cell = c;
+    count = grid.stencil_ranges(c, begin, end);
+    candidates = 0;
+    for (int k = 0; k < count; ++k) candidates += end[k] - begin[k];
+  }
+};
+
+/// Writes the neighbors of the point at query position x (sorted position `self`, excluded)
+/// to out and returns how many. out must have room for every candidate plus kPad.
+/// The squared distance is computed exactly as norm2(x - x_j) is (same operations, same
+/// order, no fused multiply-add), so lists agree bit for bit with a brute-force search.
+template <int D, std::floating_point R>
+std::uint32_t gather_scalar(const UniformGrid<D, R>& grid, const Stencil<D, R>& st, const Vec<D, R>& x,
+                            std::uint32_t self, R r2, std::uint32_t* out) {
+  const std::uint32_t* sorted = grid.sorted();
+  const R* c[D];
+  for (int d = 0; d < D; ++d) c[d] = grid.sorted_coord(d);
+  std::uint32_t m = 0;
+  for (int q = 0; q < st.count; ++q)
+    for (std::uint32_t k = st.begin[q]; k < st.end[q]; ++k) {
+      R d2 = 0;
+      for (int d = 0; d < D; ++d) {
+        const R t = x[d] - c[d][k];
+        d2 += t * t;
+      }
+      out[m] = sorted[k];
+      m += static_cast<std::uint32_t>((d2 < r2) & (k != self));
+    }
+  return m;
 }
 
+#if SPH_HAVE_AVX512
+template <int D>
+std::uint32_t gather_vector(const UniformGrid<D, double>& grid, const Stencil<D, double>& st,
+                            const Vec<D, double>& x, std::uint32_t self, double r2, std::uint32_t* out) {
+  const std::uint32_t* sorted = grid.sorted();
+  const double* c[D];
+  __m512d xv[D];
+  for (int d = 0; d < D; ++d) c[d] = grid.sorted_coord(d), xv[d] = _mm512_set1_pd(x[d]);
+  const __m512d r2v = _mm512_set1_pd(r2);
+  std::uint32_t m = 0;
+  for (int q = 0; q < st.count; ++q) {
+    const std::uint32_t e = st.end[q];
+    for (std::uint32_t k = st.begin[q]; k < e; k += 8) {
+      const __m512d t0 = _mm512_sub_pd(xv[0], _mm512_loadu_pd(c[0] + k));
+      const __m512d t1 = _mm512_sub_pd(xv[1], _mm512_loadu_pd(c[1] + k));
+      __m512d d2 = _mm512_add_pd(_mm512_mul_pd(t0, t0), _mm512_mul_pd(t1, t1));
+      if constexpr (D == 3) {
+        const __m512d t2 = _mm512_sub_pd(xv[2], _mm512_loadu_pd(c[2] + k));
+        d2 = _mm512_add_pd(d2, _mm512_mul_pd(t2, t2));
+      }
+      unsigned keep = e - k < 8 ? (1u << (e - k)) - 1u : 0xffu;
+      const std::uint32_t off = self - k;
+      if (off < 8) keep &= ~(1u << off);
+      const __mmask8 hit = static_cast<__mmask8>(_mm512_cmp_pd_mask(d2, r2v, _CMP_LT_OQ) & keep);
+      const __m256i idx = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(sorted + k));
+      // Register compress + plain store: the memory form of vpcompressd is slow on some CPUs.
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + m), _mm256_maskz_compress_epi32(hit, idx));
+      m += static_cast<std::uint32_t>(__builtin_popcount(hit));
+    }
+  }
+  return m;
+}
+
+template <int D>
+std::uint32_t gather_vector(const UniformGrid<D, float>& grid, const Stencil<D, float>& st, const Vec<D, float>& x,
+                            std::uint32_t self, float r2, std::uint32_t* out) {
+  const std::uint32_t* sorted = grid.sorted();
+  const float* c[D];
+  __m512 xv[D];
+  for (int d = 0; d < D; ++d) c[d] = grid.sorted_coord(d), xv[d] = _mm512_set1_ps(x[d]);
+  const __m512 r2v = _mm512_set1_ps(r2);
+  std::uint32_t m = 0;
+  for (int q = 0; q < st.count; ++q) {
+    const std::uint32_t e = st.end[q];
+    for (std::uint32_t k = st.begin[q]; k < e; k += 16) {
+      const __m512 t0 = _mm512_sub_ps(xv[0], _mm512_loadu_ps(c[0] + k));
+      const __m512 t1 = _mm512_sub_ps(xv[1], _mm512_loadu_ps(c[1] + k));
+      __m512 d2 = _mm512_add_ps(_mm512_mul_ps(t0, t0), _mm512_mul_ps(t1, t1));
+      if constexpr (D == 3) {
+        const __m512 t2 = _mm512_sub_ps(xv[2], _mm512_loadu_ps(c[2] + k));
+        d2 = _mm512_add_ps(d2, _mm512_mul_ps(t2, t2));
+      }
+      unsigned keep = e - k < 16 ? (1u << (e - k)) - 1u : 0xffffu;
+      const std::uint32_t off = self - k;
+      if (off < 16) keep &= ~(1u << off);
+      const __mmask16 hit = static_cast<__mmask16>(_mm512_cmp_ps_mask(d2, r2v, _CMP_LT_OQ) & keep);
+      const __m512i idx = _mm512_loadu_si512(sorted + k);
+      _mm512_storeu_si512(out + m, _mm512_maskz_compress_epi32(hit, idx));
+      m += static_cast<std::uint32_t>(__builtin_popcount(hit));
+    }
+  }
+  return m;
+}
+#endif
+
 template <int D, std::floating_point R>
-void ListBuilder<D, R>::set_offsets(std::size_t n, NeighborLists& out) const {
-  out.offsets.resize(n + 1);
-  out.offsets[0] = 0;
-  for (std::size_t i = 0; i < n; ++i) out.offsets[i + 1] = out.offsets[i] + counts_[i];
-  out.indices.resize(out.offsets[n]);
+std::uint32_t gather(bool vector, const UniformGrid<D, R>& grid, const Stencil<D, R>& st, const Vec<D, R>& x,
+                     std::uint32_t self, R r2, std::uint32_t* out) {
+#if SPH_HAVE_AVX512
+  if (vector) return gather_vector<D>(grid, st, x, self, r2, out);
+#else
+  (void)vector;
+#endif
+  return gather_scalar<D, R>(grid, st, x, self, r2, out);
+}
+
+/// Makes buf at least `need` long, growing by an eighth at least (few reallocations while the
+/// lists grow, little spare room once they are stable).
+void ensure_room(std::vector<std::uint32_t>& buf, std::size_t need) {
+  if (buf.size() >= need) return;
+  buf.resize(std::max(need, buf.size() + buf.size() / 8 + 4096));
+}
+
+constexpr std::size_t kRoom = 16;  // a vector store may write this far past the last hit
+
+}  // namespace
+
+template <int D, std::floating_point R>
+bool ListBuilder<D, R>::vector_kernel_available() {
+  return SPH_HAVE_AVX512 != 0;
 }
 
 template <int D, std::floating_point R>
@@ -34,23 +157,27 @@ void ListBuilder<D, R>::build(const UniformGrid<D, R>& grid, std::span<const Vec
   const std::size_t n = positions.size();
   const R r2 = radius * radius;
   const std::size_t chunks = chunk_count(n);
-  if (chunk_indices_.size() < chunks) chunk_indices_.resize(chunks);
-  counts_.resize(n);
+  out.chunks_.resize(chunks);
+  out.begin_.resize(n);
+  out.count_.resize(n);
+  chunk_entries_.resize(chunks);
 
-  // Pass 1: each fixed chunk of particles gathers its lists into its own buffer.
-  parallel_chunks(n, [&](std::size_t c, std::size_t begin, std::size_t end) {
-    auto& buf = chunk_indices_[c];
-    buf.clear();
-    for (std::size_t i = begin; i < end; ++i) counts_[i] = gather(grid, positions, r2, i, buf);
+  parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
+    auto& buf = out.chunks_[c];
+    Stencil<D, R> st;
+    std::size_t used = 0;
+    for (std::size_t i = b; i < e; ++i) {
+      st.update(grid, grid.cell_of(i));
+      ensure_room(buf, used + st.candidates + kRoom);
+      const std::uint32_t m = gather(vector_, grid, st, positions[i], grid.rank(i), r2, buf.data() + used);
+      out.begin_[i] = static_cast<std::uint32_t>(used);
+      out.count_[i] = m;
+      used += m;
+    }
+    chunk_entries_[c] = used;
   });
-
-  // Offsets by prefix sum, then copy each chunk's buffer to its place.
-  set_offsets(n, out);
-  parallel_for(chunks, [&](std::size_t c) {
-    const auto& buf = chunk_indices_[c];
-    if (!buf.empty())
-      std::memcpy(out.indices.data() + out.offsets[c * kChunkSize], buf.data(), buf.size() * sizeof(std::uint32_t));
-  });
+  out.entries_ = 0;
+  for (std::size_t c = 0; c < chunks; ++c) out.entries_ += chunk_entries_[c];
 }
 
 template <int D, std::floating_point R>
@@ -61,39 +188,62 @@ void ListBuilder<D, R>::rebuild_some(const UniformGrid<D, R>& grid, std::span<co
   SPH_CHECK(rebuild.size() == n && old_n <= n, "rebuild flags must cover every particle");
   const R r2 = radius * radius;
   const std::size_t chunks = chunk_count(n);
-  if (chunk_indices_.size() < chunks) chunk_indices_.resize(chunks);
-  counts_.resize(n);
+  lists.chunks_.resize(chunks);
+  lists.begin_.resize(n);
+  lists.count_.resize(n);
+  chunk_entries_.resize(chunks);
 
-  // Pass 1: new lists of the marked particles, per chunk; old lengths for the others.
-  parallel_chunks(n, [&](std::size_t c, std::size_t begin, std::size_t end) {
-    auto& buf = chunk_indices_[c];
-    buf.clear();
-    for (std::size_t i = begin; i < end; ++i) {
-      if (rebuild[i] || i >= old_n)
-        counts_[i] = gather(grid, positions, r2, i, buf);
+  parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
+    const auto marked = [&](std::size_t i) { return rebuild[i] != 0 || i >= old_n; };
+    std::size_t kept = 0;
+    bool any = false;
+    for (std::size_t i = b; i < e; ++i) {
+      if (marked(i))
+        any = true;
       else
-        counts_[i] = static_cast<std::uint32_t>(lists.offsets[i + 1] - lists.offsets[i]);
+        kept += lists.count_[i];
     }
-  });
-
-  // Pass 2: merge old and new lists into the scratch storage, then swap it in.
-  NeighborLists& out = scratch_;
-  set_offsets(n, out);
-  parallel_chunks(n, [&](std::size_t c, std::size_t begin, std::size_t end) {
-    const std::uint32_t* fresh = chunk_indices_[c].data();
-    for (std::size_t i = begin; i < end; ++i) {
-      std::uint32_t* dst = out.indices.data() + out.offsets[i];
-      const std::size_t len = counts_[i];
-      if (len == 0) continue;
-      if (rebuild[i] || i >= old_n) {
-        std::memcpy(dst, fresh, len * sizeof(std::uint32_t));
-        fresh += len;
+    if (!any) {
+      chunk_entries_[c] = kept;
+      return;
+    }
+    // New lists of the marked particles first, then old and new merged into a fresh buffer
+    // that replaces the chunk's (the old buffer becomes this thread's spare).
+    thread_local std::vector<std::uint32_t> fresh, merged;
+    thread_local std::vector<std::uint32_t> fresh_count;
+    fresh_count.resize(e - b);
+    Stencil<D, R> st;
+    std::size_t used = 0;
+    for (std::size_t i = b; i < e; ++i) {
+      if (!marked(i)) continue;
+      st.update(grid, grid.cell_of(i));
+      ensure_room(fresh, used + st.candidates + kRoom);
+      fresh_count[i - b] = gather(vector_, grid, st, positions[i], grid.rank(i), r2, fresh.data() + used);
+      used += fresh_count[i - b];
+    }
+    ensure_room(merged, kept + used);
+    const std::uint32_t* old = lists.chunks_[c].data();
+    const std::uint32_t* next_fresh = fresh.data();
+    std::size_t at = 0;
+    for (std::size_t i = b; i < e; ++i) {
+      std::uint32_t len;
+      if (marked(i)) {
+        len = fresh_count[i - b];
+        std::copy_n(next_fresh, len, merged.data() + at);
+        next_fresh += len;
       } else {
-        std::memcpy(dst, lists.indices.data() + lists.offsets[i], len * sizeof(std::uint32_t));
+        len = lists.count_[i];
+        std::copy_n(old + lists.begin_[i], len, merged.data() + at);
       }
+      lists.begin_[i] = static_cast<std::uint32_t>(at);
+      lists.count_[i] = len;
+      at += len;
     }
+    lists.chunks_[c].swap(merged);
+    chunk_entries_[c] = at;
   });
-  std::swap(lists, out);
+  lists.entries_ = 0;
+  for (std::size_t c = 0; c < chunks; ++c) lists.entries_ += chunk_entries_[c];
 }
 
 template class ListBuilder<2, float>;

@@ -1,28 +1,56 @@
 #pragma once
-/// \file NeighborLists: full per-particle neighbor lists in flat storage (offsets + indices).
+/// \file NeighborLists: full per-particle neighbor lists, stored per chunk of particles.
 
 #include <cstdint>
 #include <span>
 #include <vector>
 
+#include <sph/core/parallel.h>
+
 namespace sph {
 
-/// Full neighbor lists: particle i's neighbors (never i itself) are
-/// indices[offsets[i] .. offsets[i+1]). Both directions of a pair are stored.
-struct NeighborLists {
-  std::vector<std::uint64_t> offsets{0};
-  std::vector<std::uint32_t> indices;
+template <int D, std::floating_point R>
+class ListBuilder;
 
-  std::size_t particle_count() const { return offsets.size() - 1; }
+/// Full neighbor lists: of(i) holds particle i's neighbors (never i itself). Both directions
+/// of a pair are stored.
+///
+/// Storage follows the fixed particle chunks of parallel_chunks (kChunkSize particles each):
+/// chunk c's lists lie one after the other in their own buffer, so a builder can write each
+/// chunk's lists in place, in parallel, without a second copy of all lists and without
+/// knowing the other chunks' sizes. A chunk's buffer may be longer than its lists (room kept
+/// from earlier builds, so that steady-state rebuilds allocate nothing).
+class NeighborLists {
+ public:
+  std::size_t particle_count() const { return count_.size(); }
   /// Number of stored (directed) entries: twice the number of pairs for symmetric lists.
-  std::size_t entry_count() const { return indices.size(); }
+  std::size_t entry_count() const { return entries_; }
   std::span<const std::uint32_t> of(std::size_t i) const {
-    return {indices.data() + offsets[i], static_cast<std::size_t>(offsets[i + 1] - offsets[i])};
+    return {chunks_[i / kChunkSize].data() + begin_[i], count_[i]};
   }
   void clear() {
-    offsets.assign(1, 0);
-    indices.clear();
+    chunks_.clear();
+    begin_.clear();
+    count_.clear();
+    entries_ = 0;
   }
+  /// Bytes of memory held (capacity, not just what is in use).
+  std::size_t memory_bytes() const;
+
+  /// Lists given explicitly, one vector per particle (tests, brute force).
+  static NeighborLists from(const std::vector<std::vector<std::uint32_t>>& lists);
+
+  /// The same lists, in the same order (storage layout and spare room do not matter).
+  friend bool operator==(const NeighborLists& a, const NeighborLists& b);
+
+ private:
+  template <int D, std::floating_point R>
+  friend class ListBuilder;
+
+  std::vector<std::vector<std::uint32_t>> chunks_;  // chunk c: lists of particles [c K, (c+1) K)
+  std::vector<std::uint32_t> begin_;                // start of list i in its chunk's buffer
+  std::vector<std::uint32_t> count_;                // length of list i
+  std::size_t entries_ = 0;
 };
 
 }  // namespace sph

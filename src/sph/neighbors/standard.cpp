@@ -23,17 +23,13 @@ void StandardNeighbors<D, R>::update(const ParticleSet<D, R>& particles, R /*dt*
 
 template <int D, std::floating_point R>
 NeighborLists brute_force_lists(std::span<const Vec<D, R>> positions, R radius) {
-  NeighborLists out;
   const std::size_t n = positions.size();
   const R r2 = radius * radius;
-  out.offsets.resize(n + 1);
-  out.offsets[0] = 0;
-  for (std::size_t i = 0; i < n; ++i) {
+  std::vector<std::vector<std::uint32_t>> lists(n);
+  for (std::size_t i = 0; i < n; ++i)
     for (std::size_t j = 0; j < n; ++j)
-      if (j != i && norm2(positions[i] - positions[j]) < r2) out.indices.push_back(static_cast<std::uint32_t>(j));
-    out.offsets[i + 1] = out.indices.size();
-  }
-  return out;
+      if (j != i && norm2(positions[i] - positions[j]) < r2) lists[i].push_back(static_cast<std::uint32_t>(j));
+  return NeighborLists::from(lists);
 }
 
 template <int D, std::floating_point R>

@@ -55,17 +55,33 @@ void UniformGrid<D, R>::build(std::span<const V> positions, R radius) {
     cells *= static_cast<std::size_t>(dims_[d]);
   }
 
+  SPH_CHECK(cells < std::numeric_limits<std::uint32_t>::max(), "too many grid cells for 32-bit cell indices");
+
   // Counting sort by cell, stable in the point index.
   cell_of_.resize(n);
   parallel_for(n, [&](std::size_t i) { cell_of_[i] = static_cast<std::uint32_t>(linear(cell_coords(positions[i]))); });
   cell_start_.assign(cells + 1, 0);
   for (std::size_t i = 0; i < n; ++i) ++cell_start_[cell_of_[i] + 1];
   for (std::size_t c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
-  sorted_.resize(n);
+  sorted_.resize(n + kPad);
+  rank_.resize(n);
   // Scatter using a running cursor per cell (cell_start_ shifted by one, then restored).
-  for (std::size_t i = 0; i < n; ++i) sorted_[cell_start_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t k = cell_start_[cell_of_[i]]++;
+    sorted_[k] = static_cast<std::uint32_t>(i);
+    rank_[i] = k;
+  }
   for (std::size_t c = cells; c > 0; --c) cell_start_[c] = cell_start_[c - 1];
   cell_start_[0] = 0;
+  std::fill(sorted_.begin() + static_cast<std::ptrdiff_t>(n), sorted_.end(), 0u);
+
+  // Coordinates in sorted order, one array per axis.
+  for (auto& c : coords_) c.resize(n + kPad);
+  parallel_for(n, [&](std::size_t k) {
+    const V& x = positions[sorted_[k]];
+    for (int d = 0; d < D; ++d) coords_[static_cast<std::size_t>(d)][k] = x[d];
+  });
+  for (auto& c : coords_) std::fill(c.begin() + static_cast<std::ptrdiff_t>(n), c.end(), R(0));
 }
 
 template class UniformGrid<2, float>;

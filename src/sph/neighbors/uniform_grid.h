@@ -1,6 +1,7 @@
 #pragma once
 /// \file UniformGrid: dense cells over the particles' bounding box, filled by counting sort.
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -27,6 +28,53 @@ class UniformGrid {
   R cell_size() const { return cell_size_; }
   std::size_t cell_count() const { return cell_start_.empty() ? 0 : cell_start_.size() - 1; }
   const std::array<std::int64_t, D>& dims() const { return dims_; }
+
+  /// Cell (linear index) of point i, as built.
+  std::uint32_t cell_of(std::size_t i) const { return cell_of_[i]; }
+  /// Position of point i in the cell-sorted order.
+  std::uint32_t rank(std::size_t i) const { return rank_[i]; }
+  /// Point indices in cell-sorted order (stable within a cell), followed by kPad zeros.
+  const std::uint32_t* sorted() const { return sorted_.data(); }
+  /// Coordinate d of the points in cell-sorted order, followed by kPad zeros: candidates of
+  /// one row of cells are contiguous here, ready for vector loads.
+  const R* sorted_coord(int d) const { return coords_[static_cast<std::size_t>(d)].data(); }
+
+  /// Readable padding after the sorted arrays, so that vector loads may run past the end.
+  static constexpr std::size_t kPad = 16;
+  /// Most row ranges stencil_ranges() returns: 3 in 2D, 9 in 3D.
+  static constexpr int kMaxRanges = D == 3 ? 9 : 3;
+
+  /// The candidates of every point in `cell`: the 3^D cells around it, as up to kMaxRanges
+  /// contiguous ranges [begin[k], end[k]) of sorted positions (one per row of cells along x,
+  /// empty rows skipped), in a fixed order. Returns the number of ranges.
+  int stencil_ranges(std::uint32_t cell, std::uint32_t* begin, std::uint32_t* end) const {
+    std::int64_t c[D];
+    std::int64_t rest = cell;
+    for (int d = 0; d < D; ++d) {
+      c[d] = rest % dims_[d];
+      rest /= dims_[d];
+    }
+    const std::int64_t x0 = c[0] > 0 ? c[0] - 1 : 0;
+    const std::int64_t x1 = c[0] + 1 < dims_[0] ? c[0] + 1 : dims_[0] - 1;
+    const std::int64_t y0 = c[1] > 0 ? c[1] - 1 : 0;
+    const std::int64_t y1 = c[1] + 1 < dims_[1] ? c[1] + 1 : dims_[1] - 1;
+    std::int64_t z0 = 0, z1 = 0;
+    if constexpr (D == 3) {
+      z0 = c[2] > 0 ? c[2] - 1 : 0;
+      z1 = c[2] + 1 < dims_[2] ? c[2] + 1 : dims_[2] - 1;
+    }
+    int k = 0;
+    for (std::int64_t z = z0; z <= z1; ++z)
+      for (std::int64_t y = y0; y <= y1; ++y) {
+        const std::int64_t row = (D == 3 ? z * dims_[1] + y : y) * dims_[0];
+        const std::uint32_t b = cell_start_[static_cast<std::size_t>(row + x0)];
+        const std::uint32_t e = cell_start_[static_cast<std::size_t>(row + x1) + 1];
+        begin[k] = b;
+        end[k] = e;
+        k += e > b ? 1 : 0;
+      }
+    return k;
+  }
 
   /// Calls f(j) for every point j (index into the built positions) in the 3^D cells around x,
   /// in a deterministic order. Candidates may be farther than the radius: callers test distance.
@@ -82,8 +130,10 @@ class UniformGrid {
   R inv_cell_ = 0;
   std::array<std::int64_t, D> dims_{};
   std::vector<std::uint32_t> cell_start_;  // size cells + 1
-  std::vector<std::uint32_t> sorted_;      // point indices sorted by cell (stable)
+  std::vector<std::uint32_t> sorted_;      // point indices sorted by cell (stable), + kPad
   std::vector<std::uint32_t> cell_of_;     // cell of each point
+  std::vector<std::uint32_t> rank_;        // sorted position of each point
+  std::array<std::vector<R>, D> coords_;   // coordinates in sorted order, + kPad
 };
 
 extern template class UniformGrid<2, float>;

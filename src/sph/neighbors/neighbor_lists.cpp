@@ -1,0 +1,42 @@
+#include <sph/neighbors/neighbor_lists.h>
+
+#include <algorithm>
+
+#include <sph/core/error.h>
+
+namespace sph {
+
+std::size_t NeighborLists::memory_bytes() const {
+  std::size_t bytes = chunks_.capacity() * sizeof(chunks_[0]) +
+                      (begin_.capacity() + count_.capacity()) * sizeof(std::uint32_t);
+  for (const auto& c : chunks_) bytes += c.capacity() * sizeof(std::uint32_t);
+  return bytes;
+}
+
+NeighborLists NeighborLists::from(const std::vector<std::vector<std::uint32_t>>& lists) {
+  NeighborLists out;
+  const std::size_t n = lists.size();
+  out.chunks_.resize(chunk_count(n));
+  out.begin_.resize(n);
+  out.count_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    auto& chunk = out.chunks_[i / kChunkSize];
+    SPH_CHECK(chunk.size() + lists[i].size() < (std::size_t{1} << 32), "neighbor list chunk too large");
+    out.begin_[i] = static_cast<std::uint32_t>(chunk.size());
+    out.count_[i] = static_cast<std::uint32_t>(lists[i].size());
+    chunk.insert(chunk.end(), lists[i].begin(), lists[i].end());
+    out.entries_ += lists[i].size();
+  }
+  return out;
+}
+
+bool operator==(const NeighborLists& a, const NeighborLists& b) {
+  if (a.particle_count() != b.particle_count() || a.entry_count() != b.entry_count()) return false;
+  for (std::size_t i = 0; i < a.particle_count(); ++i) {
+    const auto x = a.of(i), y = b.of(i);
+    if (!std::equal(x.begin(), x.end(), y.begin(), y.end())) return false;
+  }
+  return true;
+}
+
+}  // namespace sph

@@ -1,0 +1,40 @@
+#pragma once
+/// \file MortonOrder: a permutation that sorts points along a Z-order (Morton) curve, so that
+/// particles close in space are close in memory (neighbor search and the SPH loops then read
+/// memory almost sequentially, even after a flow has scrambled the particle order).
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <sph/core/vec.h>
+
+namespace sph {
+
+/// Computes Morton-order permutations. Keeps its scratch buffers between calls.
+template <int D, std::floating_point R>
+class MortonOrder {
+ public:
+  /// Fills `perm` (resized to positions.size()) so that perm[k] is the index of the point that
+  /// comes k-th along the Z-order curve of cells of size `cell` over the points' bounding box.
+  /// Points in the same cell keep their relative order (stable), so the result depends only on
+  /// the input. Non-finite positions are refused with sph::Error. cell must be > 0.
+  void compute(std::span<const Vec<D, R>> positions, R cell, std::vector<std::uint32_t>& perm);
+
+ private:
+  std::vector<std::uint64_t> keys_, keys_tmp_;
+  std::vector<std::uint32_t> tmp_;
+  std::vector<std::uint32_t> histogram_;
+};
+
+/// Interleaves the low bits of cell coordinates into a Morton key (21 bits per axis in 3D,
+/// 32 in 2D).
+std::uint64_t morton_key(std::uint32_t x, std::uint32_t y);
+std::uint64_t morton_key(std::uint32_t x, std::uint32_t y, std::uint32_t z);
+
+extern template class MortonOrder<2, float>;
+extern template class MortonOrder<2, double>;
+extern template class MortonOrder<3, float>;
+extern template class MortonOrder<3, double>;
+
+}  // namespace sph

@@ -30,6 +30,8 @@ class Poly6Kernel {
   }
   R h() const { return h_; }
   /// W(r) from the squared distance r2 = |x_i - x_j|^2.
+  /// The constant C of W = C (h^2 - r^2)^3.
+  R norm() const { return norm_; }
   R w_r2(R r2) const {
     if (r2 >= h2_) return R(0);
     const R d = h2_ - r2;
@@ -53,6 +55,8 @@ class SpikyKernel {
     norm_ = static_cast<R>(D == 3 ? 15.0 / (pi * std::pow(hd, 6)) : 10.0 / (pi * std::pow(hd, 5)));
   }
   R h() const { return h_; }
+  /// The constant C of W = C (h - r)^3.
+  R norm() const { return norm_; }
   R w(R r) const {
     if (r >= h_) return R(0);
     const R d = h_ - r;
@@ -80,6 +84,8 @@ class ViscosityKernel {
     lap_norm_ = static_cast<R>(D == 3 ? 45.0 / (pi * std::pow(hd, 6)) : 40.0 / (pi * std::pow(hd, 5)));
   }
   R h() const { return h_; }
+  /// The constant C of the Laplacian C (h - r).
+  R laplacian_norm() const { return lap_norm_; }
   /// Laplacian of W: C (h - r) for r < h.
   R laplacian(R r) const { return r >= h_ ? R(0) : lap_norm_ * (h_ - r); }
   /// W itself (singular at r = 0 in both dimensions; only used to check normalization).

@@ -142,7 +142,10 @@ void ensure_room(std::vector<std::uint32_t>& buf, std::size_t need) {
   buf.resize(std::max(need, buf.size() + buf.size() / 8 + 4096));
 }
 
-constexpr std::size_t kRoom = 16;  // a vector store may write this far past the last hit
+// Room after the last list: a vector store may write this far past the last hit, and readers
+// may load NeighborLists::kPadding entries past a list's end.
+constexpr std::size_t kRoom = 16;
+static_assert(kRoom >= NeighborLists::kPadding);
 
 }  // namespace
 
@@ -221,7 +224,7 @@ void ListBuilder<D, R>::rebuild_some(const UniformGrid<D, R>& grid, std::span<co
       fresh_count[i - b] = gather(vector_, grid, st, positions[i], grid.rank(i), r2, fresh.data() + used);
       used += fresh_count[i - b];
     }
-    ensure_room(merged, kept + used);
+    ensure_room(merged, kept + used + kRoom);
     const std::uint32_t* old = lists.chunks_[c].data();
     const std::uint32_t* next_fresh = fresh.data();
     std::size_t at = 0;

@@ -27,10 +27,12 @@ NeighborLists NeighborLists::from(const std::vector<std::vector<std::uint32_t>>&
     chunk.insert(chunk.end(), lists[i].begin(), lists[i].end());
     out.entries_ += lists[i].size();
   }
+  for (auto& chunk : out.chunks_) chunk.resize(chunk.size() + kPadding, 0);
   return out;
 }
 
 bool operator==(const NeighborLists& a, const NeighborLists& b) {
+  if (&a == &b) return true;
   if (a.particle_count() != b.particle_count() || a.entry_count() != b.entry_count()) return false;
   for (std::size_t i = 0; i < a.particle_count(); ++i) {
     const auto x = a.of(i), y = b.of(i);

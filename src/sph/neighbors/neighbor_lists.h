@@ -22,6 +22,11 @@ class ListBuilder;
 /// from earlier builds, so that steady-state rebuilds allocate nothing).
 class NeighborLists {
  public:
+  /// Entries after the end of each list that may be read (never used): every chunk buffer
+  /// ends with at least this many, and every stored value is a valid particle index, so
+  /// vector loops may load whole blocks of indices and mask the lanes past the end.
+  static constexpr std::size_t kPadding = 16;
+
   std::size_t particle_count() const { return count_.size(); }
   /// Number of stored (directed) entries: twice the number of pairs for symmetric lists.
   std::size_t entry_count() const { return entries_; }

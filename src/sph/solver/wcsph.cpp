@@ -7,44 +7,82 @@
 #include <sph/core/error.h>
 #include <sph/core/kernels.h>
 #include <sph/core/parallel.h>
+#include <sph/core/simd.h>
 
 namespace sph {
 
 namespace {
+
+using simd::Mask;
+
+/// The scalars of a vector field, x0 y0 z0 x1 y1 z1 ..., so that pair loops gather lanes.
+template <int D, std::floating_point R>
+const R* flat(const std::vector<Vec<D, R>>& v) {
+  static_assert(sizeof(Vec<D, R>) == D * sizeof(R));
+  return reinterpret_cast<const R*>(v.data());
+}
+
+/// The pair loops below take a particle's neighbors simd::kLanes<R> at a time (one vector
+/// register), each lane keeping its own partial sums, which are added in lane order at the
+/// end. Lanes past the end of a list load some valid index (NeighborLists::kPadding) and are
+/// masked out. The result is the same for any thread count and with or without AVX-512.
+
 template <bool kExitTest, int D, std::floating_point R>
 std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                           std::span<std::uint8_t> flags, R dt) {
+                           std::span<std::uint8_t> flags, R dt, std::vector<std::uint64_t>& within) {
+  using P = simd::Pack<R>;
+  constexpr int W = simd::kLanes<R>;
   const Poly6Kernel<D, R> poly6(h);
   const R w0 = poly6.w_zero();
   const R h2 = h * h;
   const R rho0 = static_cast<R>(fluid.rest_density);
   const R k = static_cast<R>(fluid.stiffness);
   const bool clamp = fluid.negative_pressure == NegativePressure::Clamp;
+  const R* pos = flat(ps.position);
+  const R* vel = flat(ps.velocity);
+  const R* mass = ps.mass.data();
+  const P h2v = P::set1(h2), normv = P::set1(poly6.norm()), zero = P::set1(R(0)), dtv = P::set1(dt);
   const auto set_flag = [&](std::size_t q) {
     std::atomic_ref<std::uint8_t>(flags[q]).store(1, std::memory_order_relaxed);
   };
-  std::vector<std::uint64_t> within(chunk_count(ps.size()), 0);
+  within.assign(chunk_count(ps.size()), 0);
   parallel_chunks(ps.size(), [&](std::size_t c, std::size_t b, std::size_t e) {
     std::uint64_t count = 0;
     for (std::size_t i = b; i < e; ++i) {
-      const Vec<D, R> xi = ps.position[i];
-      R rho = ps.mass[i] * w0;
+      P xi[D], vi[D];
+      for (int d = 0; d < D; ++d) xi[d] = P::set1(ps.position[i][d]), vi[d] = P::set1(ps.velocity[i][d]);
+      const auto nb = lists.of(i);
+      const std::uint32_t* idx = nb.data();
+      P sum = zero;
       bool flag_i = false;
-      for (std::uint32_t j : lists.of(i)) {
-        const Vec<D, R> rij = xi - ps.position[j];
-        const R r2 = norm2(rij);
-        rho += ps.mass[j] * poly6.w_r2(r2);
-        count += r2 < h2 ? 1 : 0;
+      for (std::size_t k0 = 0; k0 < nb.size(); k0 += W) {
+        const Mask valid = simd::first_lanes<R>(nb.size() - k0);
+        P rij[D], r2 = zero;
+        for (int d = 0; d < D; ++d) {
+          rij[d] = xi[d] - P::template gather<D>(pos, idx + k0, d);
+          r2 = r2 + rij[d] * rij[d];
+        }
+        const Mask in = valid & (r2 < h2v);
+        const P dd = h2v - r2;
+        // Paper Eq. 4: m_j W_poly6 = m_j C (h^2 - r^2)^3 inside the support.
+        sum = sum + select(in, P::template gather<1>(mass, idx + k0, 0) * (normv * dd * dd * dd), zero);
+        count += static_cast<std::uint64_t>(__builtin_popcount(in));
         if constexpr (kExitTest) {
           // Paper Eq. 7: the pair's distance after the step, predicted with today's velocities.
-          if (norm2(rij + (ps.velocity[i] - ps.velocity[j]) * dt) > h2) {
+          P q2 = zero;
+          for (int d = 0; d < D; ++d) {
+            const P t = rij[d] + (vi[d] - P::template gather<D>(vel, idx + k0, d)) * dtv;
+            q2 = q2 + t * t;
+          }
+          for (Mask out = valid & (q2 > h2v); out != 0; out &= out - 1) {
             flag_i = true;
-            set_flag(j);
+            set_flag(idx[k0 + static_cast<std::size_t>(__builtin_ctz(out))]);
           }
         }
       }
       if constexpr (kExitTest)
         if (flag_i) set_flag(i);
+      const R rho = mass[i] * w0 + simd::sum_lanes(sum);
       ps.density[i] = rho;
       const R p = k * (rho - rho0);
       ps.pressure[i] = clamp ? std::max(p, R(0)) : p;
@@ -55,44 +93,85 @@ std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
   for (std::uint64_t w : within) total += w;
   return total;
 }
+
+template <bool kPaper, int D, std::floating_point R>
+void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
+                const Vec<D, R>& gravity) {
+  using P = simd::Pack<R>;
+  constexpr int W = simd::kLanes<R>;
+  const P hv = P::set1(h), h2v = P::set1(h * h), zero = P::set1(R(0)), one = P::set1(R(1)),
+          minus_one = P::set1(R(-1)), half = P::set1(R(0.5));
+  const P grad_c = P::set1(R(-3) * SpikyKernel<D, R>(h).norm());
+  const R lap_c = ViscosityKernel<D, R>(h).laplacian_norm();
+  const R mu = static_cast<R>(fluid.viscosity);
+  const R* pos = flat(ps.position);
+  const R* vel = flat(ps.velocity);
+  const R* rho = ps.density.data();
+  const R* prs = ps.pressure.data();
+  const R* mass = ps.mass.data();
+  parallel_for(ps.size(), [&](std::size_t i) {
+    P xi[D], vi[D], acc[D];
+    for (int d = 0; d < D; ++d)
+      xi[d] = P::set1(ps.position[i][d]), vi[d] = P::set1(ps.velocity[i][d]), acc[d] = zero;
+    const R inv_rhoi = R(1) / rho[i];
+    // Pressure term P_ij, symmetric in i and j, so that each pair's contributions are equal
+    // and opposite: the paper's (p_i + p_j) / (2 rho_i rho_j), or p_i / rho_i^2 + p_j / rho_j^2.
+    const P pi_half = P::set1(R(0.5) * prs[i] * inv_rhoi);
+    const P pi_sym = P::set1(prs[i] * inv_rhoi * inv_rhoi);
+    const P inv_rhoi_v = P::set1(inv_rhoi);
+    const P visc_i = P::set1(mu * inv_rhoi * lap_c);
+    const auto nb = lists.of(i);
+    const std::uint32_t* idx = nb.data();
+    for (std::size_t k0 = 0; k0 < nb.size(); k0 += W) {
+      const Mask valid = simd::first_lanes<R>(nb.size() - k0);
+      P rij[D], r2 = zero;
+      for (int d = 0; d < D; ++d) {
+        rij[d] = xi[d] - P::template gather<D>(pos, idx + k0, d);
+        r2 = r2 + rij[d] * rij[d];
+      }
+      const Mask near = valid & (r2 < h2v);  // inside the support
+      const Mask apart = near & (r2 > zero);  // and not coincident (gradient defined)
+      const P r = sqrt(select(near, r2, h2v));
+      const P dh = hv - r;
+      const P inv_rhoj = one / P::template gather<1>(rho, idx + k0, 0);
+      const P pj = P::template gather<1>(prs, idx + k0, 0);
+      const P mj = P::template gather<1>(mass, idx + k0, 0);
+      P pij;
+      if constexpr (kPaper)
+        pij = (pi_half + half * pj * inv_rhoi_v) * inv_rhoj;
+      else
+        pij = pi_sym + pj * inv_rhoj * inv_rhoj;
+      // -m_j P_ij times the spiky gradient -3 C (h - r)^2 rij / r (Eq. 5), and the viscosity
+      // term mu m_j (v_j - v_i) C_lap (h - r) / (rho_i rho_j) (Eq. 6).
+      const P fp = select(apart, (grad_c * dh * dh / select(apart, r, one)) * (minus_one * mj * pij), zero);
+      const P fv = select(near, visc_i * mj * inv_rhoj * dh, zero);
+      for (int d = 0; d < D; ++d)
+        acc[d] = acc[d] + (rij[d] * fp + (P::template gather<D>(vel, idx + k0, d) - vi[d]) * fv);
+    }
+    Vec<D, R> a = gravity;
+    for (int d = 0; d < D; ++d) a[d] += simd::sum_lanes(acc[d]);
+    ps.acceleration[i] = a;
+  });
+}
+
 }  // namespace
 
 template <int D, std::floating_point R>
 std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                                        std::span<std::uint8_t> exit_flags, R dt) {
-  if (exit_flags.empty()) return density_pass<false>(ps, lists, h, fluid, exit_flags, dt);
+  thread_local std::vector<std::uint64_t> within;  // per-chunk counts, kept between steps
+  if (exit_flags.empty()) return density_pass<false>(ps, lists, h, fluid, exit_flags, dt, within);
   SPH_CHECK(exit_flags.size() == ps.size(), "one exit flag per particle");
-  return density_pass<true>(ps, lists, h, fluid, exit_flags, dt);
+  return density_pass<true>(ps, lists, h, fluid, exit_flags, dt, within);
 }
 
 template <int D, std::floating_point R>
 void compute_fluid_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                                  const Vec<D, R>& gravity) {
-  const SpikyKernel<D, R> spiky(h);
-  const ViscosityKernel<D, R> visc(h);
-  const R mu = static_cast<R>(fluid.viscosity);
-  const bool paper = fluid.pressure_force == PressureForce::Paper;
-  parallel_for(ps.size(), [&](std::size_t i) {
-    const Vec<D, R> xi = ps.position[i];
-    const Vec<D, R> vi = ps.velocity[i];
-    const R inv_rhoi = R(1) / ps.density[i];
-    // Pressure term P_ij, symmetric in i and j, so that each pair's contributions are equal
-    // and opposite: the paper's (p_i + p_j) / (2 rho_i rho_j), or p_i / rho_i^2 + p_j / rho_j^2.
-    const R pi_half = R(0.5) * ps.pressure[i] * inv_rhoi;
-    const R pi_sym = ps.pressure[i] * inv_rhoi * inv_rhoi;
-    Vec<D, R> a{};
-    for (std::uint32_t j : lists.of(i)) {
-      const Vec<D, R> rij = xi - ps.position[j];
-      const R r = norm(rij);
-      if (r >= h) continue;
-      const R inv_rhoj = R(1) / ps.density[j];
-      const R pij = paper ? (pi_half + R(0.5) * ps.pressure[j] * inv_rhoi) * inv_rhoj
-                          : pi_sym + ps.pressure[j] * inv_rhoj * inv_rhoj;
-      a += spiky.gradient(rij, r) * (-ps.mass[j] * pij);
-      a += (ps.velocity[j] - vi) * (mu * ps.mass[j] * inv_rhoi * inv_rhoj * visc.laplacian(r));
-    }
-    ps.acceleration[i] = gravity + a;
-  });
+  if (fluid.pressure_force == PressureForce::Paper)
+    force_pass<true>(ps, lists, h, fluid, gravity);
+  else
+    force_pass<false>(ps, lists, h, fluid, gravity);
 }
 
 namespace {

@@ -15,5 +15,7 @@ enum ExitCode { kOk = 0, kRunFailed = 1, kBadInput = 2, kInternal = 70 };
 std::function<int()> add_run_command(CLI::App& app);
 /// Adds `sph compare`.
 std::function<int()> add_compare_command(CLI::App& app);
+/// Adds `sph bench`.
+std::function<int()> add_bench_command(CLI::App& app);
 
 }  // namespace sph::app

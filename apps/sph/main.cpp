@@ -48,7 +48,9 @@ int main(int argc, char** argv) {
       "  sph run SCENE.json [-o DIR] [--neighbors standard|adaptive|verlet] [--steps N] [--threads N]\n"
       "                     [--set KEY=VALUE]...     run a scene (sph run --help for details)\n"
       "  sph compare SCENE.json [-o DIR] [--modes standard,adaptive,verlet] [--steps N]\n"
-      "                     compare the neighbor modes: speed, accuracy, missed pairs, images\n\n"
+      "                     compare the neighbor modes: speed, accuracy, missed pairs, images\n"
+      "  sph bench [--suite neighbors,steps,tank|all] [--size small|medium|large|full] [--threads 1,2]\n"
+      "                     [-o DIR]   benchmark suites: tables, DIR/bench.json and CSVs\n\n"
       "Example: sph run scenes/paper/dam_break_2d.json -o out/dam_break_2d\n"
       "         then open out/dam_break_2d/frames.pvd in ParaView.",
       "sph"};
@@ -56,6 +58,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::function<int()> run_cmd = add_run_command(app);
   std::function<int()> compare_cmd = add_compare_command(app);
+  std::function<int()> bench_cmd = add_bench_command(app);
 
   try {
     app.parse(argc, argv);
@@ -76,6 +79,7 @@ int main(int argc, char** argv) {
   }
 
   try {
+    if (app.got_subcommand("bench")) return bench_cmd();
     return app.got_subcommand("compare") ? compare_cmd() : run_cmd();
   } catch (const sph::Error& e) {
     fmt::print(stderr, "sph: error: {}\n", e.what());

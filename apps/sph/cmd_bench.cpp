@@ -1,0 +1,126 @@
+// `sph bench`: the benchmark suites (neighbor search, whole steps, the paper's tank), printed
+// as tables while they run and written to DIR/bench.json plus one CSV per suite.
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <sph/bench/bench.h>
+#include <sph/core/error.h>
+#include <sph/core/timer.h>
+
+#include "commands.h"
+
+namespace sph::app {
+
+namespace {
+
+struct BenchCliOptions {
+  std::string suites = "all";
+  std::string size = "small";
+  std::string threads;
+  std::string precisions;
+  std::string modes = "standard,adaptive,verlet";
+  int repeats = 5;
+  std::string output = "out/bench";
+  std::int64_t particles = 0;
+  std::int64_t warmup_steps = -1;
+  std::int64_t timed_steps = -1;
+  std::int64_t tank_steps = 0;
+  std::string scene_dir;
+  bool no_progress = false;
+};
+
+int bench(const BenchCliOptions& cli) {
+  // Everything that can be refused is checked before the output directory is touched.
+  BenchOptions opt;
+  opt.suites = parse_bench_suites(cli.suites, "--suite");
+  opt.size = parse_bench_size(cli.size, "--size");
+  if (!cli.threads.empty()) opt.threads = parse_thread_list(cli.threads, "--threads");
+  if (!cli.precisions.empty()) opt.precisions = parse_precisions(cli.precisions, "--precision");
+  opt.modes = parse_bench_modes(cli.modes, "--modes");
+  opt.repeats = cli.repeats;
+  opt.particles = cli.particles;
+  opt.warmup_steps = cli.warmup_steps;
+  opt.timed_steps = cli.timed_steps;
+  opt.tank_steps = cli.tank_steps;
+  opt.scene_dir = cli.scene_dir;
+  validate_bench_options(opt);
+  const std::filesystem::path dir(cli.output);
+  prepare_bench_directory(dir);
+
+  BenchOutput out;
+  out.table = [](const std::string& text) {
+    fmt::print(stdout, "{}\n", text);
+    std::fflush(stdout);
+  };
+  if (!cli.no_progress) out.progress = [](const std::string& text) { fmt::print(stderr, "sph: {}\n", text); };
+
+  const std::vector<int> threads = bench_threads(opt);
+  fmt::print(stderr, "sph: bench {} (size {}, threads {}, repeats {}) -> {}\n", fmt::join(opt.suites, ","),
+             to_string(opt.size), fmt::join(threads, ","), opt.repeats, dir.string());
+  Stopwatch wall;
+  try {
+    run_benchmarks(opt, dir, out);
+  } catch (const BenchFailure& e) {
+    fmt::print(stderr, "sph: error: {}\nsph: the figures measured before the failure are in {}\n", e.what(),
+               (dir / "bench.json").string());
+    return kRunFailed;
+  }
+  fmt::print(stderr, "sph: bench done in {:.1f} s: {}", wall.elapsed(), (dir / "bench.json").string());
+  for (const std::string& suite : opt.suites) fmt::print(stderr, ", {}", (dir / (suite + ".csv")).string());
+  fmt::print(stderr, "\n");
+  return kOk;
+}
+
+}  // namespace
+
+std::function<int()> add_bench_command(CLI::App& app) {
+  auto opt = std::make_shared<BenchCliOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "bench", "Benchmark suites: neighbor search, simulation steps per mode, the paper's tank; tables and CSV/JSON");
+  cmd->add_option("--suite", opt->suites, "Comma-separated suites: neighbors, steps, tank, or all")->default_str("all");
+  cmd->add_option("--size", opt->size,
+                  "small (8k particles, few steps: CI), medium (adds 64k), large (adds 512k), full (adds the 1M "
+                  "dam break to steps)")
+      ->default_str("small");
+  cmd->add_option("--threads", opt->threads,
+                  "Comma-separated thread counts to run, e.g. 1,2 (default: 1 and the core count; more threads "
+                  "than cores are allowed and marked with *)");
+  cmd->add_option("--precision", opt->precisions,
+                  "float, double or float,double (default: both; float only from 1M particles on; the tank runs "
+                  "the scene's own precision)");
+  cmd->add_option("--repeats", opt->repeats, "Timings per neighbors case and runs per tank mode (medians reported)")
+      ->check(CLI::Range(1, 1000))
+      ->default_str("5");
+  cmd->add_option("-o,--output", opt->output, "Output directory for bench.json and the CSVs")->default_str("out/bench");
+  cmd->add_option("--particles", opt->particles,
+                  "Steps suite: run one dam break of about this many particles (rounded to a cube) instead of the "
+                  "size's, e.g. 10000000")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{2'000'000'000}));
+  cmd->add_option("--modes", opt->modes, "Neighbor modes of the steps and tank suites")
+      ->default_str("standard,adaptive,verlet");
+  cmd->add_option("--warmup-steps", opt->warmup_steps,
+                  "Steps suite: untimed steps before timing (default: 10 at size small, else 20 to 3 by size)")
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{1'000'000}));
+  cmd->add_option("--timed-steps", opt->timed_steps,
+                  "Steps suite: timed steps (default: 40 at size small, else 50 to 5 by size)")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1'000'000}));
+  cmd->add_option("--steps", opt->tank_steps,
+                  "Tank suite: steps per run (default: the whole scene, 1000 at size small)")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1'000'000'000}));
+  cmd->add_option("--scene-dir", opt->scene_dir,
+                  "Directory holding tank_fill_3d.json (default: the source tree's scenes/paper)");
+  cmd->add_flag("--no-progress", opt->no_progress, "No progress lines on stderr (the tables still go to stdout)");
+  return [opt, cmd]() -> int {
+    if (!cmd->parsed()) return kBadInput;
+    return bench(*opt);
+  };
+}
+
+}  // namespace sph::app

@@ -1,16 +1,8 @@
+#include <algorithm>
 #include <sph/core/error.h>
 #include <sph/core/particle_set.h>
 
 namespace sph {
-
-namespace {
-template <class T>
-void apply_permutation(std::vector<T>& field, std::span<const std::uint32_t> perm) {
-  std::vector<T> out(field.size());
-  for (std::size_t k = 0; k < perm.size(); ++k) out[k] = field[perm[k]];
-  field.swap(out);
-}
-}  // namespace
 
 template <int D, std::floating_point R>
 void ParticleSet<D, R>::reserve(std::size_t n) {
@@ -39,15 +31,43 @@ std::uint64_t ParticleSet<D, R>::add(const V& x, const V& v, R m) {
 
 template <int D, std::floating_point R>
 void ParticleSet<D, R>::permute(std::span<const std::uint32_t> perm) {
-  SPH_CHECK(perm.size() == size(), "permutation size differs from particle count");
-  apply_permutation(position, perm);
-  apply_permutation(velocity, perm);
-  apply_permutation(acceleration, perm);
-  apply_permutation(initial_position, perm);
-  apply_permutation(density, perm);
-  apply_permutation(pressure, perm);
-  apply_permutation(mass, perm);
-  apply_permutation(id, perm);
+  const std::size_t n = size();
+  SPH_CHECK(perm.size() == n, "permutation size differs from particle count");
+  // Check it is a permutation (a repeated index would lose a particle), using the bits.
+  placed_.assign((n + 63) / 64, 0);
+  for (std::uint32_t p : perm) {
+    SPH_CHECK(p < n && !((placed_[p / 64] >> (p % 64)) & 1u), "not a permutation");
+    placed_[p / 64] |= std::uint64_t{1} << (p % 64);
+  }
+  std::fill(placed_.begin(), placed_.end(), 0);
+  const auto placed = [&](std::size_t k) { return (placed_[k / 64] >> (k % 64)) & 1u; };
+  const auto move_to = [&](std::size_t dst, std::size_t src) {
+    position[dst] = position[src];
+    velocity[dst] = velocity[src];
+    acceleration[dst] = acceleration[src];
+    initial_position[dst] = initial_position[src];
+    density[dst] = density[src];
+    pressure[dst] = pressure[src];
+    mass[dst] = mass[src];
+    id[dst] = id[src];
+  };
+  // Each cycle k -> perm[k] -> perm[perm[k]] ... is rotated through one saved particle.
+  for (std::size_t start = 0; start < n; ++start) {
+    if (placed(start) || perm[start] == start) continue;
+    const V x = position[start], v = velocity[start], a = acceleration[start], x0 = initial_position[start];
+    const R rho = density[start], p = pressure[start], m = mass[start];
+    const std::uint64_t ident = id[start];
+    std::size_t k = start;
+    for (;;) {
+      placed_[k / 64] |= std::uint64_t{1} << (k % 64);
+      const std::size_t src = perm[k];
+      if (src == start) break;
+      move_to(k, src);
+      k = src;
+    }
+    position[k] = x, velocity[k] = v, acceleration[k] = a, initial_position[k] = x0;
+    density[k] = rho, pressure[k] = p, mass[k] = m, id[k] = ident;
+  }
 }
 
 template class ParticleSet<2, float>;

@@ -43,11 +43,13 @@ class ParticleSet {
   std::uint64_t next_id() const { return next_id_; }
 
   /// Reorders every field so that new index k holds the particle previously at perm[k].
-  /// perm must be a permutation of [0, size()).
+  /// perm must be a permutation of [0, size()). Works in place, following the permutation's
+  /// cycles: no copy of the fields, and no allocation once it has run at this size.
   void permute(std::span<const std::uint32_t> perm);
 
  private:
   std::uint64_t next_id_ = 0;
+  std::vector<std::uint64_t> placed_;  // permute(): one bit per particle
 };
 
 extern template class ParticleSet<2, float>;

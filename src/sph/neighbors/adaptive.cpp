@@ -19,7 +19,8 @@ void AdaptiveNeighbors<D, R>::update(const ParticleSet<D, R>& particles, R /*dt*
   Stopwatch watch;
   const std::size_t n = particles.size();
   flags_.resize(n, 1);  // particles added since the last update start flagged
-  const bool full = updates_ % period_ == 0 || lists_.particle_count() == 0;
+  const bool full = updates_ % period_ == 0 || lists_.particle_count() == 0 || invalid_;
+  invalid_ = false;
   ++updates_;
 
   std::size_t flagged = n;

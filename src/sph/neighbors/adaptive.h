@@ -30,11 +30,15 @@ class AdaptiveNeighbors final : public NeighborStrategy<D, R> {
   const NeighborLists& lists() const override { return lists_; }
   const NeighborCounters& counters() const override { return counters_; }
   std::span<std::uint8_t> pair_exit_flags() override { return flags_; }
+  /// The next update is a full rebuild (Simulation reorders on full-rebuild steps by default,
+  /// so that this costs nothing extra).
+  void invalidate() override { invalid_ = true; }
 
  private:
   R radius_;
   int period_;
   std::int64_t updates_ = 0;
+  bool invalid_ = false;
   std::vector<std::uint8_t> flags_;
   UniformGrid<D, R> grid_;
   ListBuilder<D, R> builder_;

@@ -15,6 +15,7 @@ class StandardNeighbors final : public NeighborStrategy<D, R> {
   void update(const ParticleSet<D, R>& particles, R dt) override;
   const NeighborLists& lists() const override { return lists_; }
   const NeighborCounters& counters() const override { return counters_; }
+  void invalidate() override {}  // every update rebuilds everything anyway
 
  private:
   R radius_;
@@ -33,6 +34,7 @@ class BruteForceNeighbors final : public NeighborStrategy<D, R> {
   void update(const ParticleSet<D, R>& particles, R dt) override;
   const NeighborLists& lists() const override { return lists_; }
   const NeighborCounters& counters() const override { return counters_; }
+  void invalidate() override {}  // every update rebuilds everything anyway
 
  private:
   R radius_;

@@ -56,6 +56,10 @@ class NeighborStrategy {
   /// Eq. 7). The strategy reads and clears them in its next update(). Empty for strategies
   /// that do not ask for the test (the solver then skips it).
   virtual std::span<std::uint8_t> pair_exit_flags() { return {}; }
+
+  /// The particles were reordered in memory: the lists refer to old indices, so the next
+  /// update() rebuilds every list (and restarts whatever the strategy tracks per particle).
+  virtual void invalidate() = 0;
 };
 
 /// Creates the strategy for `mode`. Throws sph::Error for a mode this build cannot run.

@@ -20,6 +20,7 @@ class VerletNeighbors final : public NeighborStrategy<D, R> {
   void update(const ParticleSet<D, R>& particles, R dt) override;
   const NeighborLists& lists() const override { return lists_; }
   const NeighborCounters& counters() const override { return counters_; }
+  void invalidate() override { built_at_.clear(); }  // the next update rebuilds
 
   R skin() const { return skin_; }
   /// Largest displacement of a particle since the last build, as measured by the last update().

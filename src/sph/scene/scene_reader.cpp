@@ -327,7 +327,7 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
 
   root.object("Configuration",
               {"precision", "timeStepSize", "numberOfSteps", "particleRadius", "kernelRadius", "gravitation",
-               "neighbors", "fullRebuildPeriod", "verletSkin", "outputEveryNSteps"},
+               "neighbors", "fullRebuildPeriod", "verletSkin", "reorderPeriod", "outputEveryNSteps"},
               [&](ObjectReader& c) {
     const std::string prec = c.choice("precision", {"double", "float"}, "double");
     desc.precision = prec == "float" ? Precision::Float : Precision::Double;
@@ -346,6 +346,9 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
         c.choice("neighbors", {"standard", "adaptive", "verlet", "brute_force"}, "standard"), c.child("neighbors"));
     sim.full_rebuild_period = static_cast<int>(
         c.integer("fullRebuildPeriod", "a full-rebuild period of at least 1 step", 1, 1'000'000'000, 200));
+    sim.reorder_period = static_cast<int>(c.integer("reorderPeriod",
+                                                    "a whole number of steps, 0 or more (0: never reorder particles in memory)",
+                                                    0, 1'000'000'000, sim.full_rebuild_period));
     sim.verlet_skin = c.positive("verletSkin", "a positive verlet skin in metres (default 0.1 h)",
                                  kDefaultSkinFraction * sim.kernel_radius);
     if (sim.verlet_skin > 2.0 * sim.kernel_radius)

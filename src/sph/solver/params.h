@@ -83,6 +83,10 @@ struct SimulationParams {
   std::vector<EmitterParams<D>> emitters;
   NeighborMode neighbors = NeighborMode::Standard;
   int full_rebuild_period = 200;  ///< adaptive mode
+  /// Every this many steps (from step 0), particles are reordered in memory along a Morton
+  /// curve and every list is rebuilt; 0 never reorders. Defaults to full_rebuild_period so
+  /// that adaptive runs rebuild nothing extra.
+  int reorder_period = 200;
   double verlet_skin = 0;         ///< verlet mode: skin, m; 0 means kDefaultSkinFraction * h
   /// Audit the lists every step against exact lists (StepInfo::audit); costs about one
   /// standard list build per step.

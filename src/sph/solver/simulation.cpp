@@ -39,8 +39,8 @@ std::pair<Vec<D, double>, Vec<D, double>> nozzle_axes(const Vec<D, double>& dir)
 
 /// Deterministic sum over particles: fixed chunks, partial sums added in chunk order.
 template <class F>
-double chunked_sum(std::size_t n, F&& term) {
-  std::vector<double> partial(chunk_count(n), 0.0);
+double chunked_sum(std::size_t n, std::vector<double>& partial, F&& term) {
+  partial.assign(chunk_count(n), 0.0);
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     double s = 0;
     for (std::size_t i = b; i < e; ++i) s += term(i);
@@ -60,6 +60,7 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
   opt.radius = params_.kernel_radius;
   opt.full_rebuild_period = params_.full_rebuild_period;
   opt.verlet_skin = params_.verlet_skin;
+  SPH_CHECK(params_.reorder_period >= 0, "reorder period must be >= 0");
   neighbors_ = make_neighbor_strategy<D, R>(params_.neighbors, opt);
   if (params_.audit) auditor_ = std::make_unique<ListAuditor<D, R>>();
   double extent = 0;
@@ -114,9 +115,18 @@ const StepInfo& Simulation<D, R>::step() {
 
   const R dt = static_cast<R>(params_.time_step);
   const R h = static_cast<R>(params_.kernel_radius);
+  double reorder_seconds = 0;
+  if (params_.reorder_period > 0 && steps_ % params_.reorder_period == 0 && particles_.size() > 1) {
+    Stopwatch reorder;
+    morton_.compute(particles_.position, h, perm_);
+    particles_.permute(perm_);
+    neighbors_->invalidate();
+    info.reordered = true;
+    reorder_seconds = reorder.lap();
+  }
   neighbors_->update(particles_, dt);
   info.neighbors = neighbors_->counters();
-  info.seconds.grid = info.neighbors.grid_seconds;
+  info.seconds.grid = info.neighbors.grid_seconds + reorder_seconds;
   info.seconds.lists = info.neighbors.lists_seconds;
   const NeighborLists& lists = neighbors_->lists();
   if (auditor_) {
@@ -148,7 +158,8 @@ void Simulation<D, R>::check_state() const {
   const std::size_t n = particles_.size();
   const double limit2 = speed_limit_ * speed_limit_;
   // Find the first bad particle in index order (deterministic message).
-  std::vector<std::uint8_t> bad(chunk_count(n), 0);
+  std::vector<std::uint8_t>& bad = bad_;
+  bad.assign(chunk_count(n), 0);
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i)
       if (!all_finite(particles_.position[i]) || !all_finite(particles_.velocity[i]) ||
@@ -183,7 +194,7 @@ void Simulation<D, R>::check_state() const {
 
 template <int D, std::floating_point R>
 double Simulation<D, R>::kinetic_energy() const {
-  return chunked_sum(particles_.size(), [&](std::size_t i) {
+  return chunked_sum(particles_.size(), partial_, [&](std::size_t i) {
     return 0.5 * static_cast<double>(particles_.mass[i]) * static_cast<double>(norm2(particles_.velocity[i]));
   });
 }
@@ -199,7 +210,7 @@ template <int D, std::floating_point R>
 Vec<D, double> Simulation<D, R>::momentum() const {
   Vec<D, double> p{};
   for (int d = 0; d < D; ++d)
-    p[d] = chunked_sum(particles_.size(), [&](std::size_t i) {
+    p[d] = chunked_sum(particles_.size(), partial_, [&](std::size_t i) {
       return static_cast<double>(particles_.mass[i]) * static_cast<double>(particles_.velocity[i][d]);
     });
   return p;

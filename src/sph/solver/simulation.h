@@ -6,6 +6,7 @@
 
 #include <sph/core/particle_set.h>
 #include <sph/neighbors/audit.h>
+#include <sph/neighbors/reorder.h>
 #include <sph/neighbors/strategy.h>
 #include <sph/solver/params.h>
 
@@ -27,6 +28,7 @@ struct StepInfo {
   double time = 0;        ///< simulated time after the step, s
   std::size_t particles = 0;
   std::size_t emitted = 0;  ///< particles added by emitters at the start of this step
+  bool reordered = false;   ///< particles were reordered in memory (Morton curve) this step
   NeighborCounters neighbors;
   std::uint64_t pairs_within_h = 0;  ///< listed (directed) pairs closer than h this step
   bool audited = false;              ///< SimulationParams::audit was on: `audit` is filled
@@ -41,7 +43,8 @@ struct EmitterState {
 };
 
 /// A running simulation. Each step():
-///   1. emitters add their batch (if due),
+///   1. emitters add their batch (if due); every reorder_period steps the particles are
+///      reordered in memory along a Morton curve (ids are kept) and every list is rebuilt,
 ///   2. the neighbor strategy updates the lists (grid + lists phases),
 ///   3. density and pressure (Eq. 4, EOS), with the Eq. 7 test if the strategy asks for it,
 ///   4. pressure, viscous, gravity and wall accelerations (Eq. 5, 6),
@@ -89,6 +92,10 @@ class Simulation {
   ParticleSet<D, R> particles_;
   std::unique_ptr<NeighborStrategy<D, R>> neighbors_;
   std::unique_ptr<ListAuditor<D, R>> auditor_;
+  MortonOrder<D, R> morton_;
+  std::vector<std::uint32_t> perm_;
+  mutable std::vector<double> partial_;    // per-chunk partial sums (kept: no allocation per step)
+  mutable std::vector<std::uint8_t> bad_;  // per-chunk blow-up flags
   std::vector<EmitterState> emitters_;
   std::int64_t steps_ = 0;
   double speed_limit_ = 0;

@@ -35,7 +35,7 @@ struct Stencil {
   }
 };
 
-/// Writes the neighbors of the point at query position x (sorted position `self`, excluded)
+/// Writes the neighbors of point `self` (at query position x; itself excluded)
 /// to out and returns how many. out must have room for every candidate plus kPad.
 /// The squared distance is computed exactly as norm2(x - x_j) is (same operations, same
 /// order, no fused multiply-add), so lists agree bit for bit with a brute-force search.
@@ -54,7 +54,7 @@ std::uint32_t gather_scalar(const UniformGrid<D, R>& grid, const Stencil<D, R>& 
         d2 += t * t;
       }
       out[m] = sorted[k];
-      m += static_cast<std::uint32_t>((d2 < r2) & (k != self));
+      m += static_cast<std::uint32_t>((d2 < r2) & (sorted[k] != self));
     }
   return m;
 }
@@ -68,6 +68,7 @@ std::uint32_t gather_vector(const UniformGrid<D, double>& grid, const Stencil<D,
   __m512d xv[D];
   for (int d = 0; d < D; ++d) c[d] = grid.sorted_coord(d), xv[d] = _mm512_set1_pd(x[d]);
   const __m512d r2v = _mm512_set1_pd(r2);
+  const __m256i selfv = _mm256_set1_epi32(static_cast<int>(self));
   std::uint32_t m = 0;
   for (int q = 0; q < st.count; ++q) {
     const std::uint32_t e = st.end[q];
@@ -79,11 +80,9 @@ std::uint32_t gather_vector(const UniformGrid<D, double>& grid, const Stencil<D,
         const __m512d t2 = _mm512_sub_pd(xv[2], _mm512_loadu_pd(c[2] + k));
         d2 = _mm512_add_pd(d2, _mm512_mul_pd(t2, t2));
       }
-      unsigned keep = e - k < 8 ? (1u << (e - k)) - 1u : 0xffu;
-      const std::uint32_t off = self - k;
-      if (off < 8) keep &= ~(1u << off);
-      const __mmask8 hit = static_cast<__mmask8>(_mm512_cmp_pd_mask(d2, r2v, _CMP_LT_OQ) & keep);
       const __m256i idx = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(sorted + k));
+      const unsigned keep = (e - k < 8 ? (1u << (e - k)) - 1u : 0xffu) & _mm256_cmpneq_epi32_mask(idx, selfv);
+      const __mmask8 hit = static_cast<__mmask8>(_mm512_cmp_pd_mask(d2, r2v, _CMP_LT_OQ) & keep);
       // Register compress + plain store: the memory form of vpcompressd is slow on some CPUs.
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + m), _mm256_maskz_compress_epi32(hit, idx));
       m += static_cast<std::uint32_t>(__builtin_popcount(hit));
@@ -100,6 +99,7 @@ std::uint32_t gather_vector(const UniformGrid<D, float>& grid, const Stencil<D, 
   __m512 xv[D];
   for (int d = 0; d < D; ++d) c[d] = grid.sorted_coord(d), xv[d] = _mm512_set1_ps(x[d]);
   const __m512 r2v = _mm512_set1_ps(r2);
+  const __m512i selfv = _mm512_set1_epi32(static_cast<int>(self));
   std::uint32_t m = 0;
   for (int q = 0; q < st.count; ++q) {
     const std::uint32_t e = st.end[q];
@@ -111,11 +111,9 @@ std::uint32_t gather_vector(const UniformGrid<D, float>& grid, const Stencil<D, 
         const __m512 t2 = _mm512_sub_ps(xv[2], _mm512_loadu_ps(c[2] + k));
         d2 = _mm512_add_ps(d2, _mm512_mul_ps(t2, t2));
       }
-      unsigned keep = e - k < 16 ? (1u << (e - k)) - 1u : 0xffffu;
-      const std::uint32_t off = self - k;
-      if (off < 16) keep &= ~(1u << off);
-      const __mmask16 hit = static_cast<__mmask16>(_mm512_cmp_ps_mask(d2, r2v, _CMP_LT_OQ) & keep);
       const __m512i idx = _mm512_loadu_si512(sorted + k);
+      const unsigned keep = (e - k < 16 ? (1u << (e - k)) - 1u : 0xffffu) & _mm512_cmpneq_epi32_mask(idx, selfv);
+      const __mmask16 hit = static_cast<__mmask16>(_mm512_cmp_ps_mask(d2, r2v, _CMP_LT_OQ) & keep);
       _mm512_storeu_si512(out + m, _mm512_maskz_compress_epi32(hit, idx));
       m += static_cast<std::uint32_t>(__builtin_popcount(hit));
     }
@@ -161,8 +159,7 @@ void ListBuilder<D, R>::build(const UniformGrid<D, R>& grid, std::span<const Vec
   const R r2 = radius * radius;
   const std::size_t chunks = chunk_count(n);
   out.chunks_.resize(chunks);
-  out.begin_.resize(n);
-  out.count_.resize(n);
+  out.end_.resize(n);
   chunk_entries_.resize(chunks);
 
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
@@ -172,10 +169,9 @@ void ListBuilder<D, R>::build(const UniformGrid<D, R>& grid, std::span<const Vec
     for (std::size_t i = b; i < e; ++i) {
       st.update(grid, grid.cell_of(i));
       ensure_room(buf, used + st.candidates + kRoom);
-      const std::uint32_t m = gather(vector_, grid, st, positions[i], grid.rank(i), r2, buf.data() + used);
-      out.begin_[i] = static_cast<std::uint32_t>(used);
-      out.count_[i] = m;
+      const std::uint32_t m = gather(vector_, grid, st, positions[i], static_cast<std::uint32_t>(i), r2, buf.data() + used);
       used += m;
+      out.end_[i] = static_cast<std::uint32_t>(used);
     }
     chunk_entries_[c] = used;
   });
@@ -192,8 +188,7 @@ void ListBuilder<D, R>::rebuild_some(const UniformGrid<D, R>& grid, std::span<co
   const R r2 = radius * radius;
   const std::size_t chunks = chunk_count(n);
   lists.chunks_.resize(chunks);
-  lists.begin_.resize(n);
-  lists.count_.resize(n);
+  lists.end_.resize(n);
   chunk_entries_.resize(chunks);
 
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
@@ -204,7 +199,7 @@ void ListBuilder<D, R>::rebuild_some(const UniformGrid<D, R>& grid, std::span<co
       if (marked(i))
         any = true;
       else
-        kept += lists.count_[i];
+        kept += lists.of(i).size();
     }
     if (!any) {
       chunk_entries_[c] = kept;
@@ -221,26 +216,28 @@ void ListBuilder<D, R>::rebuild_some(const UniformGrid<D, R>& grid, std::span<co
       if (!marked(i)) continue;
       st.update(grid, grid.cell_of(i));
       ensure_room(fresh, used + st.candidates + kRoom);
-      fresh_count[i - b] = gather(vector_, grid, st, positions[i], grid.rank(i), r2, fresh.data() + used);
+      fresh_count[i - b] = gather(vector_, grid, st, positions[i], static_cast<std::uint32_t>(i), r2, fresh.data() + used);
       used += fresh_count[i - b];
     }
     ensure_room(merged, kept + used + kRoom);
     const std::uint32_t* old = lists.chunks_[c].data();
     const std::uint32_t* next_fresh = fresh.data();
     std::size_t at = 0;
+    std::uint32_t old_end = 0;  // end of list i - 1 before this merge
     for (std::size_t i = b; i < e; ++i) {
+      const std::uint32_t old_begin = old_end;
+      old_end = lists.end_[i];
       std::uint32_t len;
       if (marked(i)) {
         len = fresh_count[i - b];
         std::copy_n(next_fresh, len, merged.data() + at);
         next_fresh += len;
       } else {
-        len = lists.count_[i];
-        std::copy_n(old + lists.begin_[i], len, merged.data() + at);
+        len = old_end - old_begin;
+        std::copy_n(old + old_begin, len, merged.data() + at);
       }
-      lists.begin_[i] = static_cast<std::uint32_t>(at);
-      lists.count_[i] = len;
       at += len;
+      lists.end_[i] = static_cast<std::uint32_t>(at);
     }
     lists.chunks_[c].swap(merged);
     chunk_entries_[c] = at;

@@ -8,7 +8,7 @@ namespace sph {
 
 std::size_t NeighborLists::memory_bytes() const {
   std::size_t bytes = chunks_.capacity() * sizeof(chunks_[0]) +
-                      (begin_.capacity() + count_.capacity()) * sizeof(std::uint32_t);
+                      end_.capacity() * sizeof(std::uint32_t);
   for (const auto& c : chunks_) bytes += c.capacity() * sizeof(std::uint32_t);
   return bytes;
 }
@@ -17,14 +17,12 @@ NeighborLists NeighborLists::from(const std::vector<std::vector<std::uint32_t>>&
   NeighborLists out;
   const std::size_t n = lists.size();
   out.chunks_.resize(chunk_count(n));
-  out.begin_.resize(n);
-  out.count_.resize(n);
+  out.end_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     auto& chunk = out.chunks_[i / kChunkSize];
     SPH_CHECK(chunk.size() + lists[i].size() < (std::size_t{1} << 32), "neighbor list chunk too large");
-    out.begin_[i] = static_cast<std::uint32_t>(chunk.size());
-    out.count_[i] = static_cast<std::uint32_t>(lists[i].size());
     chunk.insert(chunk.end(), lists[i].begin(), lists[i].end());
+    out.end_[i] = static_cast<std::uint32_t>(chunk.size());
     out.entries_ += lists[i].size();
   }
   for (auto& chunk : out.chunks_) chunk.resize(chunk.size() + kPadding, 0);

@@ -27,16 +27,16 @@ class NeighborLists {
   /// vector loops may load whole blocks of indices and mask the lanes past the end.
   static constexpr std::size_t kPadding = 16;
 
-  std::size_t particle_count() const { return count_.size(); }
+  std::size_t particle_count() const { return end_.size(); }
   /// Number of stored (directed) entries: twice the number of pairs for symmetric lists.
   std::size_t entry_count() const { return entries_; }
   std::span<const std::uint32_t> of(std::size_t i) const {
-    return {chunks_[i / kChunkSize].data() + begin_[i], count_[i]};
+    const std::uint32_t begin = i % kChunkSize != 0 ? end_[i - 1] : 0;
+    return {chunks_[i / kChunkSize].data() + begin, end_[i] - begin};
   }
   void clear() {
     chunks_.clear();
-    begin_.clear();
-    count_.clear();
+    end_.clear();
     entries_ = 0;
   }
   /// Bytes of memory held (capacity, not just what is in use).
@@ -53,8 +53,7 @@ class NeighborLists {
   friend class ListBuilder;
 
   std::vector<std::vector<std::uint32_t>> chunks_;  // chunk c: lists of particles [c K, (c+1) K)
-  std::vector<std::uint32_t> begin_;                // start of list i in its chunk's buffer
-  std::vector<std::uint32_t> count_;                // length of list i
+  std::vector<std::uint32_t> end_;  // end of list i in its chunk's buffer (it starts where i - 1's ends)
   std::size_t entries_ = 0;
 };
 

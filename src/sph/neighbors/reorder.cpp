@@ -48,41 +48,63 @@ void MortonOrder<D, R>::compute(std::span<const Vec<D, R>> positions, R cell, st
   Vec<D, R> lo = positions[0];
   for (const auto& x : positions)
     for (int d = 0; d < D; ++d) lo[d] = std::min(lo[d], x[d]);
-  for (int d = 0; d < D; ++d) SPH_CHECK(std::isfinite(lo[d]), "non-finite particle position given to the Morton order");
+  bool finite = true;
+  for (const auto& x : positions) finite = finite && all_finite(x);
+  SPH_CHECK(finite, "non-finite particle position given to the Morton order");
 
   // Keys from cell coordinates; coordinates beyond the key's bits share the last cell (order
   // stays valid, only coarser, for absurdly elongated point sets).
+  Vec<D, R> hi = positions[0];
+  for (const auto& x : positions)
+    for (int d = 0; d < D; ++d) hi[d] = std::max(hi[d], x[d]);
   constexpr std::uint32_t kMaxCoord = D == 3 ? (1u << 21) - 1 : 0xffffffffu;
   const R inv = R(1) / cell;
-  keys_.resize(n);
-  bool finite = true;
+  std::uint32_t top = 0;  // largest cell coordinate
+  for (int d = 0; d < D; ++d) {
+    const R f = (hi[d] - lo[d]) * inv;
+    top = std::max(top, f < R(kMaxCoord) ? static_cast<std::uint32_t>(f) : kMaxCoord);
+  }
+  int bits = 0;
+  while (bits < 32 && (top >> bits) != 0) ++bits;
+  // 32-bit keys whenever they are enough (half the memory and passes of 64-bit ones).
+  if (bits * D <= 32)
+    sort_by_key(positions, lo, inv, kMaxCoord, keys32_, keys32_tmp_, perm);
+  else
+    sort_by_key(positions, lo, inv, kMaxCoord, keys64_, keys64_tmp_, perm);
+}
+
+template <int D, std::floating_point R>
+template <class Key>
+void MortonOrder<D, R>::sort_by_key(std::span<const Vec<D, R>> positions, const Vec<D, R>& lo, R inv,
+                                    std::uint32_t max_coord, std::vector<Key>& keys, std::vector<Key>& keys_tmp,
+                                    std::vector<std::uint32_t>& perm) {
+  const std::size_t n = positions.size();
+  keys.resize(n);
   parallel_for(n, [&](std::size_t i) {
     std::uint32_t c[D];
     for (int d = 0; d < D; ++d) {
       const R f = (positions[i][d] - lo[d]) * inv;
-      c[d] = f < R(kMaxCoord) ? static_cast<std::uint32_t>(f) : kMaxCoord;  // NaN also lands here
+      c[d] = f < R(max_coord) ? static_cast<std::uint32_t>(f) : max_coord;
     }
     if constexpr (D == 2)
-      keys_[i] = morton_key(c[0], c[1]);
+      keys[i] = static_cast<Key>(morton_key(c[0], c[1]));
     else
-      keys_[i] = morton_key(c[0], c[1], c[2]);
+      keys[i] = static_cast<Key>(morton_key(c[0], c[1], c[2]));
   });
-  for (const auto& x : positions) finite = finite && all_finite(x);
-  SPH_CHECK(finite, "non-finite particle position given to the Morton order");
 
   // LSD radix sort of (key, index), 8 bits per pass, only over the bits some key uses.
-  std::uint64_t all = 0;
-  for (std::uint64_t k : keys_) all |= k;
+  Key all = 0;
+  for (Key k : keys) all |= k;
   int passes = 0;
-  while (passes < 8 && (all >> (8 * passes)) != 0) ++passes;
+  while (passes < static_cast<int>(sizeof(Key)) && (static_cast<std::uint64_t>(all) >> (8 * passes)) != 0) ++passes;
   for (std::size_t i = 0; i < n; ++i) perm[i] = static_cast<std::uint32_t>(i);
-  keys_tmp_.resize(n);
+  keys_tmp.resize(n);
   tmp_.resize(n);
   histogram_.resize(256);
   for (int p = 0; p < passes; ++p) {
     const int shift = 8 * p;
     std::fill(histogram_.begin(), histogram_.end(), 0u);
-    for (std::size_t i = 0; i < n; ++i) ++histogram_[(keys_[i] >> shift) & 0xff];
+    for (std::size_t i = 0; i < n; ++i) ++histogram_[(keys[i] >> shift) & 0xff];
     std::uint32_t sum = 0;
     for (auto& h : histogram_) {
       const std::uint32_t c = h;
@@ -90,11 +112,11 @@ void MortonOrder<D, R>::compute(std::span<const Vec<D, R>> positions, R cell, st
       sum += c;
     }
     for (std::size_t i = 0; i < n; ++i) {
-      const std::uint32_t dst = histogram_[(keys_[i] >> shift) & 0xff]++;
-      keys_tmp_[dst] = keys_[i];
+      const std::uint32_t dst = histogram_[(keys[i] >> shift) & 0xff]++;
+      keys_tmp[dst] = keys[i];
       tmp_[dst] = perm[i];
     }
-    keys_.swap(keys_tmp_);
+    keys.swap(keys_tmp);
     perm.swap(tmp_);
   }
 }

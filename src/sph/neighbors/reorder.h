@@ -22,7 +22,12 @@ class MortonOrder {
   void compute(std::span<const Vec<D, R>> positions, R cell, std::vector<std::uint32_t>& perm);
 
  private:
-  std::vector<std::uint64_t> keys_, keys_tmp_;
+  template <class Key>
+  void sort_by_key(std::span<const Vec<D, R>> positions, const Vec<D, R>& lo, R inv, std::uint32_t max_coord,
+                   std::vector<Key>& keys, std::vector<Key>& keys_tmp, std::vector<std::uint32_t>& perm);
+
+  std::vector<std::uint32_t> keys32_, keys32_tmp_;
+  std::vector<std::uint64_t> keys64_, keys64_tmp_;
   std::vector<std::uint32_t> tmp_;
   std::vector<std::uint32_t> histogram_;
 };

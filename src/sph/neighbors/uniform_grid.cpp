@@ -64,12 +64,9 @@ void UniformGrid<D, R>::build(std::span<const V> positions, R radius) {
   for (std::size_t i = 0; i < n; ++i) ++cell_start_[cell_of_[i] + 1];
   for (std::size_t c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
   sorted_.resize(n + kPad);
-  rank_.resize(n);
   // Scatter using a running cursor per cell (cell_start_ shifted by one, then restored).
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t k = cell_start_[cell_of_[i]]++;
-    sorted_[k] = static_cast<std::uint32_t>(i);
-    rank_[i] = k;
+    sorted_[cell_start_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
   }
   for (std::size_t c = cells; c > 0; --c) cell_start_[c] = cell_start_[c - 1];
   cell_start_[0] = 0;

@@ -31,8 +31,6 @@ class UniformGrid {
 
   /// Cell (linear index) of point i, as built.
   std::uint32_t cell_of(std::size_t i) const { return cell_of_[i]; }
-  /// Position of point i in the cell-sorted order.
-  std::uint32_t rank(std::size_t i) const { return rank_[i]; }
   /// Point indices in cell-sorted order (stable within a cell), followed by kPad zeros.
   const std::uint32_t* sorted() const { return sorted_.data(); }
   /// Coordinate d of the points in cell-sorted order, followed by kPad zeros: candidates of
@@ -132,7 +130,6 @@ class UniformGrid {
   std::vector<std::uint32_t> cell_start_;  // size cells + 1
   std::vector<std::uint32_t> sorted_;      // point indices sorted by cell (stable), + kPad
   std::vector<std::uint32_t> cell_of_;     // cell of each point
-  std::vector<std::uint32_t> rank_;        // sorted position of each point
   std::array<std::vector<R>, D> coords_;   // coordinates in sorted order, + kPad
 };
 

@@ -45,13 +45,13 @@ struct Pack<float> {
   static Pack gather(const float* base, const std::uint32_t* idx, int offset) {
     __m512i i = _mm512_loadu_si512(idx);
     if constexpr (kStride != 1) i = _mm512_mullo_epi32(i, _mm512_set1_epi32(kStride));
-    return {_mm512_i32gather_ps(i, base + offset, 4)};
+    return {_mm512_mask_i32gather_ps(_mm512_setzero_ps(), 0xffff, i, base + offset, 4)};  // (a defined source: no warning)
   }
   friend Pack operator+(Pack a, Pack b) { return {_mm512_add_ps(a.v, b.v)}; }
   friend Pack operator-(Pack a, Pack b) { return {_mm512_sub_ps(a.v, b.v)}; }
   friend Pack operator*(Pack a, Pack b) { return {_mm512_mul_ps(a.v, b.v)}; }
   friend Pack operator/(Pack a, Pack b) { return {_mm512_div_ps(a.v, b.v)}; }
-  friend Pack sqrt(Pack a) { return {_mm512_sqrt_ps(a.v)}; }
+  friend Pack sqrt(Pack a) { return {_mm512_maskz_sqrt_ps(0xffff, a.v)}; }
   friend Mask operator<(Pack a, Pack b) { return _mm512_cmp_ps_mask(a.v, b.v, _CMP_LT_OQ); }
   friend Mask operator>(Pack a, Pack b) { return _mm512_cmp_ps_mask(a.v, b.v, _CMP_GT_OQ); }
   /// Lanes in m from a, the others from b.
@@ -67,13 +67,13 @@ struct Pack<double> {
   static Pack gather(const double* base, const std::uint32_t* idx, int offset) {
     __m256i i = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(idx));
     if constexpr (kStride != 1) i = _mm256_mullo_epi32(i, _mm256_set1_epi32(kStride));
-    return {_mm512_i32gather_pd(i, base + offset, 8)};
+    return {_mm512_mask_i32gather_pd(_mm512_setzero_pd(), 0xff, i, base + offset, 8)};
   }
   friend Pack operator+(Pack a, Pack b) { return {_mm512_add_pd(a.v, b.v)}; }
   friend Pack operator-(Pack a, Pack b) { return {_mm512_sub_pd(a.v, b.v)}; }
   friend Pack operator*(Pack a, Pack b) { return {_mm512_mul_pd(a.v, b.v)}; }
   friend Pack operator/(Pack a, Pack b) { return {_mm512_div_pd(a.v, b.v)}; }
-  friend Pack sqrt(Pack a) { return {_mm512_sqrt_pd(a.v)}; }
+  friend Pack sqrt(Pack a) { return {_mm512_maskz_sqrt_pd(0xff, a.v)}; }
   friend Mask operator<(Pack a, Pack b) { return _mm512_cmp_pd_mask(a.v, b.v, _CMP_LT_OQ); }
   friend Mask operator>(Pack a, Pack b) { return _mm512_cmp_pd_mask(a.v, b.v, _CMP_GT_OQ); }
   friend Pack select(Mask m, Pack a, Pack b) { return {_mm512_mask_blend_pd(static_cast<__mmask8>(m), b.v, a.v)}; }

@@ -201,9 +201,17 @@ double Simulation<D, R>::kinetic_energy() const {
 
 template <int D, std::floating_point R>
 double Simulation<D, R>::max_speed() const {
-  R m = 0;
-  for (const auto& v : particles_.velocity) m = std::max(m, norm2(v));
-  return std::sqrt(static_cast<double>(m));
+  // Per-chunk maxima (a max is exact: the same for any thread count).
+  const std::size_t n = particles_.size();
+  partial_.assign(chunk_count(n), 0.0);
+  parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
+    R m = 0;
+    for (std::size_t i = b; i < e; ++i) m = std::max(m, norm2(particles_.velocity[i]));
+    partial_[c] = static_cast<double>(m);
+  });
+  double m = 0;
+  for (double p : partial_) m = std::max(m, p);
+  return std::sqrt(m);
 }
 
 template <int D, std::floating_point R>

@@ -84,6 +84,8 @@ std::function<int()> add_bench_command(CLI::App& app) {
   auto opt = std::make_shared<BenchCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "bench", "Benchmark suites: neighbor search, simulation steps per mode, the paper's tank; tables and CSV/JSON");
+  // A flag given twice takes its last value, so scripts can append overrides to their defaults.
+  cmd->option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   cmd->add_option("--suite", opt->suites, "Comma-separated suites: neighbors, steps, tank, or all")->default_str("all");
   cmd->add_option("--size", opt->size,
                   "small (8k particles, few steps: CI), medium (adds 64k), large (adds 512k), full (adds the 1M "

@@ -2,6 +2,7 @@
 // message naming the flag and what is accepted, and write nothing.
 
 #include <filesystem>
+#include <fstream>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -28,6 +29,10 @@ class BenchCli : public ::testing::Test {
 
 TEST_F(BenchCli, SmallNeighborsRunWritesItsFiles) {
   const fs::path out = tmp_ / "bench";
+  // An earlier run's files for other suites must not pass for this run's.
+  fs::create_directories(out);
+  std::ofstream(out / "steps.csv") << "old\n";
+  std::ofstream(out / "tank.csv") << "old\n";
   const auto r = sph({"bench", "--size", "small", "--suite", "neighbors", "--threads", "1", "-o", out.string()});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::is_regular_file(out / "bench.json"));

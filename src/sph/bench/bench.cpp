@@ -224,7 +224,9 @@ void prepare_bench_directory(const std::filesystem::path& dir) {
     throw Error("exists and is not a directory; expected a directory for the benchmark results", dir.string());
   fs::create_directories(dir, ec);
   if (ec) throw Error("cannot create the output directory: " + ec.message(), dir.string());
-  AtomicFile probe(dir / ".write-test");  // throws sph::Error naming the path if not writable
+  { AtomicFile probe(dir / ".write-test"); }  // throws sph::Error naming the path if not writable
+  // An earlier run's files would sit next to this run's as if they belonged to it.
+  for (const char* name : {"bench.json", "neighbors.csv", "steps.csv", "tank.csv"}) fs::remove(dir / name, ec);
 }
 
 BenchResult run_benchmarks(const BenchOptions& options, const std::filesystem::path& dir, const BenchOutput& out) {

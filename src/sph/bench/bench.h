@@ -167,8 +167,8 @@ void run_tank_suite(const BenchOptions& options, BenchResult& result, const Benc
 /// Checks options (suite names, thread counts, repeats...); throws sph::Error naming the option.
 void validate_bench_options(const BenchOptions& options);
 
-/// Creates `dir` if needed and checks that files can be written there; throws sph::Error
-/// naming the path otherwise.
+/// Creates `dir` if needed, checks that files can be written there (throws sph::Error naming
+/// the path otherwise) and removes the files an earlier benchmark left there.
 void prepare_bench_directory(const std::filesystem::path& dir);
 
 /// Runs every suite of options.suites in order, writing the files (write_bench_files) after each

@@ -3,6 +3,7 @@
 #include <sys/utsname.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <ctime>
 #include <fstream>
 #include <sstream>
@@ -86,6 +87,9 @@ MachineInfo machine_info() {
   char buf[32];
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
   m.date = buf;
+  for (const char* name : {"OMP_WAIT_POLICY", "GOMP_SPINCOUNT", "OMP_PROC_BIND", "OMP_PLACES", "OMP_NUM_THREADS"})
+    if (const char* v = std::getenv(name))
+      m.openmp_env += fmt::format("{}{}={}", m.openmp_env.empty() ? "" : " ", name, v);
   std::ifstream loadavg("/proc/loadavg");
   if (!(loadavg >> m.load_average)) m.load_average = -1;
   return m;

@@ -22,6 +22,10 @@ struct MachineInfo {
   /// 1-minute load average when machine_info() was called (-1 if unknown): on a shared
   /// machine, a load above the core count means the timings are disturbed.
   double load_average = -1;
+  /// The OpenMP environment variables that change timings (OMP_WAIT_POLICY, GOMP_SPINCOUNT,
+  /// OMP_PROC_BIND, OMP_PLACES, OMP_NUM_THREADS) that are set, "NAME=value" separated by
+  /// spaces; empty when none is (the runtime's defaults).
+  std::string openmp_env;
 };
 
 MachineInfo machine_info();

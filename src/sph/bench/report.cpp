@@ -115,7 +115,8 @@ json machine_json(const MachineInfo& m) {
           {"git_commit", m.git_commit},
           {"sph_version", m.version},
           {"date", m.date},
-          {"load_average", m.load_average}};
+          {"load_average", m.load_average},
+          {"openmp_env", m.openmp_env}};
 }
 
 json options_json(const BenchResult& r) {

@@ -130,7 +130,8 @@ TEST(FastLists, RebuildSomeLeavesUnmarkedChunksUntouchedAndAppends) {
   EXPECT_EQ(lists.of(0).data(), chunk0) << "an unmarked chunk was copied";
   const NeighborLists exact = brute_force_lists<3, double>(x, r);
   for (std::size_t i : {std::size_t{2100}, x.size() - 1, x.size() - 100}) {
-    std::vector<std::uint32_t> got(lists.of(i).begin(), lists.of(i).end()), want(exact.of(i).begin(), exact.of(i).end());
+    std::vector<std::uint32_t> got(lists.of(i).begin(), lists.of(i).end()),
+        want(exact.of(i).begin(), exact.of(i).end());
     std::sort(got.begin(), got.end());
     EXPECT_EQ(got, want) << "particle " << i;
   }

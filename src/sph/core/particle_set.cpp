@@ -1,6 +1,6 @@
-#include <algorithm>
 #include <sph/core/error.h>
 #include <sph/core/particle_set.h>
+#include <algorithm>
 
 namespace sph {
 

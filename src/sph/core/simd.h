@@ -45,7 +45,8 @@ struct Pack<float> {
   static Pack gather(const float* base, const std::uint32_t* idx, int offset) {
     __m512i i = _mm512_loadu_si512(idx);
     if constexpr (kStride != 1) i = _mm512_mullo_epi32(i, _mm512_set1_epi32(kStride));
-    return {_mm512_mask_i32gather_ps(_mm512_setzero_ps(), 0xffff, i, base + offset, 4)};  // (a defined source: no warning)
+    return {
+        _mm512_mask_i32gather_ps(_mm512_setzero_ps(), 0xffff, i, base + offset, 4)};  // (a defined source: no warning)
   }
   friend Pack operator+(Pack a, Pack b) { return {_mm512_add_ps(a.v, b.v)}; }
   friend Pack operator-(Pack a, Pack b) { return {_mm512_sub_ps(a.v, b.v)}; }
@@ -92,14 +93,15 @@ struct Pack {
   template <int kStride>
   static Pack gather(const R* base, const std::uint32_t* idx, int offset) {
     Pack p;
-    for (int l = 0; l < W; ++l) p.v[l] = base[static_cast<std::size_t>(idx[l]) * kStride + static_cast<std::size_t>(offset)];
+    for (int l = 0; l < W; ++l)
+      p.v[l] = base[static_cast<std::size_t>(idx[l]) * kStride + static_cast<std::size_t>(offset)];
     return p;
   }
-#define SPH_PACK_BINARY(op)                                   \
-  friend Pack operator op(const Pack& a, const Pack& b) {     \
-    Pack p;                                                   \
-    for (int l = 0; l < W; ++l) p.v[l] = a.v[l] op b.v[l];    \
-    return p;                                                 \
+#define SPH_PACK_BINARY(op)                                \
+  friend Pack operator op(const Pack& a, const Pack& b) {  \
+    Pack p;                                                \
+    for (int l = 0; l < W; ++l) p.v[l] = a.v[l] op b.v[l]; \
+    return p;                                              \
   }
   SPH_PACK_BINARY(+)
   SPH_PACK_BINARY(-)

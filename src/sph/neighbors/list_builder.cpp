@@ -61,8 +61,8 @@ std::uint32_t gather_scalar(const UniformGrid<D, R>& grid, const Stencil<D, R>& 
 
 #if SPH_HAVE_AVX512
 template <int D>
-std::uint32_t gather_vector(const UniformGrid<D, double>& grid, const Stencil<D, double>& st,
-                            const Vec<D, double>& x, std::uint32_t self, double r2, std::uint32_t* out) {
+std::uint32_t gather_vector(const UniformGrid<D, double>& grid, const Stencil<D, double>& st, const Vec<D, double>& x,
+                            std::uint32_t self, double r2, std::uint32_t* out) {
   const std::uint32_t* sorted = grid.sorted();
   const double* c[D];
   __m512d xv[D];
@@ -169,7 +169,8 @@ void ListBuilder<D, R>::build(const UniformGrid<D, R>& grid, std::span<const Vec
     for (std::size_t i = b; i < e; ++i) {
       st.update(grid, grid.cell_of(i));
       ensure_room(buf, used + st.candidates + kRoom);
-      const std::uint32_t m = gather(vector_, grid, st, positions[i], static_cast<std::uint32_t>(i), r2, buf.data() + used);
+      const std::uint32_t m =
+          gather(vector_, grid, st, positions[i], static_cast<std::uint32_t>(i), r2, buf.data() + used);
       used += m;
       out.end_[i] = static_cast<std::uint32_t>(used);
     }
@@ -216,7 +217,8 @@ void ListBuilder<D, R>::rebuild_some(const UniformGrid<D, R>& grid, std::span<co
       if (!marked(i)) continue;
       st.update(grid, grid.cell_of(i));
       ensure_room(fresh, used + st.candidates + kRoom);
-      fresh_count[i - b] = gather(vector_, grid, st, positions[i], static_cast<std::uint32_t>(i), r2, fresh.data() + used);
+      fresh_count[i - b] =
+          gather(vector_, grid, st, positions[i], static_cast<std::uint32_t>(i), r2, fresh.data() + used);
       used += fresh_count[i - b];
     }
     ensure_room(merged, kept + used + kRoom);

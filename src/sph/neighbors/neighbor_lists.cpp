@@ -7,8 +7,7 @@
 namespace sph {
 
 std::size_t NeighborLists::memory_bytes() const {
-  std::size_t bytes = chunks_.capacity() * sizeof(chunks_[0]) +
-                      end_.capacity() * sizeof(std::uint32_t);
+  std::size_t bytes = chunks_.capacity() * sizeof(chunks_[0]) + end_.capacity() * sizeof(std::uint32_t);
   for (const auto& c : chunks_) bytes += c.capacity() * sizeof(std::uint32_t);
   return bytes;
 }

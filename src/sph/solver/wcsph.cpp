@@ -99,8 +99,8 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
                 const Vec<D, R>& gravity) {
   using P = simd::Pack<R>;
   constexpr int W = simd::kLanes<R>;
-  const P hv = P::set1(h), h2v = P::set1(h * h), zero = P::set1(R(0)), one = P::set1(R(1)),
-          minus_one = P::set1(R(-1)), half = P::set1(R(0.5));
+  const P hv = P::set1(h), h2v = P::set1(h * h), zero = P::set1(R(0)), one = P::set1(R(1)), minus_one = P::set1(R(-1)),
+          half = P::set1(R(0.5));
   const P grad_c = P::set1(R(-3) * SpikyKernel<D, R>(h).norm());
   const R lap_c = ViscosityKernel<D, R>(h).laplacian_norm();
   const R mu = static_cast<R>(fluid.viscosity);
@@ -111,8 +111,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
   const R* mass = ps.mass.data();
   parallel_for(ps.size(), [&](std::size_t i) {
     P xi[D], vi[D], acc[D];
-    for (int d = 0; d < D; ++d)
-      xi[d] = P::set1(ps.position[i][d]), vi[d] = P::set1(ps.velocity[i][d]), acc[d] = zero;
+    for (int d = 0; d < D; ++d) xi[d] = P::set1(ps.position[i][d]), vi[d] = P::set1(ps.velocity[i][d]), acc[d] = zero;
     const R inv_rhoi = R(1) / rho[i];
     // Pressure term P_ij, symmetric in i and j, so that each pair's contributions are equal
     // and opposite: the paper's (p_i + p_j) / (2 rho_i rho_j), or p_i / rho_i^2 + p_j / rho_j^2.
@@ -129,7 +128,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
         rij[d] = xi[d] - P::template gather<D>(pos, idx + k0, d);
         r2 = r2 + rij[d] * rij[d];
       }
-      const Mask near = valid & (r2 < h2v);  // inside the support
+      const Mask near = valid & (r2 < h2v);   // inside the support
       const Mask apart = near & (r2 > zero);  // and not coincident (gradient defined)
       const P r = sqrt(select(near, r2, h2v));
       const P dh = hv - r;

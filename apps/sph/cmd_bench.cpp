@@ -62,8 +62,11 @@ int bench(const BenchCliOptions& cli) {
   if (!cli.no_progress) out.progress = [](const std::string& text) { fmt::print(stderr, "sph: {}\n", text); };
 
   const std::vector<int> threads = bench_threads(opt);
-  fmt::print(stderr, "sph: bench {} (size {}, threads {}, repeats {}) -> {}\n", fmt::join(opt.suites, ","),
-             to_string(opt.size), fmt::join(threads, ","), opt.repeats, dir.string());
+  const std::string size = opt.particles > 0
+                               ? fmt::format("size {}, steps suite {} particles", to_string(opt.size), opt.particles)
+                               : fmt::format("size {}", to_string(opt.size));
+  fmt::print(stderr, "sph: bench {} ({}, threads {}, repeats {}) -> {}\n", fmt::join(opt.suites, ","), size,
+             fmt::join(threads, ","), opt.repeats, dir.string());
   Stopwatch wall;
   try {
     run_benchmarks(opt, dir, out);

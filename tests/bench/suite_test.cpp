@@ -156,8 +156,9 @@ TEST_F(SmallSuites, NeighborsPerParticleFollowTheLatticeGeometry) {
   // Both orders and both precisions see the same points, hence the same counts.
   for (const NeighborsRow& a : result_->neighbors)
     for (const NeighborsRow& b : result_->neighbors)
-      if (a.radius_dx == b.radius_dx && a.phase == b.phase)
+      if (a.radius_dx == b.radius_dx && a.phase == b.phase) {
         EXPECT_NEAR(a.neighbors_per_particle, b.neighbors_per_particle, 0.01);
+      }
 }
 
 TEST_F(SmallSuites, StepsResultsHaveTimingsThroughputAndMemory) {
@@ -179,7 +180,9 @@ TEST_F(SmallSuites, StepsResultsHaveTimingsThroughputAndMemory) {
     EXPECT_GT(mem["baseline_rss_bytes"].get<std::int64_t>(), 0);
     // Positions, velocities, densities and lists alone take over 100 bytes per particle.
     EXPECT_GT(mem["bytes_per_particle"].get<double>(), 0);
-    if (mem["peak_reset"].get<bool>()) EXPECT_GT(mem["bytes_per_particle"].get<double>(), 100);
+    if (mem["peak_reset"].get<bool>()) {
+      EXPECT_GT(mem["bytes_per_particle"].get<double>(), 100);
+    }
   }
   const json& scaling = (*doc_)["scaling"];
   ASSERT_EQ(scaling.size(), res.size());

@@ -51,7 +51,7 @@ class NeighborStrategy {
   /// Counters of the last update().
   virtual const NeighborCounters& counters() const = 0;
 
-  /// Flags, one per particle, that the solver's density pass sets for both particles of every
+  /// Flags, one per particle, that the solver's force pass sets for both particles of every
   /// listed pair whose predicted distance |x_i - x_j + dt (u_i - u_j)| exceeds h (paper
   /// Eq. 7). The strategy reads and clears them in its next update(). Empty for strategies
   /// that do not ask for the test (the solver then skips it).

@@ -136,9 +136,10 @@ const StepInfo& Simulation<D, R>::step() {
 
   Stopwatch watch;
   info.pairs_within_h =
-      compute_density_pressure(particles_, lists, h, params_.fluid, neighbors_->pair_exit_flags(), dt);
+      compute_density_pressure(particles_, lists, h, params_.fluid);
   info.seconds.density = watch.lap();
-  compute_fluid_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity));
+  compute_fluid_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity),
+                              neighbors_->pair_exit_flags(), dt);
   add_wall_accelerations(particles_, params_.container, params_.obstacles, static_cast<R>(params_.particle_radius),
                          params_.walls);
   info.seconds.forces = watch.lap();

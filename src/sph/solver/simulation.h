@@ -46,8 +46,9 @@ struct EmitterState {
 ///   1. emitters add their batch (if due); every reorder_period steps the particles are
 ///      reordered in memory along a Morton curve (ids are kept) and every list is rebuilt,
 ///   2. the neighbor strategy updates the lists (grid + lists phases),
-///   3. density and pressure (Eq. 4, EOS), with the Eq. 7 test if the strategy asks for it,
-///   4. pressure, viscous, gravity and wall accelerations (Eq. 5, 6),
+///   3. density and pressure (Eq. 4, EOS),
+///   4. pressure, viscous, gravity and wall accelerations (Eq. 5, 6), with the Eq. 7 test if
+///      the strategy asks for it (the force pass gathers every neighbor's velocity anyway),
 ///   5. symplectic Euler integration, then a check that every value is finite.
 template <int D, std::floating_point R>
 class Simulation {

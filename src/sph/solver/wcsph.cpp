@@ -27,9 +27,9 @@ const R* flat(const std::vector<Vec<D, R>>& v) {
 /// end. Lanes past the end of a list load some valid index (NeighborLists::kPadding) and are
 /// masked out. The result is the same for any thread count and with or without AVX-512.
 
-template <bool kExitTest, int D, std::floating_point R>
+template <int D, std::floating_point R>
 std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                           std::span<std::uint8_t> flags, R dt, std::vector<std::uint64_t>& within) {
+                           std::vector<std::uint64_t>& within) {
   using P = simd::Pack<R>;
   constexpr int W = simd::kLanes<R>;
   const Poly6Kernel<D, R> poly6(h);
@@ -39,22 +39,17 @@ std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
   const R k = static_cast<R>(fluid.stiffness);
   const bool clamp = fluid.negative_pressure == NegativePressure::Clamp;
   const R* pos = flat(ps.position);
-  const R* vel = flat(ps.velocity);
   const R* mass = ps.mass.data();
-  const P h2v = P::set1(h2), normv = P::set1(poly6.norm()), zero = P::set1(R(0)), dtv = P::set1(dt);
-  const auto set_flag = [&](std::size_t q) {
-    std::atomic_ref<std::uint8_t>(flags[q]).store(1, std::memory_order_relaxed);
-  };
+  const P h2v = P::set1(h2), normv = P::set1(poly6.norm()), zero = P::set1(R(0));
   within.assign(chunk_count(ps.size()), 0);
   parallel_chunks(ps.size(), [&](std::size_t c, std::size_t b, std::size_t e) {
     std::uint64_t count = 0;
     for (std::size_t i = b; i < e; ++i) {
-      P xi[D], vi[D];
-      for (int d = 0; d < D; ++d) xi[d] = P::set1(ps.position[i][d]), vi[d] = P::set1(ps.velocity[i][d]);
+      P xi[D];
+      for (int d = 0; d < D; ++d) xi[d] = P::set1(ps.position[i][d]);
       const auto nb = lists.of(i);
       const std::uint32_t* idx = nb.data();
       P sum = zero;
-      bool flag_i = false;
       for (std::size_t k0 = 0; k0 < nb.size(); k0 += W) {
         const Mask valid = simd::first_lanes<R>(nb.size() - k0);
         P rij[D], r2 = zero;
@@ -67,21 +62,7 @@ std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
         // Paper Eq. 4: m_j W_poly6 = m_j C (h^2 - r^2)^3 inside the support.
         sum = sum + select(in, P::template gather<1>(mass, idx + k0, 0) * (normv * dd * dd * dd), zero);
         count += static_cast<std::uint64_t>(__builtin_popcount(in));
-        if constexpr (kExitTest) {
-          // Paper Eq. 7: the pair's distance after the step, predicted with today's velocities.
-          P q2 = zero;
-          for (int d = 0; d < D; ++d) {
-            const P t = rij[d] + (vi[d] - P::template gather<D>(vel, idx + k0, d)) * dtv;
-            q2 = q2 + t * t;
-          }
-          for (Mask out = valid & (q2 > h2v); out != 0; out &= out - 1) {
-            flag_i = true;
-            set_flag(idx[k0 + static_cast<std::size_t>(__builtin_ctz(out))]);
-          }
-        }
       }
-      if constexpr (kExitTest)
-        if (flag_i) set_flag(i);
       const R rho = mass[i] * w0 + simd::sum_lanes(sum);
       ps.density[i] = rho;
       const R p = k * (rho - rho0);
@@ -94,9 +75,9 @@ std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
   return total;
 }
 
-template <bool kPaper, int D, std::floating_point R>
+template <bool kPaper, bool kExitTest, int D, std::floating_point R>
 void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                const Vec<D, R>& gravity) {
+                const Vec<D, R>& gravity, std::span<std::uint8_t> flags, R dt) {
   using P = simd::Pack<R>;
   constexpr int W = simd::kLanes<R>;
   const P hv = P::set1(h), h2v = P::set1(h * h), zero = P::set1(R(0)), one = P::set1(R(1)), minus_one = P::set1(R(-1)),
@@ -109,8 +90,13 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
   const R* rho = ps.density.data();
   const R* prs = ps.pressure.data();
   const R* mass = ps.mass.data();
+  const P dtv = P::set1(dt);
+  const auto set_flag = [&](std::size_t q) {
+    std::atomic_ref<std::uint8_t>(flags[q]).store(1, std::memory_order_relaxed);
+  };
   parallel_for(ps.size(), [&](std::size_t i) {
     P xi[D], vi[D], acc[D];
+    bool flag_i = false;
     for (int d = 0; d < D; ++d) xi[d] = P::set1(ps.position[i][d]), vi[d] = P::set1(ps.velocity[i][d]), acc[d] = zero;
     const R inv_rhoi = R(1) / rho[i];
     // Pressure term P_ij, symmetric in i and j, so that each pair's contributions are equal
@@ -144,9 +130,23 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
       // term mu m_j (v_j - v_i) C_lap (h - r) / (rho_i rho_j) (Eq. 6).
       const P fp = select(apart, (grad_c * dh * dh / select(apart, r, one)) * (minus_one * mj * pij), zero);
       const P fv = select(near, visc_i * mj * inv_rhoj * dh, zero);
-      for (int d = 0; d < D; ++d)
-        acc[d] = acc[d] + (rij[d] * fp + (P::template gather<D>(vel, idx + k0, d) - vi[d]) * fv);
+      P q2 = zero;  // Eq. 7: squared pair distance after the step, predicted with today's velocities
+      for (int d = 0; d < D; ++d) {
+        const P vj = P::template gather<D>(vel, idx + k0, d);
+        acc[d] = acc[d] + (rij[d] * fp + (vj - vi[d]) * fv);
+        if constexpr (kExitTest) {
+          const P t = rij[d] + (vi[d] - vj) * dtv;
+          q2 = q2 + t * t;
+        }
+      }
+      if constexpr (kExitTest)
+        for (Mask out = valid & (q2 > h2v); out != 0; out &= out - 1) {
+          flag_i = true;
+          set_flag(idx[k0 + static_cast<std::size_t>(__builtin_ctz(out))]);
+        }
     }
+    if constexpr (kExitTest)
+      if (flag_i) set_flag(i);
     Vec<D, R> a = gravity;
     for (int d = 0; d < D; ++d) a[d] += simd::sum_lanes(acc[d]);
     ps.acceleration[i] = a;
@@ -156,21 +156,28 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
 }  // namespace
 
 template <int D, std::floating_point R>
-std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                                       std::span<std::uint8_t> exit_flags, R dt) {
+std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h,
+                                       const FluidParams& fluid) {
   thread_local std::vector<std::uint64_t> within;  // per-chunk counts, kept between steps
-  if (exit_flags.empty()) return density_pass<false>(ps, lists, h, fluid, exit_flags, dt, within);
-  SPH_CHECK(exit_flags.size() == ps.size(), "one exit flag per particle");
-  return density_pass<true>(ps, lists, h, fluid, exit_flags, dt, within);
+  return density_pass(ps, lists, h, fluid, within);
 }
 
 template <int D, std::floating_point R>
 void compute_fluid_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                                 const Vec<D, R>& gravity) {
-  if (fluid.pressure_force == PressureForce::Paper)
-    force_pass<true>(ps, lists, h, fluid, gravity);
-  else
-    force_pass<false>(ps, lists, h, fluid, gravity);
+                                 const Vec<D, R>& gravity, std::span<std::uint8_t> exit_flags, R dt) {
+  SPH_CHECK(exit_flags.empty() || exit_flags.size() == ps.size(), "one exit flag per particle");
+  const bool paper = fluid.pressure_force == PressureForce::Paper;
+  if (exit_flags.empty()) {
+    if (paper)
+      force_pass<true, false>(ps, lists, h, fluid, gravity, exit_flags, dt);
+    else
+      force_pass<false, false>(ps, lists, h, fluid, gravity, exit_flags, dt);
+  } else {
+    if (paper)
+      force_pass<true, true>(ps, lists, h, fluid, gravity, exit_flags, dt);
+    else
+      force_pass<false, true>(ps, lists, h, fluid, gravity, exit_flags, dt);
+  }
 }
 
 namespace {
@@ -249,9 +256,9 @@ double lattice_mass(double rest_density, double spacing, double h) {
 
 #define SPH_INSTANTIATE(D, R)                                                                                      \
   template std::uint64_t compute_density_pressure<D, R>(ParticleSet<D, R>&, const NeighborLists&, R,               \
-                                                        const FluidParams&, std::span<std::uint8_t>, R);           \
+                                                        const FluidParams&);                                       \
   template void compute_fluid_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&, \
-                                                  const Vec<D, R>&);                                               \
+                                                  const Vec<D, R>&, std::span<std::uint8_t>, R);                   \
   template void add_wall_accelerations<D, R>(ParticleSet<D, R>&, const Box<D>&, const std::vector<Box<D>>&, R,     \
                                              const WallParams&);                                                   \
   template void integrate_symplectic_euler<D, R>(ParticleSet<D, R>&, R);

@@ -11,15 +11,9 @@ namespace sph {
 /// p_i = k (rho_i - rho0), clamped at 0 when negative pressure is NegativePressure::Clamp.
 /// Listed pairs at or beyond h contribute nothing.
 ///
-/// If `exit_flags` is not empty (one per particle), the same pass also evaluates paper Eq. 7
-/// for every listed pair, |x_i - x_j + dt (u_i - u_j)|^2 > h^2, and sets exit_flags[i] and
-/// exit_flags[j] to 1 when it holds (flags are only ever set, never cleared, so concurrent
-/// setting is race-free and the result is the same for any thread count).
-///
 /// Returns the number of listed (directed) pairs closer than h.
 template <int D, std::floating_point R>
-std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                                       std::span<std::uint8_t> exit_flags = {}, R dt = 0);
+std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid);
 
 /// Accelerations from pressure (Eq. 5, spiky gradient), viscosity (Eq. 6 with (v_j - v_i),
 /// viscosity-kernel Laplacian) and gravity:
@@ -28,9 +22,15 @@ std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborList
 /// divided by rho_i) or p_i / rho_i^2 + p_j / rho_j^2 (PressureForce::Symmetric).
 /// Every pair term is antisymmetric (m_i a_i = -m_j a_j), so total momentum is conserved when
 /// lists are symmetric.
+///
+/// If `exit_flags` is not empty (one per particle), the same pass also evaluates paper Eq. 7
+/// for every listed pair, |x_i - x_j + dt (u_i - u_j)|^2 > h^2, and sets exit_flags[i] and
+/// exit_flags[j] to 1 when it holds (flags are only ever set, never cleared, so concurrent
+/// setting is race-free and the result is the same for any thread count). This pass gathers
+/// every neighbor's position and velocity anyway, so the test costs a few operations per pair.
 template <int D, std::floating_point R>
 void compute_fluid_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                                 const Vec<D, R>& gravity);
+                                 const Vec<D, R>& gravity, std::span<std::uint8_t> exit_flags = {}, R dt = 0);
 
 /// Adds the damped penalty accelerations of the container walls and of the obstacles.
 /// A particle interacts with a wall plane when closer than `particle_radius` to it.

@@ -126,6 +126,29 @@ TEST(Reorder, DoesNotChangeThePhysicsBeyondRoundOff) {
   EXPECT_NEAR(a.kinetic_energy(), b.kinetic_energy(), 1e-9 * a.kinetic_energy());
 }
 
+TEST(FusedPasses, AccelerationsEqualFluidThenWallsBitForBit) {
+  // Simulation::step runs forces and walls in one pass; it must give the two calls' values.
+  auto sim = dam_break<double>(8, NeighborMode::Standard, 0);
+  for (int s = 0; s < 30; ++s) sim.step();  // particles now touch the floor and the left wall
+  ParticleSet<3, double> a = sim.particles(), b = sim.particles();
+  SimulationParams<3> p = sim.params();
+  p.obstacles.push_back({{{0.05, 0.0, 0.0}}, {{0.1, 0.05, 0.16}}});  // and an obstacle among them
+  const double h = p.kernel_radius;
+  const NeighborLists& lists = sim.neighbors().lists();
+  std::vector<std::uint8_t> fa(a.size(), 0), fb(b.size(), 0);
+  compute_density_pressure<3, double>(a, lists, h, p.fluid);
+  compute_density_pressure<3, double>(b, lists, h, p.fluid);
+  compute_fluid_accelerations<3, double>(a, lists, h, p.fluid, p.gravity, fa, p.time_step);
+  add_wall_accelerations<3, double>(a, p.container, p.obstacles, p.particle_radius, p.walls);
+  const WallContact<3, double> walls(p.container, p.obstacles, p.particle_radius, p.walls);
+  compute_accelerations<3, double>(b, lists, h, p.fluid, p.gravity, walls, fb, p.time_step);
+  EXPECT_TRUE(a.acceleration == b.acceleration);
+  EXPECT_EQ(fa, fb);
+  std::size_t touching = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) touching += norm2(walls(a.position[i], a.velocity[i])) > 0 ? 1 : 0;
+  EXPECT_GT(touching, 10u) << "the walls must be part of the comparison";
+}
+
 TEST(ParticleSetPermute, RejectsARepeatedIndex) {
   ParticleSet<2, double> ps;
   for (int i = 0; i < 3; ++i) ps.add(Vec<2, double>::filled(i), {}, 1.0);

@@ -135,17 +135,16 @@ const StepInfo& Simulation<D, R>::step() {
   }
 
   Stopwatch watch;
-  info.pairs_within_h =
-      compute_density_pressure(particles_, lists, h, params_.fluid);
+  info.pairs_within_h = compute_density_pressure(particles_, lists, h, params_.fluid);
   info.seconds.density = watch.lap();
-  compute_fluid_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity),
-                              neighbors_->pair_exit_flags(), dt);
-  add_wall_accelerations(particles_, params_.container, params_.obstacles, static_cast<R>(params_.particle_radius),
-                         params_.walls);
+  // Fluid forces and walls in one pass (compute_fluid_accelerations + add_wall_accelerations).
+  const WallContact<D, R> walls(params_.container, params_.obstacles, static_cast<R>(params_.particle_radius),
+                                params_.walls);
+  compute_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity), walls,
+                        neighbors_->pair_exit_flags(), dt);
   info.seconds.forces = watch.lap();
-  integrate_symplectic_euler(particles_, dt);
-  ++steps_;
-  check_state();
+  ++steps_;  // counted even if the check below throws (as before the passes were fused)
+  integrate_and_check(dt);
   info.seconds.integrate = watch.lap();
 
   info.time = time();
@@ -155,20 +154,23 @@ const StepInfo& Simulation<D, R>::step() {
 }
 
 template <int D, std::floating_point R>
-void Simulation<D, R>::check_state() const {
+void Simulation<D, R>::integrate_and_check(R dt) {
+  // Symplectic Euler (integrate_symplectic_euler) and the blow-up check in one pass.
   const std::size_t n = particles_.size();
   const double limit2 = speed_limit_ * speed_limit_;
-  // Find the first bad particle in index order (deterministic message).
   std::vector<std::uint8_t>& bad = bad_;
   bad.assign(chunk_count(n), 0);
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i)
-      if (!all_finite(particles_.position[i]) || !all_finite(particles_.velocity[i]) ||
-          static_cast<double>(norm2(particles_.velocity[i])) > limit2) {
-        bad[c] = 1;
-        return;
-      }
+    bool any = false;
+    for (std::size_t i = b; i < e; ++i) {
+      particles_.velocity[i] += particles_.acceleration[i] * dt;
+      particles_.position[i] += particles_.velocity[i] * dt;
+      any = any || !all_finite(particles_.position[i]) || !all_finite(particles_.velocity[i]) ||
+            static_cast<double>(norm2(particles_.velocity[i])) > limit2;
+    }
+    bad[c] = any ? 1 : 0;
   });
+  // Name the first bad particle in index order (a deterministic message).
   for (std::size_t c = 0; c < bad.size(); ++c) {
     if (!bad[c]) continue;
     for (std::size_t i = c * kChunkSize; i < std::min(n, (c + 1) * kChunkSize); ++i) {

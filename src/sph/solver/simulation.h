@@ -87,7 +87,8 @@ class Simulation {
 
  private:
   std::size_t emit();
-  void check_state() const;
+  /// Integrates (symplectic Euler) and checks every value: throws on a blow-up.
+  void integrate_and_check(R dt);
 
   SimulationParams<D> params_;
   ParticleSet<D, R> particles_;

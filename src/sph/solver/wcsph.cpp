@@ -77,7 +77,7 @@ std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
 
 template <bool kPaper, bool kExitTest, int D, std::floating_point R>
 void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                const Vec<D, R>& gravity, std::span<std::uint8_t> flags, R dt) {
+                const Vec<D, R>& gravity, const WallContact<D, R>* walls, std::span<std::uint8_t> flags, R dt) {
   using P = simd::Pack<R>;
   constexpr int W = simd::kLanes<R>;
   const P hv = P::set1(h), h2v = P::set1(h * h), zero = P::set1(R(0)), one = P::set1(R(1)), minus_one = P::set1(R(-1)),
@@ -149,6 +149,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
       if (flag_i) set_flag(i);
     Vec<D, R> a = gravity;
     for (int d = 0; d < D; ++d) a[d] += simd::sum_lanes(acc[d]);
+    if (walls != nullptr) a += (*walls)(ps.position[i], ps.velocity[i]);
     ps.acceleration[i] = a;
   });
 }
@@ -162,72 +163,45 @@ std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborList
   return density_pass(ps, lists, h, fluid, within);
 }
 
+namespace {
 template <int D, std::floating_point R>
-void compute_fluid_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                                 const Vec<D, R>& gravity, std::span<std::uint8_t> exit_flags, R dt) {
+void dispatch_force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
+                         const Vec<D, R>& gravity, const WallContact<D, R>* walls, std::span<std::uint8_t> exit_flags,
+                         R dt) {
   SPH_CHECK(exit_flags.empty() || exit_flags.size() == ps.size(), "one exit flag per particle");
   const bool paper = fluid.pressure_force == PressureForce::Paper;
   if (exit_flags.empty()) {
     if (paper)
-      force_pass<true, false>(ps, lists, h, fluid, gravity, exit_flags, dt);
+      force_pass<true, false>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
     else
-      force_pass<false, false>(ps, lists, h, fluid, gravity, exit_flags, dt);
+      force_pass<false, false>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
   } else {
     if (paper)
-      force_pass<true, true>(ps, lists, h, fluid, gravity, exit_flags, dt);
+      force_pass<true, true>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
     else
-      force_pass<false, true>(ps, lists, h, fluid, gravity, exit_flags, dt);
+      force_pass<false, true>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
   }
-}
-
-namespace {
-/// Acceleration of a penalty contact along unit axis normal sign*e_d: never attractive.
-template <std::floating_point R>
-R contact(R penetration, R normal_velocity, R ks, R kd) {
-  return std::max(R(0), ks * penetration - kd * normal_velocity);
 }
 }  // namespace
 
 template <int D, std::floating_point R>
+void compute_fluid_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
+                                 const Vec<D, R>& gravity, std::span<std::uint8_t> exit_flags, R dt) {
+  dispatch_force_pass<D, R>(ps, lists, h, fluid, gravity, nullptr, exit_flags, dt);
+}
+
+template <int D, std::floating_point R>
 void add_wall_accelerations(ParticleSet<D, R>& ps, const Box<D>& container, const std::vector<Box<D>>& obstacles,
                             R particle_radius, const WallParams& walls) {
-  const R ks = static_cast<R>(walls.stiffness);
-  const R kd = static_cast<R>(walls.damping);
-  const Vec<D, R> lo = vec_cast<R>(container.lo), hi = vec_cast<R>(container.hi);
-  std::vector<Box<D>> const& obs = obstacles;
-  parallel_for(ps.size(), [&](std::size_t i) {
-    const Vec<D, R> x = ps.position[i];
-    const Vec<D, R> v = ps.velocity[i];
-    Vec<D, R> a{};
-    // Container: particles inside the box, pushed back from each of its 2D faces.
-    for (int d = 0; d < D; ++d) {
-      const R pen_lo = lo[d] + particle_radius - x[d];
-      if (pen_lo > 0) a[d] += contact(pen_lo, v[d], ks, kd);
-      const R pen_hi = x[d] - (hi[d] - particle_radius);
-      if (pen_hi > 0) a[d] -= contact(pen_hi, -v[d], ks, kd);
-    }
-    // Obstacles: a particle inside the box grown by one radius is pushed out through the
-    // nearest face.
-    for (const Box<D>& b : obs) {
-      R best = std::numeric_limits<R>::max();
-      int best_d = -1;
-      R best_sign = 0;
-      bool inside = true;
-      for (int d = 0; d < D && inside; ++d) {
-        const R to_lo = x[d] - (static_cast<R>(b.lo[d]) - particle_radius);
-        const R to_hi = (static_cast<R>(b.hi[d]) + particle_radius) - x[d];
-        if (to_lo <= 0 || to_hi <= 0) {
-          inside = false;
-          break;
-        }
-        if (to_lo < best) best = to_lo, best_d = d, best_sign = R(-1);
-        if (to_hi < best) best = to_hi, best_d = d, best_sign = R(1);
-      }
-      if (!inside) continue;
-      a[best_d] += best_sign * contact(best, best_sign * v[best_d], ks, kd);
-    }
-    ps.acceleration[i] += a;
-  });
+  const WallContact<D, R> contact(container, obstacles, particle_radius, walls);
+  parallel_for(ps.size(), [&](std::size_t i) { ps.acceleration[i] += contact(ps.position[i], ps.velocity[i]); });
+}
+
+template <int D, std::floating_point R>
+void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
+                           const Vec<D, R>& gravity, const WallContact<D, R>& walls, std::span<std::uint8_t> exit_flags,
+                           R dt) {
+  dispatch_force_pass(ps, lists, h, fluid, gravity, &walls, exit_flags, dt);
 }
 
 template <int D, std::floating_point R>
@@ -254,13 +228,15 @@ double lattice_mass(double rest_density, double spacing, double h) {
   return rest_density / sum;
 }
 
-#define SPH_INSTANTIATE(D, R)                                                                                      \
-  template std::uint64_t compute_density_pressure<D, R>(ParticleSet<D, R>&, const NeighborLists&, R,               \
-                                                        const FluidParams&);                                       \
-  template void compute_fluid_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&, \
-                                                  const Vec<D, R>&, std::span<std::uint8_t>, R);                   \
-  template void add_wall_accelerations<D, R>(ParticleSet<D, R>&, const Box<D>&, const std::vector<Box<D>>&, R,     \
-                                             const WallParams&);                                                   \
+#define SPH_INSTANTIATE(D, R)                                                                                        \
+  template std::uint64_t compute_density_pressure<D, R>(ParticleSet<D, R>&, const NeighborLists&, R,                 \
+                                                        const FluidParams&);                                         \
+  template void compute_fluid_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&,   \
+                                                  const Vec<D, R>&, std::span<std::uint8_t>, R);                     \
+  template void add_wall_accelerations<D, R>(ParticleSet<D, R>&, const Box<D>&, const std::vector<Box<D>>&, R,       \
+                                             const WallParams&);                                                     \
+  template void compute_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&,         \
+                                            const Vec<D, R>&, const WallContact<D, R>&, std::span<std::uint8_t>, R); \
   template void integrate_symplectic_euler<D, R>(ParticleSet<D, R>&, R);
 SPH_INSTANTIATE(2, float)
 SPH_INSTANTIATE(2, double)

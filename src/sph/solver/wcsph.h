@@ -1,6 +1,10 @@
 #pragma once
 /// \file The WCSPH operators of the paper (Section 3), as loops that gather into particle i.
 
+#include <algorithm>
+#include <limits>
+#include <vector>
+
 #include <sph/core/particle_set.h>
 #include <sph/neighbors/neighbor_lists.h>
 #include <sph/solver/params.h>
@@ -13,7 +17,8 @@ namespace sph {
 ///
 /// Returns the number of listed (directed) pairs closer than h.
 template <int D, std::floating_point R>
-std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid);
+std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h,
+                                       const FluidParams& fluid);
 
 /// Accelerations from pressure (Eq. 5, spiky gradient), viscosity (Eq. 6 with (v_j - v_i),
 /// viscosity-kernel Laplacian) and gravity:
@@ -32,11 +37,75 @@ template <int D, std::floating_point R>
 void compute_fluid_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                                  const Vec<D, R>& gravity, std::span<std::uint8_t> exit_flags = {}, R dt = 0);
 
+/// The damped penalty acceleration of the container walls and the obstacles on one particle.
+/// A particle interacts with a wall plane when closer than `particle_radius` to it; the contact
+/// pushes along the wall's normal and never pulls.
+template <int D, std::floating_point R>
+class WallContact {
+ public:
+  WallContact(const Box<D>& container, const std::vector<Box<D>>& obstacles, R particle_radius, const WallParams& walls)
+      : lo_(vec_cast<R>(container.lo)),
+        hi_(vec_cast<R>(container.hi)),
+        obstacles_(&obstacles),
+        radius_(particle_radius),
+        ks_(static_cast<R>(walls.stiffness)),
+        kd_(static_cast<R>(walls.damping)) {}
+
+  Vec<D, R> operator()(const Vec<D, R>& x, const Vec<D, R>& v) const {
+    Vec<D, R> a{};
+    // Container: particles inside the box, pushed back from each of its 2D faces.
+    for (int d = 0; d < D; ++d) {
+      const R pen_lo = lo_[d] + radius_ - x[d];
+      if (pen_lo > 0) a[d] += contact(pen_lo, v[d]);
+      const R pen_hi = x[d] - (hi_[d] - radius_);
+      if (pen_hi > 0) a[d] -= contact(pen_hi, -v[d]);
+    }
+    // Obstacles: a particle inside the box grown by one radius is pushed out through the
+    // nearest face.
+    for (const Box<D>& b : *obstacles_) {
+      R best = std::numeric_limits<R>::max();
+      int best_d = -1;
+      R best_sign = 0;
+      bool inside = true;
+      for (int d = 0; d < D && inside; ++d) {
+        const R to_lo = x[d] - (static_cast<R>(b.lo[d]) - radius_);
+        const R to_hi = (static_cast<R>(b.hi[d]) + radius_) - x[d];
+        if (to_lo <= 0 || to_hi <= 0) {
+          inside = false;
+          break;
+        }
+        if (to_lo < best) best = to_lo, best_d = d, best_sign = R(-1);
+        if (to_hi < best) best = to_hi, best_d = d, best_sign = R(1);
+      }
+      if (!inside) continue;
+      a[best_d] += best_sign * contact(best, best_sign * v[best_d]);
+    }
+    return a;
+  }
+
+ private:
+  /// Acceleration of a penalty contact along its normal: never attractive.
+  R contact(R penetration, R normal_velocity) const {
+    return std::max(R(0), ks_ * penetration - kd_ * normal_velocity);
+  }
+
+  Vec<D, R> lo_, hi_;
+  const std::vector<Box<D>>* obstacles_;
+  R radius_, ks_, kd_;
+};
+
 /// Adds the damped penalty accelerations of the container walls and of the obstacles.
 /// A particle interacts with a wall plane when closer than `particle_radius` to it.
 template <int D, std::floating_point R>
 void add_wall_accelerations(ParticleSet<D, R>& ps, const Box<D>& container, const std::vector<Box<D>>& obstacles,
                             R particle_radius, const WallParams& walls);
+
+/// compute_fluid_accelerations and then the walls' accelerations, in one pass over the
+/// particles (what Simulation::step runs; the same values as the two calls).
+template <int D, std::floating_point R>
+void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
+                           const Vec<D, R>& gravity, const WallContact<D, R>& walls,
+                           std::span<std::uint8_t> exit_flags = {}, R dt = 0);
 
 /// Symplectic Euler: v += dt a; x += dt v.
 template <int D, std::floating_point R>

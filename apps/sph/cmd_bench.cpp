@@ -27,6 +27,7 @@ struct BenchCliOptions {
   std::string precisions;
   std::string modes = "standard,adaptive,verlet";
   int repeats = 5;
+  int step_runs = 3;
   std::string output = "out/bench";
   std::int64_t particles = 0;
   std::int64_t warmup_steps = -1;
@@ -45,6 +46,7 @@ int bench(const BenchCliOptions& cli) {
   if (!cli.precisions.empty()) opt.precisions = parse_precisions(cli.precisions, "--precision");
   opt.modes = parse_bench_modes(cli.modes, "--modes");
   opt.repeats = cli.repeats;
+  opt.step_runs = cli.step_runs;
   opt.particles = cli.particles;
   opt.warmup_steps = cli.warmup_steps;
   opt.timed_steps = cli.timed_steps;
@@ -103,6 +105,11 @@ std::function<int()> add_bench_command(CLI::App& app) {
   cmd->add_option("--repeats", opt->repeats, "Timings per neighbors case and runs per tank mode (medians reported)")
       ->check(CLI::Range(1, 1000))
       ->default_str("5");
+  cmd->add_option("--step-runs", opt->step_runs,
+                  "Steps suite: runs per workload; the run of median wall time is reported, with the fastest and "
+                  "slowest")
+      ->check(CLI::Range(1, 100))
+      ->default_str("3");
   cmd->add_option("-o,--output", opt->output, "Output directory for bench.json and the CSVs")->default_str("out/bench");
   cmd->add_option("--particles", opt->particles,
                   "Steps suite: run one dam break of about this many particles (rounded to a cube) instead of the "

@@ -77,6 +77,7 @@ class SmallSuites : public ::testing::Test {
     o.modes = {NeighborMode::Standard, NeighborMode::Verlet};
     o.warmup_steps = 2;
     o.timed_steps = 3;
+    o.step_runs = 3;
     BenchOutput out;
     out.table = [](const std::string& line) { table_ += line + "\n"; };
     result_ = new BenchResult(run_benchmarks(o, dir_->path(), out));
@@ -171,6 +172,10 @@ TEST_F(SmallSuites, StepsResultsHaveTimingsThroughputAndMemory) {
       EXPECT_GE(r["ms_per_step"][phase].get<double>(), 0) << phase;
     EXPECT_GT(r["ms_per_step"]["total"].get<double>(), 0);
     EXPECT_GE(r["ms_per_step"]["wall"].get<double>(), r["ms_per_step"]["total"].get<double>() * 0.99);
+    // The reported run is the median of three: between the fastest and the slowest.
+    EXPECT_EQ(r["runs"], 3);
+    EXPECT_LE(r["wall_ms_per_step_min"].get<double>(), r["ms_per_step"]["wall"].get<double>());
+    EXPECT_GE(r["wall_ms_per_step_max"].get<double>(), r["ms_per_step"]["wall"].get<double>());
     EXPECT_GT(r["particle_steps_per_second"].get<double>(), 0);
     EXPECT_GT(r["ns_per_particle_step"].get<double>(), 0);
     // A lattice block: the first lists hold the ~30 neighbors within h = 2 dx (verlet more).

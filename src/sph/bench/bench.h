@@ -38,6 +38,7 @@ struct BenchOptions {
   std::vector<int> threads;           ///< thread counts; empty: 1 and the core count
   std::vector<Precision> precisions;  ///< empty: each suite's default (see the suites)
   int repeats = 5;                    ///< neighbors: timings per case; tank: runs per mode
+  int step_runs = 3;                  ///< steps: runs per workload (the median run is reported)
   std::int64_t particles = 0;         ///< steps: one explicit particle count (rounded to a cube) instead of the size's
   std::int64_t warmup_steps = -1;     ///< steps: untimed steps before timing (-1: by size)
   std::int64_t timed_steps = -1;      ///< steps: timed steps (-1: by size)
@@ -93,6 +94,8 @@ struct StepsRow {
   std::int64_t warmup_steps = 0, timed_steps = 0;
   PhaseTimes ms_per_step;                ///< milliseconds per timed step, by phase
   double wall_ms_per_step = 0;           ///< wall time of the timed loop per step (phases plus bookkeeping)
+  int runs = 1;                          ///< runs of this workload; the row is the run of median wall time
+  double wall_ms_min = 0, wall_ms_max = 0;  ///< fastest and slowest run's wall ms per step
   double particle_steps_per_second = 0;  ///< particles * steps / wall seconds
   double ns_per_particle_step = 0;       ///< the scaling figure: wall ns per particle and step
   double lists_rebuilt_per_step = 0;     ///< mean over the timed steps

@@ -1,6 +1,8 @@
 // The steps suite: whole simulation steps of a 3D dam break (workload.h) per neighbor mode,
 // precision and thread count, with the peak memory of each workload.
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include <sph/bench/bench.h>
@@ -85,7 +87,8 @@ void run_steps_suite(const BenchOptions& options, BenchResult& result, const Ben
   }
   if (out.table) {
     out.table(
-        "\nsteps: 3D dam break (side^3 particles, spacing 0.02 m, h = 0.04 m, dt = 4e-4 s), ms per step by phase, "
+        "\nsteps: 3D dam break (side^3 particles, spacing 0.02 m, h = 0.04 m, dt = 4e-4 s), ms per step by phase "
+        "of the run of median wall time (of --step-runs runs), "
         "after warm-up steps");
     out.table(detail::steps_table_header());
   }
@@ -109,13 +112,22 @@ void run_steps_suite(const BenchOptions& options, BenchResult& result, const Ben
             }
           }
           set_num_threads(t);
-          StepsRow row;
-          try {
-            row = p == Precision::Float ? run_workload<float>(desc, side, mode, t, warmup, timed)
-                                        : run_workload<double>(desc, side, mode, t, warmup, timed);
-          } catch (const Error& e) {
-            throw BenchFailure(fmt::format("the steps workload {} failed: {}", name, e.what()));
+          // Several runs; the row is the run of median wall time, with the spread beside it.
+          std::vector<StepsRow> runs;
+          for (int r = 0; r < options.step_runs; ++r) {
+            try {
+              runs.push_back(p == Precision::Float ? run_workload<float>(desc, side, mode, t, warmup, timed)
+                                                   : run_workload<double>(desc, side, mode, t, warmup, timed));
+            } catch (const Error& e) {
+              throw BenchFailure(fmt::format("the steps workload {} failed: {}", name, e.what()));
+            }
           }
+          std::sort(runs.begin(), runs.end(),
+                    [](const StepsRow& a, const StepsRow& b) { return a.wall_ms_per_step < b.wall_ms_per_step; });
+          StepsRow row = runs[runs.size() / 2];
+          row.runs = static_cast<int>(runs.size());
+          row.wall_ms_min = runs.front().wall_ms_per_step;
+          row.wall_ms_max = runs.back().wall_ms_per_step;
           row.oversubscribed = t > cores;
           if (!row.peak_reset && !peak_warned) {
             peak_warned = true;

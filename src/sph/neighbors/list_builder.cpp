@@ -133,11 +133,11 @@ std::uint32_t gather(bool vector, const UniformGrid<D, R>& grid, const Stencil<D
   return gather_scalar<D, R>(grid, st, x, self, r2, out);
 }
 
-/// Makes buf at least `need` long, growing by an eighth at least (few reallocations while the
+/// Makes buf at least `need` long, growing by a sixteenth at least (few reallocations while the
 /// lists grow, little spare room once they are stable).
 void ensure_room(std::vector<std::uint32_t>& buf, std::size_t need) {
   if (buf.size() >= need) return;
-  buf.resize(std::max(need, buf.size() + buf.size() / 8 + 4096));
+  buf.resize(std::max(need, buf.size() + buf.size() / 16 + 4096));
 }
 
 // Room after the last list: a vector store may write this far past the last hit, and readers

@@ -61,15 +61,45 @@ void UniformGrid<D, R>::build(std::span<const V> positions, R radius) {
   cell_of_.resize(n);
   parallel_for(n, [&](std::size_t i) { cell_of_[i] = static_cast<std::uint32_t>(linear(cell_coords(positions[i]))); });
   cell_start_.assign(cells + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) ++cell_start_[cell_of_[i] + 1];
-  for (std::size_t c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
   sorted_.resize(n + kPad);
-  // Scatter using a running cursor per cell (cell_start_ shifted by one, then restored).
-  for (std::size_t i = 0; i < n; ++i) {
-    sorted_[cell_start_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+  // A stable sort by cell has one result, however it is computed: with several threads, each
+  // of B contiguous blocks of points counts its cells, a prefix over (cell, block) gives each
+  // block its own cursors, and the blocks scatter in parallel. Only when the B histograms are
+  // small next to the points (they are kept between builds).
+  const std::size_t blocks = std::min<std::size_t>(static_cast<std::size_t>(num_threads()), 64);
+  if (blocks > 1 && n >= 16384 && blocks * cells <= n / 2) {
+    block_cursor_.resize(blocks * cells);
+    const auto range = [&](std::size_t b) { return std::pair{n * b / blocks, n * (b + 1) / blocks}; };
+    parallel_for(blocks, [&](std::size_t b) {
+      std::uint32_t* count = block_cursor_.data() + b * cells;
+      std::fill(count, count + cells, 0u);
+      const auto [first, last] = range(b);
+      for (std::size_t i = first; i < last; ++i) ++count[cell_of_[i]];
+    });
+    std::uint32_t running = 0;
+    for (std::size_t c = 0; c < cells; ++c) {
+      cell_start_[c] = running;
+      for (std::size_t b = 0; b < blocks; ++b) {
+        std::uint32_t& k = block_cursor_[b * cells + c];
+        const std::uint32_t count = k;
+        k = running;
+        running += count;
+      }
+    }
+    cell_start_[cells] = running;
+    parallel_for(blocks, [&](std::size_t b) {
+      std::uint32_t* cursor = block_cursor_.data() + b * cells;
+      const auto [first, last] = range(b);
+      for (std::size_t i = first; i < last; ++i) sorted_[cursor[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+    });
+  } else {
+    for (std::size_t i = 0; i < n; ++i) ++cell_start_[cell_of_[i] + 1];
+    for (std::size_t c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
+    // Scatter using a running cursor per cell (cell_start_ shifted by one, then restored).
+    for (std::size_t i = 0; i < n; ++i) sorted_[cell_start_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+    for (std::size_t c = cells; c > 0; --c) cell_start_[c] = cell_start_[c - 1];
+    cell_start_[0] = 0;
   }
-  for (std::size_t c = cells; c > 0; --c) cell_start_[c] = cell_start_[c - 1];
-  cell_start_[0] = 0;
   std::fill(sorted_.begin() + static_cast<std::ptrdiff_t>(n), sorted_.end(), 0u);
 
   // Coordinates in sorted order, one array per axis.

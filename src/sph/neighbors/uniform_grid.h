@@ -130,6 +130,7 @@ class UniformGrid {
   std::vector<std::uint32_t> cell_start_;  // size cells + 1
   std::vector<std::uint32_t> sorted_;      // point indices sorted by cell (stable), + kPad
   std::vector<std::uint32_t> cell_of_;     // cell of each point
+  std::vector<std::uint32_t> block_cursor_;  // parallel counting sort: per block and cell
   std::array<std::vector<R>, D> coords_;   // coordinates in sorted order, + kPad
 };
 

@@ -74,9 +74,10 @@ class Cli : public testing::Test {
     fs::remove_all(root_, ec);
   }
 
-  /// Runs `sph ARGS...` in work_ (the arguments are passed verbatim, not through word splitting).
-  Result sph(const std::vector<std::string>& args) {
-    std::string cmd = "cd " + shell_quote(work_.string()) + " && " + shell_quote(SPH_BINARY);
+  /// Runs `sph ARGS...` in work_ (the arguments are passed verbatim, not through word splitting),
+  /// with `env_prefix` (e.g. "env -u VAR") in front of the binary.
+  Result sph(const std::vector<std::string>& args, const std::string& env_prefix = "") {
+    std::string cmd = "cd " + shell_quote(work_.string()) + " && " + env_prefix + " " + shell_quote(SPH_BINARY);
     for (const auto& a : args) cmd += " " + shell_quote(a);
     const fs::path err = root_ / "stderr.txt";
     cmd += " 2>" + shell_quote(err.string());
@@ -355,6 +356,22 @@ TEST_F(Cli, RunWritesSummaryStatsAndFrames) {
   // No temporary or probe files are left behind.
   for (const auto& e : fs::recursive_directory_iterator(dir))
     EXPECT_NE(e.path().filename().string().front(), '.') << e.path();
+}
+
+TEST_F(Cli, OpenMpThreadsSleepByDefaultAndTheUsersPolicyIsKept) {
+  // Spinning OpenMP threads make steps many times slower when another program competes for the
+  // cores: sph restarts itself with OMP_WAIT_POLICY=passive unless the user chose a policy.
+  const std::vector<std::string> args{"run", kDamBreak, "--steps", "3", "--no-progress", "-o", "w"};
+  Result r = sph(args, "env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_CONTAINS(read_file(work_ / "w" / "summary.json"), "\"openmp_wait_policy\": \"passive\"");
+  r = sph(args, "env -u GOMP_SPINCOUNT OMP_WAIT_POLICY=active");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_CONTAINS(read_file(work_ / "w" / "summary.json"), "\"openmp_wait_policy\": \"active\"");
+  // GOMP_SPINCOUNT is a choice too: then no policy is imposed.
+  r = sph(args, "env -u OMP_WAIT_POLICY GOMP_SPINCOUNT=1000");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_CONTAINS(read_file(work_ / "w" / "summary.json"), "\"openmp_wait_policy\": \"\"");
 }
 
 TEST_F(Cli, SetOverrideReachesTheEffectiveScene) {

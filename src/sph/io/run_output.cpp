@@ -1,5 +1,7 @@
 #include <sph/io/run_output.h>
 
+#include <cstdlib>
+
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -110,6 +112,8 @@ void RunOutput<D, R>::finish(const Simulation<D, R>& sim, const std::string& sta
   s["precision"] = std::is_same_v<R, float> ? "float" : "double";
   s["neighbors"] = info_.mode;
   s["threads"] = info_.threads;
+  const char* wait_policy = std::getenv("OMP_WAIT_POLICY");
+  s["openmp_wait_policy"] = wait_policy != nullptr ? wait_policy : "";
   s["steps"] = sim.steps_done();
   s["simulated_time"] = sim.time();
   s["time_step"] = sim.params().time_step;

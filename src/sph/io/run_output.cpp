@@ -112,8 +112,11 @@ void RunOutput<D, R>::finish(const Simulation<D, R>& sim, const std::string& sta
   s["precision"] = std::is_same_v<R, float> ? "float" : "double";
   s["neighbors"] = info_.mode;
   s["threads"] = info_.threads;
-  const char* wait_policy = std::getenv("OMP_WAIT_POLICY");
-  s["openmp_wait_policy"] = wait_policy != nullptr ? wait_policy : "";
+  // How idle OpenMP threads wait (sph sets GOMP_SPINCOUNT=1000 unless the user chose).
+  std::string wait;
+  for (const char* var : {"OMP_WAIT_POLICY", "GOMP_SPINCOUNT"})
+    if (const char* v = std::getenv(var)) wait += (wait.empty() ? "" : " ") + std::string(var) + "=" + v;
+  s["openmp_wait"] = wait;
   s["steps"] = sim.steps_done();
   s["simulated_time"] = sim.time();
   s["time_step"] = sim.params().time_step;

@@ -96,6 +96,31 @@ TEST(FastLists, ParallelCountingSortGivesTheSerialOrder) {
   }
 }
 
+TEST(FastLists, PaddingHoldsValidIndicesAfterALargerSetOnTheSameThread) {
+  // Vector loops read up to 16 entries past a list: they must be indices of this particle set,
+  // never stale ones left by an earlier, larger set (thread-local merge buffers, reused lists).
+  const auto big = jittered_lattice<3, double>(18, 0.025, 0.0025, 1, false);   // 5,832 points
+  const auto small = jittered_lattice<3, double>(3, 0.025, 0.0025, 2, false);  // 27 points
+  UniformGrid<3, double> grid;
+  ListBuilder<3, double> builder;
+  NeighborLists reused;
+  grid.build(big, 0.05);
+  builder.build(grid, big, 0.05, reused);
+  std::vector<std::uint8_t> all(big.size(), 1);
+  builder.rebuild_some(grid, big, 0.05, all, reused);  // fills the merge buffers with big indices
+  ASSERT_TRUE(reused.padding_is_valid());
+  grid.build(small, 0.05);
+  builder.build(grid, small, 0.05, reused);  // the same lists object, now for 27 points
+  EXPECT_TRUE(reused.padding_is_valid());
+  NeighborLists fresh;
+  builder.build(grid, small, 0.05, fresh);
+  std::vector<std::uint8_t> some(small.size(), 0);
+  some[3] = some[20] = 1;
+  builder.rebuild_some(grid, small, 0.05, some, fresh);
+  EXPECT_TRUE(fresh.padding_is_valid());
+  EXPECT_TRUE(NeighborLists::from({{1}, {0}}).padding_is_valid());
+}
+
 TEST(FastLists, PairsExactlyAtRadiusAreExcluded) {
   // Points on an exact lattice at spacing 1 with r = 2: the neighbors at distance exactly 2
   // are not strictly closer and must be left out by both kernels.

@@ -149,6 +149,31 @@ TEST(FusedPasses, AccelerationsEqualFluidThenWallsBitForBit) {
   EXPECT_GT(touching, 10u) << "the walls must be part of the comparison";
 }
 
+TEST(Reorder, ParticlesEmittedOnAReorderStepAreTheLastOnes) {
+  // Reorder and emission on the same step: the new particles must still be at the end (sph
+  // compare perturbs [n - emitted, n) after each step).
+  auto params = dam_break<double>(6, NeighborMode::Adaptive, 8).params();
+  EmitterParams<3> e;
+  e.origin = {{0.2, 0.1, 0.06}};
+  e.direction = {{0, -1, 0}};
+  e.speed = 0.5;
+  e.width = e.height = 3;
+  e.spacing = 0.02;
+  e.every_steps = 4;
+  e.max_particles = 200;
+  params.emitters.push_back(e);
+  Simulation<3, double> sim(params, dam_break<double>(6, NeighborMode::Adaptive, 8).particles());
+  int both = 0;
+  for (int s = 0; s < 40; ++s) {
+    const StepInfo& info = sim.step();
+    const auto& P = sim.particles();
+    if (info.reordered && info.emitted > 0) ++both;
+    for (std::size_t i = P.size() - info.emitted; i < P.size(); ++i)
+      ASSERT_GE(P.id[i], P.next_id() - info.emitted) << "step " << s << ": index " << i << " is an old particle";
+  }
+  EXPECT_GE(both, 4) << "the test must cover steps that reorder and emit";
+}
+
 TEST(ParticleSetPermute, RejectsARepeatedIndex) {
   ParticleSet<2, double> ps;
   for (int i = 0; i < 3; ++i) ps.add(Vec<2, double>::filled(i), {}, 1.0);

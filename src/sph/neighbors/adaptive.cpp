@@ -15,7 +15,7 @@ AdaptiveNeighbors<D, R>::AdaptiveNeighbors(R radius, int full_rebuild_period)
 
 template <int D, std::floating_point R>
 void AdaptiveNeighbors<D, R>::update(const ParticleSet<D, R>& particles, R /*dt*/) {
-  // Algorithm 2. The Eq. 7 test itself runs in the solver's density pass, which sets flags_.
+  // Algorithm 2. The Eq. 7 test itself runs in the solver's force pass, which sets flags_.
   Stopwatch watch;
   const std::size_t n = particles.size();
   flags_.resize(n, 1);  // particles added since the last update start flagged

@@ -143,6 +143,12 @@ void ensure_room(std::vector<std::uint32_t>& buf, std::size_t need) {
 // Room after the last list: a vector store may write this far past the last hit, and readers
 // may load NeighborLists::kPadding entries past a list's end.
 constexpr std::size_t kRoom = 16;
+
+/// Per-thread scratch: grows to twice what is needed, so that after a few steps it covers the
+/// largest chunk any thread meets and stops allocating (which thread merges which chunk varies).
+void ensure_scratch(std::vector<std::uint32_t>& buf, std::size_t need) {
+  if (buf.size() < need) buf.resize(2 * need);
+}
 static_assert(kRoom >= NeighborLists::kPadding);
 
 }  // namespace
@@ -174,6 +180,7 @@ void ListBuilder<D, R>::build(const UniformGrid<D, R>& grid, std::span<const Vec
       used += m;
       out.end_[i] = static_cast<std::uint32_t>(used);
     }
+    std::fill_n(buf.data() + used, kRoom, 0u);  // readable padding, valid indices (not stale ones)
     chunk_entries_[c] = used;
   });
   out.entries_ = 0;
@@ -206,42 +213,47 @@ void ListBuilder<D, R>::rebuild_some(const UniformGrid<D, R>& grid, std::span<co
       chunk_entries_[c] = kept;
       return;
     }
-    // New lists of the marked particles first, then old and new merged into a fresh buffer
-    // that replaces the chunk's (the old buffer becomes this thread's spare).
-    thread_local std::vector<std::uint32_t> fresh, merged;
+    // New lists of the marked particles first; then the chunk's old lists are copied aside and
+    // merged with the new ones back into the chunk's own buffer (which keeps its room: no
+    // allocation unless the lists grew).
+    thread_local std::vector<std::uint32_t> fresh, old_copy;
     thread_local std::vector<std::uint32_t> fresh_count;
-    fresh_count.resize(e - b);
+    fresh_count.resize(kChunkSize);
     Stencil<D, R> st;
     std::size_t used = 0;
     for (std::size_t i = b; i < e; ++i) {
       if (!marked(i)) continue;
       st.update(grid, grid.cell_of(i));
-      ensure_room(fresh, used + st.candidates + kRoom);
+      ensure_scratch(fresh, used + st.candidates + kRoom);
       fresh_count[i - b] =
           gather(vector_, grid, st, positions[i], static_cast<std::uint32_t>(i), r2, fresh.data() + used);
       used += fresh_count[i - b];
     }
-    ensure_room(merged, kept + used + kRoom);
-    const std::uint32_t* old = lists.chunks_[c].data();
+    std::vector<std::uint32_t>& buf = lists.chunks_[c];
+    const std::size_t last_old = std::min(e, old_n);  // particles [b, last_old) had lists
+    const std::size_t old_size = last_old > b ? lists.end_[last_old - 1] : 0;
+    ensure_scratch(old_copy, old_size);
+    std::copy_n(buf.data(), old_size, old_copy.data());
+    ensure_room(buf, kept + used + kRoom);
     const std::uint32_t* next_fresh = fresh.data();
     std::size_t at = 0;
     std::uint32_t old_end = 0;  // end of list i - 1 before this merge
     for (std::size_t i = b; i < e; ++i) {
       const std::uint32_t old_begin = old_end;
-      old_end = lists.end_[i];
+      old_end = i < old_n ? lists.end_[i] : old_end;
       std::uint32_t len;
       if (marked(i)) {
         len = fresh_count[i - b];
-        std::copy_n(next_fresh, len, merged.data() + at);
+        std::copy_n(next_fresh, len, buf.data() + at);
         next_fresh += len;
       } else {
         len = old_end - old_begin;
-        std::copy_n(old + old_begin, len, merged.data() + at);
+        std::copy_n(old_copy.data() + old_begin, len, buf.data() + at);
       }
       at += len;
       lists.end_[i] = static_cast<std::uint32_t>(at);
     }
-    lists.chunks_[c].swap(merged);
+    std::fill_n(buf.data() + at, kRoom, 0u);  // readable padding, valid indices
     chunk_entries_[c] = at;
   });
   lists.entries_ = 0;

@@ -28,6 +28,18 @@ NeighborLists NeighborLists::from(const std::vector<std::vector<std::uint32_t>>&
   return out;
 }
 
+bool NeighborLists::padding_is_valid() const {
+  const std::size_t n = particle_count();
+  for (std::size_t c = 0; c < chunks_.size(); ++c) {
+    const std::size_t last = std::min(n, (c + 1) * kChunkSize) - 1;
+    const std::size_t end = end_[last];
+    if (chunks_[c].size() < end + kPadding) return false;
+    for (std::size_t k = end; k < end + kPadding; ++k)
+      if (chunks_[c][k] >= n) return false;
+  }
+  return true;
+}
+
 bool operator==(const NeighborLists& a, const NeighborLists& b) {
   if (&a == &b) return true;
   if (a.particle_count() != b.particle_count() || a.entry_count() != b.entry_count()) return false;

@@ -42,6 +42,10 @@ class NeighborLists {
   /// Bytes of memory held (capacity, not just what is in use).
   std::size_t memory_bytes() const;
 
+  /// Checks the padding promise: every chunk's buffer holds kPadding entries after its last
+  /// list, all of them indices below particle_count() (tests).
+  bool padding_is_valid() const;
+
   /// Lists given explicitly, one vector per particle (tests, brute force).
   static NeighborLists from(const std::vector<std::vector<std::uint32_t>>& lists);
 

@@ -18,7 +18,8 @@ class MortonOrder {
   /// Fills `perm` (resized to positions.size()) so that perm[k] is the index of the point that
   /// comes k-th along the Z-order curve of cells of size `cell` over the points' bounding box.
   /// Points in the same cell keep their relative order (stable), so the result depends only on
-  /// the input. Non-finite positions are refused with sph::Error. cell must be > 0.
+  /// the input. Non-finite positions are a bug upstream (the solver stops a blow-up first): refused with
+  /// std::logic_error (SPH_CHECK). cell must be > 0.
   void compute(std::span<const Vec<D, R>> positions, R cell, std::vector<std::uint32_t>& perm);
 
  private:

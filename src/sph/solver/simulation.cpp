@@ -111,7 +111,6 @@ template <int D, std::floating_point R>
 const StepInfo& Simulation<D, R>::step() {
   StepInfo info;
   info.step = steps_;
-  info.emitted = emit();
 
   const R dt = static_cast<R>(params_.time_step);
   const R h = static_cast<R>(params_.kernel_radius);
@@ -124,6 +123,9 @@ const StepInfo& Simulation<D, R>::step() {
     info.reordered = true;
     reorder_seconds = reorder.lap();
   }
+  // Emit after reordering, so that this step's new particles are the last ones (callers, like
+  // sph compare's perturbation, rely on that).
+  info.emitted = emit();
   neighbors_->update(particles_, dt);
   info.neighbors = neighbors_->counters();
   info.seconds.grid = info.neighbors.grid_seconds + reorder_seconds;

@@ -43,8 +43,9 @@ struct EmitterState {
 };
 
 /// A running simulation. Each step():
-///   1. emitters add their batch (if due); every reorder_period steps the particles are
-///      reordered in memory along a Morton curve (ids are kept) and every list is rebuilt,
+///   1. every reorder_period steps the particles are reordered in memory along a Morton curve
+///      (ids are kept) and every list is rebuilt; then emitters add their batch (if due), at
+///      the end of the particle arrays,
 ///   2. the neighbor strategy updates the lists (grid + lists phases),
 ///   3. density and pressure (Eq. 4, EOS),
 ///   4. pressure, viscous, gravity and wall accelerations (Eq. 5, 6), with the Eq. 7 test if
@@ -72,7 +73,8 @@ class Simulation {
   /// sqrt(k) plus the speed of free fall over the container's size. m/s.
   double speed_limit() const { return speed_limit_; }
 
-  /// Total kinetic energy, J (J/m in 2D). Deterministic for any thread count.
+  /// Total kinetic energy, J (J/m in 2D). Deterministic for any thread count. (This and the
+  /// other reductions use a shared scratch buffer: do not call them concurrently.)
   double kinetic_energy() const;
   /// Largest particle speed, m/s.
   double max_speed() const;

@@ -22,6 +22,14 @@ const R* flat(const std::vector<Vec<D, R>>& v) {
   return reinterpret_cast<const R*>(v.data());
 }
 
+/// What the pair loops assume: lists for exactly these particles, and indices times D that fit
+/// the 32-bit signed offsets of the vector gathers.
+template <int D, std::floating_point R>
+void check_pass_inputs(const ParticleSet<D, R>& ps, const NeighborLists& lists) {
+  SPH_CHECK(lists.particle_count() == ps.size(), "neighbor lists do not cover the particles");
+  SPH_CHECK(ps.size() * D < (std::size_t{1} << 31), "too many particles for 32-bit gather offsets");
+}
+
 /// The pair loops below take a particle's neighbors simd::kLanes<R> at a time (one vector
 /// register), each lane keeping its own partial sums, which are added in lane order at the
 /// end. Lanes past the end of a list load some valid index (NeighborLists::kPadding) and are
@@ -159,6 +167,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
 template <int D, std::floating_point R>
 std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h,
                                        const FluidParams& fluid) {
+  check_pass_inputs(ps, lists);
   thread_local std::vector<std::uint64_t> within;  // per-chunk counts, kept between steps
   return density_pass(ps, lists, h, fluid, within);
 }
@@ -169,6 +178,7 @@ void dispatch_force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h,
                          const Vec<D, R>& gravity, const WallContact<D, R>* walls, std::span<std::uint8_t> exit_flags,
                          R dt) {
   SPH_CHECK(exit_flags.empty() || exit_flags.size() == ps.size(), "one exit flag per particle");
+  check_pass_inputs(ps, lists);
   const bool paper = fluid.pressure_force == PressureForce::Paper;
   if (exit_flags.empty()) {
     if (paper)

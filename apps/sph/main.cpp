@@ -91,7 +91,14 @@ int main(int argc, char** argv) {
     std::string message = e.what();
     const std::string unknown = first_unknown_option(app, argc, argv);
     if (!unknown.empty()) message = "unknown option " + unknown;
-    fmt::print(stderr, "sph: error: {}\nRun 'sph --help' or 'sph run --help' for usage.\n", message);
+    // Point at the help of the subcommand the user typed, if any.
+    std::string sub = "run";
+    for (int i = 1; i < argc; ++i)
+      if (const std::string a = argv[i]; a == "run" || a == "compare" || a == "bench") {
+        sub = a;
+        break;
+      }
+    fmt::print(stderr, "sph: error: {}\nRun 'sph --help' or 'sph {} --help' for usage.\n", message, sub);
     return kBadInput;
   }
 

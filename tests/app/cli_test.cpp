@@ -373,6 +373,18 @@ TEST_F(Cli, OpenMpThreadsSpinBrieflyByDefaultAndTheUsersChoiceIsKept) {
   EXPECT_CONTAINS(read_file(work_ / "w" / "summary.json"), "\"openmp_wait\": \"GOMP_SPINCOUNT=50\"");
 }
 
+TEST_F(Cli, UsageHintNamesTheSubcommandTyped) {
+  Result r = sph({"bench", "--step-runs", "0"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_CONTAINS(r.err, "sph bench --help");
+  r = sph({"compare", "--bogus"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_CONTAINS(r.err, "sph compare --help");
+  r = sph({"run"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_CONTAINS(r.err, "sph run --help");
+}
+
 TEST_F(Cli, SetOverrideReachesTheEffectiveScene) {
   const Result r = sph({"run", kDamBreak, "--steps", "1", "--no-progress", "--set", "Fluid.stiffness=2000", "--set",
                         "FluidBlocks[0].end=[0.2,0.4]", "-o", "o"});

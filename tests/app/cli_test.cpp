@@ -2,12 +2,7 @@
 // does not do) to the output directory. Each test runs the built binary from its own temporary
 // directory.
 
-#include <sys/wait.h>
-
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -16,6 +11,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "support/run_sph.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -23,23 +20,8 @@ namespace fs = std::filesystem;
 const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
 const std::string kBadScene = SPH_SOURCE_DIR "/tests/scene/bad/typo_optional_key_viscosity.json";  // Fluid.viscosty
 
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void write_file(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary);
-  out << text;
-}
+std::string read_file(const fs::path& p) { return sph::test::slurp(p); }
+void write_file(const fs::path& p, const std::string& text) { sph::test::spit(p, text); }
 
 std::size_t count(const std::string& text, const std::string& what) {
   std::size_t n = 0;
@@ -54,11 +36,7 @@ std::size_t count(const std::string& text, const std::string& what) {
     EXPECT_TRUE(h_.find(n_) != std::string::npos) << "expected \"" << n_ << "\" in:\n" << h_; \
   } while (false)
 
-struct Result {
-  int code = -1;    ///< exit status, or 128 + signal
-  std::string out;  ///< stdout
-  std::string err;  ///< stderr
-};
+using Result = sph::test::CommandResult;
 
 class Cli : public testing::Test {
  protected:
@@ -77,23 +55,7 @@ class Cli : public testing::Test {
   /// Runs `sph ARGS...` in work_ (the arguments are passed verbatim, not through word splitting),
   /// with `env_prefix` (e.g. "env -u VAR") in front of the binary.
   Result sph(const std::vector<std::string>& args, const std::string& env_prefix = "") {
-    std::string cmd = "cd " + shell_quote(work_.string()) + " && " + env_prefix + " " + shell_quote(SPH_BINARY);
-    for (const auto& a : args) cmd += " " + shell_quote(a);
-    const fs::path err = root_ / "stderr.txt";
-    cmd += " 2>" + shell_quote(err.string());
-    Result r;
-    FILE* p = ::popen(cmd.c_str(), "r");
-    if (!p) {
-      ADD_FAILURE() << "popen failed for " << cmd;
-      return r;
-    }
-    char buf[4096];
-    std::size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-    const int status = ::pclose(p);
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
-    r.err = read_file(err);
-    return r;
+    return sph::test::run_sph(args, work_, root_ / "stderr.txt", env_prefix);
   }
 
   /// A completed 5-step run of the 2D dam break into work_/DIR.

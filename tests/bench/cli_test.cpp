@@ -24,7 +24,7 @@ class BenchCli : public ::testing::Test {
     for (auto pos = text.find(what); pos != std::string::npos; pos = text.find(what, pos + what.size())) ++n;
     return n;
   }
-  test::BenchTempDir tmp_;
+  test::TempDir tmp_;
 };
 
 TEST_F(BenchCli, SmallNeighborsRunWritesItsFiles) {
@@ -39,7 +39,7 @@ TEST_F(BenchCli, SmallNeighborsRunWritesItsFiles) {
   EXPECT_TRUE(fs::is_regular_file(out / "neighbors.csv"));
   EXPECT_FALSE(fs::exists(out / "steps.csv"));
   EXPECT_FALSE(fs::exists(out / "tank.csv"));
-  const auto doc = nlohmann::json::parse(test::read_text(out / "bench.json"));
+  const auto doc = nlohmann::json::parse(test::slurp(out / "bench.json"));
   EXPECT_EQ(doc["neighbors"]["results"].size(), 16u);
   EXPECT_EQ(doc["options"]["repeats"], 5);
   // The table goes to stdout as it runs, one line per result.

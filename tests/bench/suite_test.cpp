@@ -68,7 +68,7 @@ TEST(ExpectedNeighbors, MatchesTheLatticeCountsWithoutJitter) {
 class SmallSuites : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new test::BenchTempDir();
+    dir_ = new test::TempDir();
     BenchOptions o;
     o.suites = {"neighbors", "steps"};
     o.size = BenchSize::Small;
@@ -81,14 +81,14 @@ class SmallSuites : public ::testing::Test {
     BenchOutput out;
     out.table = [](const std::string& line) { table_ += line + "\n"; };
     result_ = new BenchResult(run_benchmarks(o, dir_->path(), out));
-    doc_ = new json(json::parse(test::read_text(dir_->path() / "bench.json")));
+    doc_ = new json(json::parse(test::slurp(dir_->path() / "bench.json")));
   }
   static void TearDownTestSuite() {
     delete doc_;
     delete result_;
     delete dir_;
   }
-  static inline test::BenchTempDir* dir_ = nullptr;
+  static inline test::TempDir* dir_ = nullptr;
   static inline BenchResult* result_ = nullptr;
   static inline json* doc_ = nullptr;
   static inline std::string table_;
@@ -195,10 +195,10 @@ TEST_F(SmallSuites, StepsResultsHaveTimingsThroughputAndMemory) {
 }
 
 TEST_F(SmallSuites, CsvRowsMatchTheResults) {
-  const auto neighbors = test::lines_of(test::read_text(dir_->path() / "neighbors.csv"));
+  const auto neighbors = test::lines_of(test::slurp(dir_->path() / "neighbors.csv"));
   ASSERT_EQ(neighbors.size(), 1u + 16u);
   EXPECT_EQ(neighbors[0].rfind("particles,side,radius_dx,precision,order,threads", 0), 0u) << neighbors[0];
-  const auto steps = test::lines_of(test::read_text(dir_->path() / "steps.csv"));
+  const auto steps = test::lines_of(test::slurp(dir_->path() / "steps.csv"));
   ASSERT_EQ(steps.size(), 1u + 4u);
   EXPECT_NE(steps[0].find("ns_per_particle_step"), std::string::npos);
   EXPECT_NE(steps[0].find("bytes_per_particle"), std::string::npos);

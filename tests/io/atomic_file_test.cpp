@@ -10,7 +10,7 @@
 #include <sph/core/error.h>
 #include <sph/io/atomic_file.h>
 
-#include "temp_dir.h"
+#include "support/temp_dir.h"
 
 namespace sph {
 namespace {

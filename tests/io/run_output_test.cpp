@@ -15,7 +15,7 @@
 #include <sph/scene/builders.h>
 #include <sph/scene/scene_reader.h>
 
-#include "temp_dir.h"
+#include "support/temp_dir.h"
 
 namespace sph {
 namespace {

@@ -16,7 +16,7 @@
 #include <sph/core/error.h>
 #include <sph/io/vtk.h>
 
-#include "temp_dir.h"
+#include "support/temp_dir.h"
 
 namespace sph {
 namespace {

@@ -16,7 +16,7 @@ namespace sph::test {
 class TempDir {
  public:
   TempDir() {
-    std::string tmpl = (std::filesystem::temp_directory_path() / "sph_io_test_XXXXXX").string();
+    std::string tmpl = (std::filesystem::temp_directory_path() / "sph_test_XXXXXX").string();
     if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
     path_ = tmpl;
   }

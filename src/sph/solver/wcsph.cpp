@@ -30,6 +30,20 @@ void check_pass_inputs(const ParticleSet<D, R>& ps, const NeighborLists& lists) 
   SPH_CHECK(ps.size() * D < (std::size_t{1} << 31), "too many particles for 32-bit gather offsets");
 }
 
+/// rij = x_i - x_j for one register of neighbors j = idx[0..lanes), gathered from the flat
+/// positions; returns |rij|^2, summed as norm2 does (the lists' distance test uses the same).
+template <int D, std::floating_point R>
+simd::Pack<R> pair_offsets(const simd::Pack<R> (&xi)[D], const R* pos, const std::uint32_t* idx,
+                           simd::Pack<R> (&rij)[D]) {
+  using P = simd::Pack<R>;
+  P r2 = P::set1(R(0));
+  for (int d = 0; d < D; ++d) {
+    rij[d] = xi[d] - P::template gather<D>(pos, idx, d);
+    r2 = r2 + rij[d] * rij[d];
+  }
+  return r2;
+}
+
 /// The pair loops below take a particle's neighbors simd::kLanes<R> at a time (one vector
 /// register), each lane keeping its own partial sums, which are added in lane order at the
 /// end. Lanes past the end of a list load some valid index (NeighborLists::kPadding) and are
@@ -60,11 +74,8 @@ std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
       P sum = zero;
       for (std::size_t k0 = 0; k0 < nb.size(); k0 += W) {
         const Mask valid = simd::first_lanes<R>(nb.size() - k0);
-        P rij[D], r2 = zero;
-        for (int d = 0; d < D; ++d) {
-          rij[d] = xi[d] - P::template gather<D>(pos, idx + k0, d);
-          r2 = r2 + rij[d] * rij[d];
-        }
+        P rij[D];
+        const P r2 = pair_offsets<D>(xi, pos, idx + k0, rij);
         const Mask in = valid & (r2 < h2v);
         const P dd = h2v - r2;
         // Paper Eq. 4: m_j W_poly6 = m_j C (h^2 - r^2)^3 inside the support.
@@ -117,11 +128,8 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
     const std::uint32_t* idx = nb.data();
     for (std::size_t k0 = 0; k0 < nb.size(); k0 += W) {
       const Mask valid = simd::first_lanes<R>(nb.size() - k0);
-      P rij[D], r2 = zero;
-      for (int d = 0; d < D; ++d) {
-        rij[d] = xi[d] - P::template gather<D>(pos, idx + k0, d);
-        r2 = r2 + rij[d] * rij[d];
-      }
+      P rij[D];
+      const P r2 = pair_offsets<D>(xi, pos, idx + k0, rij);
       const Mask near = valid & (r2 < h2v);   // inside the support
       const Mask apart = near & (r2 > zero);  // and not coincident (gradient defined)
       const P r = sqrt(select(near, r2, h2v));

@@ -1,6 +1,7 @@
 // `sph run SCENE.json`: runs a scene and writes frames, stats and a summary.
 
 #include <algorithm>
+#include <csignal>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -13,6 +14,8 @@
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 #include <sph/core/timer.h>
+#include <sph/core/version.h>
+#include <sph/io/checkpoint.h>
 #include <sph/io/run_output.h>
 #include <sph/scene/builders.h>
 #include <sph/scene/scene_reader.h>
@@ -33,34 +36,101 @@ struct RunOptions {
   std::vector<std::string> sets;
   bool no_progress = false;
   bool audit = false;
+  std::int64_t checkpoint_every = 0;
+  std::string resume;
 };
 
+/// `word` as one shell word: unchanged if it is plain, else in single quotes.
+std::string shell_word(const std::string& word) {
+  if (!word.empty() && word.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789/._-+") ==
+                           std::string::npos)
+    return word;
+  std::string q = "'";
+  for (char c : word) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+/// The signal that asked the run to stop (SIGINT or SIGTERM), 0 if none. The handler only
+/// records it; the step loop finishes its step, writes a checkpoint and exits.
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+extern "C" void record_stop_signal(int sig) { g_stop_signal = sig; }
+
+/// Installs the handler for SIGINT and SIGTERM for the life of the step loop. SA_RESETHAND:
+/// a second signal kills the program at once (files stay whole: every file is written under a
+/// temporary name and renamed into place).
+class StopSignals {
+ public:
+  StopSignals() {
+    struct sigaction sa = {};
+    sa.sa_handler = record_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESETHAND;
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~StopSignals() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  struct sigaction old_int_ = {}, old_term_ = {};
+};
+
+/// Runs `desc` into `dir`: a new run, or (with `checkpoint`) the continuation of the run that
+/// wrote it.
 template <int D, std::floating_point R>
-int run_scene(const SceneDesc& desc, const RunOptions& opt) {
+int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesystem::path& dir,
+              CheckpointReader* checkpoint) {
   // Everything that can be refused is checked before the output directory is touched.
   Simulation<D, R> sim = make_simulation<D, R>(desc);
-  const std::filesystem::path dir =
-      opt.output.empty() ? std::filesystem::path("out") / desc.name : std::filesystem::path(opt.output);
-  prepare_output_directory(dir);
+  if (checkpoint)
+    prepare_resume_directory(dir);
+  else
+    prepare_output_directory(dir);
 
   RunInfo info{std::string(to_string(sim.params().neighbors)), num_threads()};
   RunOutput<D, R> out(dir, desc, info);
-  fmt::print(stderr, "sph: {} ({}D, {}, {} neighbors, {} thread{}): {} particles{}, {} steps of {:.4g} s -> {}\n",
+  Stopwatch wall;
+  if (checkpoint) {
+    const std::string warning = checkpoint->restore(sim, out);
+    if (!warning.empty()) fmt::print(stderr, "sph: warning: {}\n", warning);
+  }
+  const std::int64_t first = sim.steps_done();
+  fmt::print(stderr, "sph: {} ({}D, {}, {} neighbors, {} thread{}): {} particles{}, {} steps of {:.4g} s{} -> {}\n",
              desc.name, D, std::is_same_v<R, float> ? "float" : "double", info.mode, info.threads,
              info.threads == 1 ? "" : "s", sim.particles().size(),
              sim.params().emitters.empty() ? "" : " (emitters add more)", desc.steps, sim.params().time_step,
-             dir.string());
-  Stopwatch wall;
-  out.begin(sim);
+             checkpoint ? fmt::format(", resumed at step {}", first) : std::string(), dir.string());
+  if (!checkpoint) out.begin(sim);
   Progress progress(
-      desc.steps,
+      desc.steps - first,
       opt.no_progress ? Progress::Mode::Off : (::isatty(STDERR_FILENO) ? Progress::Mode::Bar : Progress::Mode::Lines),
       stderr);
+  const StopSignals signals;
   try {
-    for (std::int64_t s = 0; s < desc.steps; ++s) {
+    for (std::int64_t s = first; s < desc.steps; ++s) {
       const StepInfo& step = sim.step();
-      out.after_step(sim, step, s + 1 == desc.steps);
-      progress.update(s + 1, step.particles);
+      const bool last = s + 1 == desc.steps;
+      out.after_step(sim, step, last);
+      progress.update(s + 1 - first, step.particles);
+      if (const int sig = g_stop_signal) {
+        write_checkpoint(dir, desc, sim, out, wall.elapsed(), opt.checkpoint_every);
+        progress.finish();
+        const char* name = sig == SIGINT ? "SIGINT" : "SIGTERM";
+        out.finish(sim, fmt::format("interrupted by {} after step {} of {}", name, sim.steps_done(), desc.steps),
+                   wall.elapsed());
+        fmt::print(stderr,
+                   "sph: interrupted by {} after step {} of {}: wrote a checkpoint. Continue the run with:\n"
+                   "  sph run --resume {}\n",
+                   name, sim.steps_done(), desc.steps, shell_word(dir.string()));
+        return 128 + sig;
+      }
+      if (opt.checkpoint_every > 0 && (sim.steps_done() % opt.checkpoint_every == 0 || last))
+        write_checkpoint(dir, desc, sim, out, wall.elapsed(), opt.checkpoint_every);
     }
   } catch (const Error& e) {
     progress.finish();
@@ -72,23 +142,70 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt) {
   progress.finish();
   const double seconds = wall.elapsed();
   out.finish(sim, "completed", seconds);
+  const std::int64_t ran = desc.steps - first;
   fmt::print(stderr,
-             "sph: done: {} steps, {} particles, {:.2f} s ({:.3f} ms/step). Wrote {} frames.\n"
+             "sph: done: {} steps, {} particles, {:.2f} s ({:.3f} ms/step). {} {} frames.\n"
              "  {}/frames.pvd   open in ParaView (Filters > Point Gaussian to see particles)\n"
              "  {}/stats.csv    per-step energy, neighbors and phase timings\n"
              "  {}/summary.json totals\n",
-             desc.steps, sim.particles().size(), seconds, 1e3 * seconds / static_cast<double>(desc.steps),
-             out.frames_written(), dir.string(), dir.string(), dir.string());
+             ran, sim.particles().size(), seconds, 1e3 * seconds / static_cast<double>(std::max<std::int64_t>(ran, 1)),
+             checkpoint ? "The run now has" : "Wrote", out.frames_written(), dir.string(), dir.string(), dir.string());
   if (opt.audit)
     fmt::print(stderr,
                "sph: audit: {} pairs within h were missing from the lists, in {} of {} steps; the deepest miss "
                "was (h - r) / h = {:.3g}\n",
-               out.audit_totals().missed_pairs, out.audit_steps_with_misses(), desc.steps,
+               out.audit_totals().missed_pairs, out.audit_steps_with_misses(), sim.steps_done(),
                out.audit_totals().max_penetration);
   return kOk;
 }
 
+/// `sph run --resume DIR`: continues the run whose checkpoint is in DIR.
+int resume(RunOptions opt) {
+  const char* conflict = !opt.scene.empty()     ? "a SCENE file"
+                         : !opt.output.empty()  ? "-o/--output"
+                         : !opt.sets.empty()    ? "--set"
+                         : !opt.neighbors.empty() ? "--neighbors"
+                         : opt.audit            ? "--audit"
+                                                : nullptr;
+  if (conflict)
+    throw Error(fmt::format("--resume continues a run with the scene and settings it started with; {} cannot be "
+                            "given with it (allowed: --steps, --threads, --checkpoint-every, --no-progress)",
+                            conflict));
+  const std::filesystem::path dir(opt.resume);
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec))
+    throw Error("no such directory; expected the output directory of an earlier run (sph run -o DIR)", dir.string());
+  CheckpointReader checkpoint(dir / kCheckpointFile);
+  const CheckpointHeader& h = checkpoint.header();
+  if (h.sph_version != kVersion)
+    fmt::print(stderr, "sph: warning: the checkpoint was written by sph {}, this is sph {}\n", h.sph_version, kVersion);
+  std::vector<std::string> sets;
+  if (opt.steps > 0) sets.push_back("Configuration.numberOfSteps=" + std::to_string(opt.steps));
+  if (opt.threads > 0) set_num_threads(opt.threads);
+  SceneDesc desc = parse_scene(h.scene_json, h.scene_source, sets);
+  if (opt.checkpoint_every == 0) opt.checkpoint_every = h.checkpoint_every;  // go on as the run did
+  desc.body2.sim.audit = desc.body3.sim.audit = h.audit;
+  if (desc.steps <= h.step)
+    throw Error(opt.steps > 0
+                    ? fmt::format("--steps {} is not beyond the checkpoint, which is at step {}; give a larger total",
+                                  opt.steps, h.step)
+                    : fmt::format("the run already did all its {} steps (its checkpoint is at step {}); give --steps "
+                                  "N with N > {} to continue it further",
+                                  desc.steps, h.step, h.step),
+                dir.string());
+  const bool f = desc.precision == Precision::Float;
+  if (desc.dimension != h.dimension || f != (h.precision == Precision::Float))
+    throw Error("the checkpoint's dimension or precision differs from its scene's: the file is corrupt",
+                (dir / kCheckpointFile).string());
+  if (desc.dimension == 2)
+    return f ? run_scene<2, float>(desc, opt, dir, &checkpoint) : run_scene<2, double>(desc, opt, dir, &checkpoint);
+  return f ? run_scene<3, float>(desc, opt, dir, &checkpoint) : run_scene<3, double>(desc, opt, dir, &checkpoint);
+}
+
 int run(const RunOptions& opt) {
+  if (!opt.resume.empty()) return resume(opt);
+  if (opt.scene.empty())
+    throw Error("sph run needs a scene file: sph run SCENE.json (or --resume DIR to continue a run); see sph run --help");
   std::vector<std::string> sets = opt.sets;
   if (!opt.neighbors.empty()) sets.push_back("Configuration.neighbors=\"" + opt.neighbors + "\"");
   if (opt.steps > 0) sets.push_back("Configuration.numberOfSteps=" + std::to_string(opt.steps));
@@ -97,9 +214,12 @@ int run(const RunOptions& opt) {
   SceneDesc desc = read_scene_file(opt.scene, sets);
   desc.body2.sim.audit = desc.body3.sim.audit = opt.audit;
   for (const auto& w : desc.warnings) fmt::print(stderr, "sph: warning: {}\n", w);
+  const std::filesystem::path dir =
+      opt.output.empty() ? std::filesystem::path("out") / desc.name : std::filesystem::path(opt.output);
   const bool f = desc.precision == Precision::Float;
-  if (desc.dimension == 2) return f ? run_scene<2, float>(desc, opt) : run_scene<2, double>(desc, opt);
-  return f ? run_scene<3, float>(desc, opt) : run_scene<3, double>(desc, opt);
+  if (desc.dimension == 2)
+    return f ? run_scene<2, float>(desc, opt, dir, nullptr) : run_scene<2, double>(desc, opt, dir, nullptr);
+  return f ? run_scene<3, float>(desc, opt, dir, nullptr) : run_scene<3, double>(desc, opt, dir, nullptr);
 }
 
 }  // namespace
@@ -107,7 +227,7 @@ int run(const RunOptions& opt) {
 std::function<int()> add_run_command(CLI::App& app) {
   auto opt = std::make_shared<RunOptions>();
   CLI::App* cmd = app.add_subcommand("run", "Run a scene file and write frames (VTK), stats.csv and summary.json");
-  cmd->add_option("scene", opt->scene, "Scene file (JSON; see docs/scene-format.md)")->required();
+  cmd->add_option("scene", opt->scene, "Scene file (JSON; see docs/scene-format.md); required unless --resume");
   cmd->add_option("-o,--output", opt->output, "Output directory (default: out/<scene name>)");
   cmd->add_option("--neighbors", opt->neighbors, "Neighbor strategy, overriding the scene's Configuration.neighbors")
       ->check(CLI::IsMember({"standard", "adaptive", "verlet", "brute_force"}));
@@ -122,6 +242,16 @@ std::function<int()> add_run_command(CLI::App& app) {
                 "Check the lists every step against exact lists and record the pairs within h they miss "
                 "(stats.csv columns missed_pairs, particles_missing, max_missed_penetration; costs about one "
                 "extra standard list build per step)");
+  cmd->add_option("--checkpoint-every", opt->checkpoint_every,
+                  "Write DIR/checkpoint.sphc every N steps and at the last step (the latest replaces the "
+                  "previous, atomically). Ctrl-C or SIGTERM always writes one: the run finishes its step, "
+                  "writes the checkpoint and stops")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1'000'000'000'000}))
+      ->type_name("N");
+  cmd->add_option("--resume", opt->resume,
+                  "Continue the run in DIR from its checkpoint, bitwise identically to a run never interrupted; "
+                  "only --steps (a new total), --threads, --checkpoint-every and --no-progress may be given with it")
+      ->type_name("DIR");
   cmd->add_flag("--no-progress", opt->no_progress,
                 "No progress output (default: a bar with ETA on a terminal, a line every 10 % otherwise)");
   return [opt, cmd]() -> int {

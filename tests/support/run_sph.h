@@ -2,7 +2,11 @@
 // Running the sph binary from a test: arguments passed verbatim (no word splitting), stdout and
 // stderr captured, the exit status decoded.
 
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -43,5 +47,50 @@ inline CommandResult run_sph(const std::vector<std::string>& args, const std::fi
   r.err = slurp(err_file);
   return r;
 }
+
+/// A running `sph` process (for tests that signal or kill it). Killed and reaped at scope exit
+/// if still running.
+class SphProcess {
+ public:
+  /// Starts SPH_BINARY args... in `cwd`, stdout and stderr to `log`.
+  SphProcess(const std::vector<std::string>& args, const std::filesystem::path& cwd, const std::filesystem::path& log) {
+    // sh changes directory, then becomes sph (exec): the pid is sph's.
+    std::string script = "cd " + shell_quote(cwd.string()) + " && exec " + shell_quote(SPH_BINARY);
+    for (const auto& a : args) script += " " + shell_quote(a);
+    std::string sh = "/bin/sh", c = "-c";
+    char* argv[] = {sh.data(), c.data(), script.data(), nullptr};
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&fa, 1, 2);
+    if (::posix_spawn(&pid_, "/bin/sh", &fa, nullptr, argv, environ) != 0) pid_ = -1;
+    posix_spawn_file_actions_destroy(&fa);
+  }
+  SphProcess(const SphProcess&) = delete;
+  SphProcess& operator=(const SphProcess&) = delete;
+  ~SphProcess() {
+    if (pid_ > 0 && !reaped_) {
+      ::kill(pid_, SIGKILL);
+      wait();
+    }
+  }
+  bool started() const { return pid_ > 0; }
+  void signal(int sig) const { ::kill(pid_, sig); }
+  /// Waits for the exit; returns the exit status, or 128 + the signal that killed it.
+  int wait() {
+    if (reaped_) return code_;
+    int status = 0;
+    while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+    }
+    reaped_ = true;
+    code_ = WIFEXITED(status) ? WEXITSTATUS(status) : WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
+    return code_;
+  }
+
+ private:
+  pid_t pid_ = -1;
+  bool reaped_ = false;
+  int code_ = -1;
+};
 
 }  // namespace sph::test

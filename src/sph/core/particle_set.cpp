@@ -2,6 +2,8 @@
 #include <sph/core/particle_set.h>
 #include <algorithm>
 
+#include <sph/core/state_stream.h>
+
 namespace sph {
 
 template <int D, std::floating_point R>
@@ -68,6 +70,37 @@ void ParticleSet<D, R>::permute(std::span<const std::uint32_t> perm) {
     position[k] = x, velocity[k] = v, acceleration[k] = a, initial_position[k] = x0;
     density[k] = rho, pressure[k] = p, mass[k] = m, id[k] = ident;
   }
+}
+
+template <int D, std::floating_point R>
+void ParticleSet<D, R>::save(StateWriter& out) const {
+  out.put(next_id_);
+  out.put(position);
+  out.put(velocity);
+  out.put(acceleration);
+  out.put(initial_position);
+  out.put(density);
+  out.put(pressure);
+  out.put(mass);
+  out.put(id);
+}
+
+template <int D, std::floating_point R>
+void ParticleSet<D, R>::load(StateReader& in) {
+  in.get(next_id_);
+  in.get(position);
+  in.get(velocity);
+  in.get(acceleration);
+  in.get(initial_position);
+  in.get(density);
+  in.get(pressure);
+  in.get(mass);
+  in.get(id);
+  const std::size_t n = position.size();
+  in.expect(velocity.size() == n && acceleration.size() == n && initial_position.size() == n &&
+                density.size() == n && pressure.size() == n && mass.size() == n && id.size() == n,
+            "particle fields of different lengths");
+  for (std::uint64_t i : id) in.expect(i < next_id_, "a particle id at or above the next id");
 }
 
 template class ParticleSet<2, float>;

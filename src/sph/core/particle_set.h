@@ -9,6 +9,9 @@
 
 namespace sph {
 
+class StateWriter;
+class StateReader;
+
 /// Structure of arrays holding all per-particle state. This is the only place that resizes,
 /// appends and permutes particle data: a field added here is carried through every operation.
 ///
@@ -46,6 +49,12 @@ class ParticleSet {
   /// perm must be a permutation of [0, size()). Works in place, following the permutation's
   /// cycles: no copy of the fields, and no allocation once it has run at this size.
   void permute(std::span<const std::uint32_t> perm);
+
+  /// Writes every field and the next id (checkpoints).
+  void save(StateWriter& out) const;
+  /// Replaces every field and the next id with what save() wrote. Throws sph::Error if the
+  /// data is inconsistent (fields of different lengths, an id not below the next id).
+  void load(StateReader& in);
 
  private:
   std::uint64_t next_id_ = 0;

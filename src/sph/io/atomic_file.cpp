@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <system_error>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <sph/core/error.h>
@@ -31,15 +32,29 @@ AtomicFile::~AtomicFile() {
   }
 }
 
-void AtomicFile::commit() {
+namespace {
+/// fsync of a file or directory by path; false if it failed.
+bool sync_path(const std::filesystem::path& path, int flags) {
+  const int fd = ::open(path.c_str(), flags | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool ok = ::fsync(fd) == 0;
+  return ::close(fd) == 0 && ok;
+}
+}  // namespace
+
+void AtomicFile::commit(bool sync) {
   out_.flush();
   const bool ok = static_cast<bool>(out_);
   out_.close();
   if (!ok || out_.fail()) throw Error("writing failed (disk full?)", path_.string());
+  if (sync && !sync_path(tmp_, O_RDONLY)) throw Error("cannot flush the file to disk", path_.string());
   std::error_code ec;
   std::filesystem::rename(tmp_, path_, ec);
   if (ec) throw Error("cannot rename the finished file into place: " + ec.message(), path_.string());
   committed_ = true;
+  const std::filesystem::path parent = path_.has_parent_path() ? path_.parent_path() : ".";
+  if (sync && !sync_path(parent, O_RDONLY | O_DIRECTORY))
+    throw Error("cannot flush the directory to disk", parent.string());
 }
 
 void write_file_atomic(const std::filesystem::path& path, std::string_view content) {

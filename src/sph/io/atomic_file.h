@@ -21,7 +21,9 @@ class AtomicFile {
   std::ofstream& stream() { return out_; }
   void write(std::string_view bytes) { out_.write(bytes.data(), static_cast<std::streamsize>(bytes.size())); }
   /// Flushes, closes and renames the temporary file to the final path; throws sph::Error on failure.
-  void commit();
+  /// With `sync`, the data reaches the disk (fsync) before the rename, and the rename before
+  /// commit() returns (fsync of the directory): the file survives a power cut whole (checkpoints).
+  void commit(bool sync = false);
 
  private:
   std::filesystem::path path_, tmp_;

@@ -1,12 +1,14 @@
 #include <sph/io/run_output.h>
 
 #include <cstdlib>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
+#include <sph/core/state_stream.h>
 #include <sph/core/timer.h>
 #include <sph/core/version.h>
 #include <sph/io/atomic_file.h>
@@ -15,17 +17,57 @@ namespace sph {
 
 namespace fs = std::filesystem;
 
-void prepare_output_directory(const fs::path& dir) {
+namespace {
+
+/// Checks that files can be created in dir and dir/frames (creating them if needed).
+void check_writable(const fs::path& dir) {
   std::error_code ec;
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
     throw Error("exists and is not a directory; expected a directory for the run's output", dir.string());
   fs::create_directories(dir / "frames", ec);
   if (ec) throw Error("cannot create the output directory: " + ec.message(), dir.string());
-  // Check that files can be created here before anything else is touched.
   { AtomicFile probe(dir / ".write-test"); }
   { AtomicFile probe(dir / "frames" / ".write-test"); }
+}
+
+/// Removes AtomicFile's temporary files (".NAME.tmpPID-N") that a killed process left in `dir`.
+void remove_stale_temporaries(const fs::path& dir) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string f = entry.path().filename().string();
+    const std::size_t tmp = f.rfind(".tmp");
+    if (f.empty() || f[0] != '.' || tmp == std::string::npos || !entry.is_regular_file(ec)) continue;
+    const std::string tail = f.substr(tmp + 4);  // "PID-N"
+    const std::size_t dash = tail.find('-');
+    const auto digits = [](const std::string& t) {
+      return !t.empty() && t.find_first_not_of("0123456789") == std::string::npos;
+    };
+    if (dash != std::string::npos && digits(tail.substr(0, dash)) && digits(tail.substr(dash + 1)))
+      fs::remove(entry.path(), ec);
+  }
+}
+
+}  // namespace
+
+void prepare_resume_directory(const fs::path& dir) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    throw Error("no such directory; expected the output directory of an earlier run (sph run -o DIR)",
+                dir.string());
+  check_writable(dir);
+  remove_stale_temporaries(dir);
+  remove_stale_temporaries(dir / "frames");
+}
+
+void prepare_output_directory(const fs::path& dir) {
+  std::error_code ec;
+  // Check that files can be created here before anything else is touched.
+  check_writable(dir);
+  remove_stale_temporaries(dir);
+  remove_stale_temporaries(dir / "frames");
   // Remove what a previous run left, so that frames of two runs are never mixed.
-  for (const char* name : {"frames.pvd", "stats.csv", "summary.json", "scene.json"}) fs::remove(dir / name, ec);
+  for (const char* name : {"frames.pvd", "stats.csv", "summary.json", "scene.json", "checkpoint.sphc"})
+    fs::remove(dir / name, ec);
   for (const auto& entry : fs::directory_iterator(dir / "frames", ec)) {
     const std::string f = entry.path().filename().string();
     if (f.rfind("frame_", 0) == 0 && entry.path().extension() == ".vtu") fs::remove(entry.path(), ec);
@@ -34,8 +76,10 @@ void prepare_output_directory(const fs::path& dir) {
 
 template <int D, std::floating_point R>
 RunOutput<D, R>::RunOutput(fs::path dir, const SceneDesc& desc, RunInfo info)
-    : dir_(std::move(dir)), desc_(desc), info_(std::move(info)) {
-  stats_tmp_ = dir_ / ".stats.csv.partial";
+    : dir_(std::move(dir)), desc_(desc), info_(std::move(info)), stats_tmp_(dir_ / ".stats.csv.partial") {}
+
+template <int D, std::floating_point R>
+void RunOutput<D, R>::open_stats() {
   stats_.open(stats_tmp_, std::ios::trunc);
   if (!stats_) throw Error("cannot create stats.csv", dir_.string());
   stats_ << kStatsColumns << '\n';
@@ -43,7 +87,7 @@ RunOutput<D, R>::RunOutput(fs::path dir, const SceneDesc& desc, RunInfo info)
 
 template <int D, std::floating_point R>
 RunOutput<D, R>::~RunOutput() {
-  if (!finished_) {
+  if (!finished_ && stats_.is_open()) {
     stats_.close();
     std::error_code ec;
     fs::rename(stats_tmp_, dir_ / "stats.csv", ec);
@@ -61,9 +105,101 @@ void RunOutput<D, R>::write_frame(const Simulation<D, R>& sim) {
 template <int D, std::floating_point R>
 void RunOutput<D, R>::begin(const Simulation<D, R>& sim) {
   Stopwatch w;
+  open_stats();
   write_file_atomic(dir_ / "scene.json", desc_.effective_json + "\n");
   if (desc_.output_every_steps > 0) write_frame(sim);
   output_seconds_ += w.lap();
+}
+
+namespace {
+
+/// The complete rows of a stats file whose step (first column) is below `steps`, and their count.
+std::pair<std::string, std::int64_t> stats_rows_before(const fs::path& file, std::int64_t steps) {
+  std::ifstream in(file);
+  std::string line, rows;
+  std::int64_t count = 0;
+  if (!std::getline(in, line) || line != kStatsColumns) return {};  // another header: not ours
+  std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::size_t begin = 0;
+  for (std::size_t end; (end = all.find('\n', begin)) != std::string::npos; begin = end + 1) {
+    const std::string row = all.substr(begin, end - begin + 1);  // only whole lines
+    std::int64_t step = -1;
+    std::istringstream(row.substr(0, row.find(','))) >> step;
+    if (step != count || step >= steps) break;  // rows are consecutive steps from 0
+    rows += row;
+    ++count;
+  }
+  return {rows, count};
+}
+
+}  // namespace
+
+template <int D, std::floating_point R>
+std::string RunOutput<D, R>::resume(const Simulation<D, R>& sim, StateReader& in) {
+  Stopwatch w;
+  const std::size_t frames = in.count(sizeof(double));
+  pvd_.resize(frames);
+  for (PvdEntry& e : pvd_) {
+    in.get(e.time);
+    in.get(e.file);
+  }
+  in.get(totals_);
+  in.get(totals_lists_rebuilt_);
+  in.get(audit_);
+  in.get(audit_steps_with_misses_);
+  in.get(output_seconds_);
+  in.get(earlier_wall_seconds_);
+  in.get(resumed_at_);
+  in.get(last_checkpoint_step_);
+  const std::int64_t steps = sim.steps_done();
+  resumed_at_.push_back(steps);
+  write_file_atomic(dir_ / "scene.json", desc_.effective_json + "\n");
+
+  // Frames the interrupted run wrote after the checkpoint: the resumed run writes them again.
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir_ / "frames", ec)) {
+    const std::string f = entry.path().filename().string();
+    unsigned index = 0;
+    if (std::sscanf(f.c_str(), "frame_%u.vtu", &index) == 1 && index >= pvd_.size()) fs::remove(entry.path(), ec);
+  }
+  if (!pvd_.empty()) write_pvd(dir_ / "frames.pvd", pvd_);
+  fs::remove(dir_ / "summary.json", ec);
+
+  // Stats rows of the steps before the checkpoint: from the partial file of a killed run if it
+  // has them all, else from stats.csv (an interrupted run renames its partial file there).
+  auto [rows, count] = stats_rows_before(stats_tmp_, steps);
+  if (count < steps) {
+    auto [rows2, count2] = stats_rows_before(dir_ / "stats.csv", steps);
+    if (count2 > count) rows = std::move(rows2), count = count2;
+  }
+  open_stats();
+  stats_ << rows;
+  output_seconds_ += w.lap();
+  if (count < steps)
+    return fmt::format("stats.csv held only the first {} of the {} steps before the checkpoint; the rows of "
+                       "steps {} to {} are missing from it",
+                       count, steps, count, steps - 1);
+  return {};
+}
+
+template <int D, std::floating_point R>
+void RunOutput<D, R>::save_state(StateWriter& out, const Simulation<D, R>& sim, double wall_seconds) {
+  stats_.flush();
+  if (!stats_) throw Error("writing stats.csv failed (disk full?)", dir_.string());
+  out.put(static_cast<std::uint64_t>(pvd_.size()));
+  for (const PvdEntry& e : pvd_) {
+    out.put(e.time);
+    out.put(e.file);
+  }
+  out.put(totals_);
+  out.put(totals_lists_rebuilt_);
+  out.put(audit_);
+  out.put(audit_steps_with_misses_);
+  out.put(output_seconds_);
+  out.put(earlier_wall_seconds_ + wall_seconds);
+  out.put(resumed_at_);
+  last_checkpoint_step_ = sim.steps_done();
+  out.put(last_checkpoint_step_);
 }
 
 template <int D, std::floating_point R>
@@ -122,7 +258,9 @@ void RunOutput<D, R>::finish(const Simulation<D, R>& sim, const std::string& sta
   s["time_step"] = sim.params().time_step;
   s["particles"] = sim.particles().size();
   s["frames"] = pvd_.size();
-  s["wall_seconds"] = wall_seconds;
+  s["wall_seconds"] = earlier_wall_seconds_ + wall_seconds;
+  if (!resumed_at_.empty()) s["resumed_at_steps"] = resumed_at_;
+  if (last_checkpoint_step_ >= 0) s["last_checkpoint_step"] = last_checkpoint_step_;
   s["phase_seconds"] = {{"grid", totals_.grid},     {"lists", totals_.lists},         {"density", totals_.density},
                         {"forces", totals_.forces}, {"integrate", totals_.integrate}, {"output", output_seconds_}};
   s["lists_rebuilt"] = totals_lists_rebuilt_;

@@ -6,6 +6,7 @@
 ///   DIR/stats.csv              one row per step (see kStatsColumns)
 ///   DIR/summary.json           written at the end: scene, mode, steps, timings, status
 ///   DIR/scene.json             the effective scene (after --set overrides)
+///   DIR/checkpoint.sphc        the latest checkpoint (see checkpoint.h), if one was written
 /// Every file appears whole or not at all.
 
 #include <filesystem>
@@ -36,6 +37,11 @@ struct RunInfo {
 /// previous run left there (frames, stats, summary). Throws sph::Error naming the path.
 void prepare_output_directory(const std::filesystem::path& dir);
 
+/// For a resumed run: checks that `dir` is a directory where files can be created, and
+/// removes the temporary files a killed run may have left (never a finished file). Throws
+/// sph::Error naming the path.
+void prepare_resume_directory(const std::filesystem::path& dir);
+
 template <int D, std::floating_point R>
 class RunOutput {
  public:
@@ -43,12 +49,25 @@ class RunOutput {
   RunOutput(std::filesystem::path dir, const SceneDesc& desc, RunInfo info);
   ~RunOutput();
 
-  /// Writes frame 0 (the initial state) and scene.json.
+  /// Writes frame 0 (the initial state) and scene.json, and starts stats.csv.
   void begin(const Simulation<D, R>& sim);
+  /// Instead of begin(), continues the run that wrote a checkpoint (`sim` restored from it,
+  /// `in` positioned at what save_state() wrote): restores the frame list and the totals,
+  /// removes the frames written after the checkpoint, keeps the stats rows of the steps before
+  /// it (from stats.csv, or from the partial file a killed run left) and removes summary.json
+  /// until finish() writes it again. Returns a warning ("" if none), e.g. missing stats rows.
+  std::string resume(const Simulation<D, R>& sim, StateReader& in);
+  /// Writes the frame list and the totals for a checkpoint of `sim`, `wall_seconds` into this
+  /// session. Flushes stats.csv's partial file first, so that every row before the checkpoint
+  /// is on disk.
+  void save_state(StateWriter& out, const Simulation<D, R>& sim, double wall_seconds);
+  /// Wall seconds of the run's earlier sessions (before the checkpoint it resumed from).
+  double earlier_wall_seconds() const { return earlier_wall_seconds_; }
   /// After each step: writes a frame if one is due (every output_every_steps steps and at the
   /// last step), then the step's stats row. Returns the seconds spent writing.
   double after_step(const Simulation<D, R>& sim, const StepInfo& info, bool last);
-  /// Closes stats.csv and writes summary.json with `status` ("completed" or an error message).
+  /// Closes stats.csv and writes summary.json with `status` ("completed" or an error message);
+  /// `wall_seconds` of this session (earlier sessions of a resumed run are added).
   void finish(const Simulation<D, R>& sim, const std::string& status, double wall_seconds);
 
   std::size_t frames_written() const { return pvd_.size(); }
@@ -60,6 +79,7 @@ class RunOutput {
 
  private:
   void write_frame(const Simulation<D, R>& sim);
+  void open_stats();
 
   std::filesystem::path dir_;
   const SceneDesc& desc_;
@@ -72,6 +92,9 @@ class RunOutput {
   ListAudit audit_;  // summed missed pairs, largest penetration
   std::uint64_t audit_steps_with_misses_ = 0;
   double output_seconds_ = 0;
+  double earlier_wall_seconds_ = 0;
+  std::vector<std::int64_t> resumed_at_;  // steps this run was resumed from, in order
+  std::int64_t last_checkpoint_step_ = -1;
   bool finished_ = false;
 };
 

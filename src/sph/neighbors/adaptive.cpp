@@ -2,6 +2,7 @@
 
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
+#include <sph/core/state_stream.h>
 #include <sph/core/timer.h>
 
 namespace sph {
@@ -42,6 +43,24 @@ void AdaptiveNeighbors<D, R>::update(const ParticleSet<D, R>& particles, R /*dt*
   counters_.lists_seconds = watch.lap();
   counters_.lists_rebuilt = flagged;
   counters_.pairs_stored = lists_.entry_count();
+}
+
+template <int D, std::floating_point R>
+void AdaptiveNeighbors<D, R>::save_state(StateWriter& out) const {
+  out.put(updates_);
+  out.put(static_cast<std::uint8_t>(invalid_));
+  out.put(flags_);
+  lists_.save(out);
+}
+
+template <int D, std::floating_point R>
+void AdaptiveNeighbors<D, R>::load_state(StateReader& in, std::size_t particles) {
+  in.get(updates_);
+  invalid_ = in.get<std::uint8_t>() != 0;
+  in.get(flags_);
+  lists_.load(in);
+  in.expect(updates_ >= 0 && flags_.size() == lists_.particle_count() && flags_.size() <= particles,
+            "adaptive neighbor state does not match the particles");
 }
 
 template class AdaptiveNeighbors<2, float>;

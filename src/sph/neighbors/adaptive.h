@@ -33,6 +33,8 @@ class AdaptiveNeighbors final : public NeighborStrategy<D, R> {
   /// The next update is a full rebuild (Simulation reorders on full-rebuild steps by default,
   /// so that this costs nothing extra).
   void invalidate() override { invalid_ = true; }
+  void save_state(StateWriter& out) const override;
+  void load_state(StateReader& in, std::size_t particles) override;
 
  private:
   R radius_;

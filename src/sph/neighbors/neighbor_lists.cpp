@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include <sph/core/error.h>
+#include <sph/core/state_stream.h>
 
 namespace sph {
 
@@ -38,6 +39,31 @@ bool NeighborLists::padding_is_valid() const {
       if (chunks_[c][k] >= n) return false;
   }
   return true;
+}
+
+void NeighborLists::save(StateWriter& out) const {
+  out.put(end_);
+  for (std::size_t c = 0; c < chunks_.size(); ++c) {
+    const std::size_t last = std::min(end_.size(), (c + 1) * kChunkSize) - 1;
+    out.put(std::span<const std::uint32_t>(chunks_[c].data(), end_[last]));
+  }
+}
+
+void NeighborLists::load(StateReader& in) {
+  clear();
+  in.get(end_);
+  const std::size_t n = end_.size();
+  chunks_.resize(chunk_count(n));
+  for (std::size_t c = 0; c < chunks_.size(); ++c) {
+    const std::size_t first = c * kChunkSize, last = std::min(n, first + kChunkSize) - 1;
+    for (std::size_t i = first + 1; i <= last; ++i) in.expect(end_[i - 1] <= end_[i], "neighbor list offsets go backwards");
+    std::vector<std::uint32_t>& chunk = chunks_[c];
+    in.get(chunk);
+    in.expect(chunk.size() == end_[last], "a neighbor list chunk of the wrong length");
+    for (std::uint32_t j : chunk) in.expect(j < n, "a neighbor index out of range");
+    entries_ += chunk.size();
+    chunk.resize(chunk.size() + kPadding, 0);
+  }
 }
 
 bool operator==(const NeighborLists& a, const NeighborLists& b) {

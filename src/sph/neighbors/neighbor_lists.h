@@ -9,6 +9,9 @@
 
 namespace sph {
 
+class StateWriter;
+class StateReader;
+
 template <int D, std::floating_point R>
 class ListBuilder;
 
@@ -48,6 +51,12 @@ class NeighborLists {
 
   /// Lists given explicitly, one vector per particle (tests, brute force).
   static NeighborLists from(const std::vector<std::vector<std::uint32_t>>& lists);
+
+  /// Writes the lists (not the spare room) for a checkpoint.
+  void save(StateWriter& out) const;
+  /// Replaces the lists with what save() wrote; throws sph::Error if they are inconsistent
+  /// (an index out of range, offsets that go backwards).
+  void load(StateReader& in);
 
   /// The same lists, in the same order (storage layout and spare room do not matter).
   friend bool operator==(const NeighborLists& a, const NeighborLists& b);

@@ -10,6 +10,9 @@
 
 namespace sph {
 
+class StateWriter;
+class StateReader;
+
 /// Neighbor strategies. `standard` rebuilds every list every step (paper Section 4);
 /// `adaptive` is the paper's Algorithm 2; `verlet` keeps exact lists with a skin radius.
 enum class NeighborMode { Standard, Adaptive, Verlet, BruteForce };
@@ -60,6 +63,18 @@ class NeighborStrategy {
   /// The particles were reordered in memory: the lists refer to old indices, so the next
   /// update() rebuilds every list (and restarts whatever the strategy tracks per particle).
   virtual void invalidate() = 0;
+
+  /// Writes what the strategy carries from one update() to the next (checkpoints: lists,
+  /// flags, reference positions), so that a resumed run makes exactly the choices the
+  /// uninterrupted run would have made. Strategies that rebuild every list every step write
+  /// nothing.
+  virtual void save_state(StateWriter& out) const { (void)out; }
+  /// Restores what save_state() wrote, for a set of `particles` particles. Throws sph::Error
+  /// if the data does not fit.
+  virtual void load_state(StateReader& in, std::size_t particles) {
+    (void)in;
+    (void)particles;
+  }
 };
 
 /// Creates the strategy for `mode`. Throws sph::Error for a mode this build cannot run.

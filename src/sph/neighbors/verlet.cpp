@@ -5,6 +5,7 @@
 
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
+#include <sph/core/state_stream.h>
 #include <sph/core/timer.h>
 
 namespace sph {
@@ -48,6 +49,22 @@ void VerletNeighbors<D, R>::update(const ParticleSet<D, R>& particles, R /*dt*/)
   }
   counters_.lists_seconds = watch.lap();
   counters_.pairs_stored = lists_.entry_count();
+}
+
+template <int D, std::floating_point R>
+void VerletNeighbors<D, R>::save_state(StateWriter& out) const {
+  out.put(max_disp_);
+  out.put(built_at_);
+  lists_.save(out);
+}
+
+template <int D, std::floating_point R>
+void VerletNeighbors<D, R>::load_state(StateReader& in, std::size_t particles) {
+  in.get(max_disp_);
+  in.get(built_at_);
+  lists_.load(in);
+  in.expect(built_at_.size() <= particles && lists_.particle_count() <= particles,
+            "verlet neighbor state does not match the particles");
 }
 
 template class VerletNeighbors<2, float>;

@@ -21,6 +21,8 @@ class VerletNeighbors final : public NeighborStrategy<D, R> {
   const NeighborLists& lists() const override { return lists_; }
   const NeighborCounters& counters() const override { return counters_; }
   void invalidate() override { built_at_.clear(); }  // the next update rebuilds
+  void save_state(StateWriter& out) const override;
+  void load_state(StateReader& in, std::size_t particles) override;
 
   R skin() const { return skin_; }
   /// Largest displacement of a particle since the last build, as measured by the last update().

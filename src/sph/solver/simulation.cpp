@@ -7,6 +7,7 @@
 
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
+#include <sph/core/state_stream.h>
 #include <sph/core/timer.h>
 #include <sph/solver/wcsph.h>
 
@@ -66,9 +67,7 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
   double extent = 0;
   for (int d = 0; d < D; ++d) extent = std::max(extent, params_.container.hi[d] - params_.container.lo[d]);
   speed_limit_ = 20.0 * std::sqrt(params_.fluid.stiffness) + std::sqrt(2.0 * norm(params_.gravity) * extent);
-  std::int64_t capacity = static_cast<std::int64_t>(particles_.size());
-  for (const auto& e : params_.emitters) capacity += e.max_particles;
-  particles_.reserve(static_cast<std::size_t>(capacity));
+  reserve_for_emitters();
   // Density and pressure of the initial state, so that frame 0 shows real values. Exact lists
   // from a throwaway standard strategy: the run's own strategy starts at step 0.
   if (!particles_.empty()) {
@@ -76,6 +75,14 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
     exact->update(particles_, static_cast<R>(params_.time_step));
     compute_density_pressure(particles_, exact->lists(), static_cast<R>(params_.kernel_radius), params_.fluid);
   }
+}
+
+template <int D, std::floating_point R>
+void Simulation<D, R>::reserve_for_emitters() {
+  std::int64_t capacity = static_cast<std::int64_t>(particles_.size());
+  for (std::size_t k = 0; k < params_.emitters.size(); ++k)
+    capacity += params_.emitters[k].max_particles - (k < emitters_.size() ? emitters_[k].emitted : 0);
+  particles_.reserve(static_cast<std::size_t>(capacity));
 }
 
 template <int D, std::floating_point R>
@@ -249,6 +256,32 @@ void Simulation<D, R>::perturb_positions(std::size_t first, double amplitude, st
     dir *= amplitude / std::sqrt(len2);
     particles_.position[i] += vec_cast<R>(dir);
   }
+}
+
+template <int D, std::floating_point R>
+void Simulation<D, R>::save_state(StateWriter& out) const {
+  out.put(static_cast<std::uint8_t>(params_.neighbors));
+  out.put(steps_);
+  out.put(emitters_);
+  particles_.save(out);
+  neighbors_->save_state(out);
+}
+
+template <int D, std::floating_point R>
+void Simulation<D, R>::load_state(StateReader& in) {
+  in.expect(in.get<std::uint8_t>() == static_cast<std::uint8_t>(params_.neighbors),
+            "written in another neighbor mode");
+  in.get(steps_);
+  in.expect(steps_ >= 0, "a negative step count");
+  in.get(emitters_);
+  in.expect(emitters_.size() == params_.emitters.size(), "a different number of emitters");
+  for (std::size_t k = 0; k < emitters_.size(); ++k)
+    in.expect(emitters_[k].emitted >= 0 && emitters_[k].emitted <= params_.emitters[k].max_particles,
+              "an emitter's count out of range");
+  particles_.load(in);
+  neighbors_->load_state(in, particles_.size());
+  reserve_for_emitters();
+  info_ = StepInfo{};
 }
 
 template class Simulation<2, float>;

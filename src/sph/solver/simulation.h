@@ -87,8 +87,18 @@ class Simulation {
   /// differ by round-off drift apart (the chaos floor of `sph compare`).
   void perturb_positions(std::size_t first, double amplitude, std::uint64_t seed);
 
+  /// Writes the complete state for a checkpoint: steps done, every particle field and id,
+  /// emitter progress, and the neighbor strategy's state (lists and flags). There is no random
+  /// state: nothing in a step draws random numbers.
+  void save_state(StateWriter& out) const;
+  /// Replaces the state with what save_state() wrote (by a simulation of the same scene and
+  /// mode): the following steps are bitwise identical to those of the simulation that wrote
+  /// it. Throws sph::Error if the data does not fit this simulation.
+  void load_state(StateReader& in);
+
  private:
   std::size_t emit();
+  void reserve_for_emitters();
   /// Integrates (symplectic Euler) and checks every value: throws on a blow-up.
   void integrate_and_check(R dt);
 

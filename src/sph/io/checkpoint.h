@@ -1,0 +1,72 @@
+#pragma once
+/// \file Checkpoints: the complete state of a run in one file, DIR/checkpoint.sphc, from which
+/// `sph run --resume DIR` continues bitwise identically to a run that was never interrupted.
+///
+/// Layout (docs/reliability.md):
+///   header   8 bytes "SPHCKPT" + NUL, u32 format version, u32 byte-order mark 0x01020304
+///   payload  written by StateWriter: sph version, dimension, precision, step, the effective
+///            scene (JSON text) and its file name, the audit flag, --checkpoint-every, Simulation::save_state, RunOutput::save_state
+///   trailer  u64 payload length, u64 payload checksum (Checksum), 8 bytes "SPHCKEND"
+/// The file is written under a temporary name, synced to disk and renamed over the previous
+/// checkpoint: at any moment the directory holds the old checkpoint or the new one, whole.
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include <sph/io/run_output.h>
+#include <sph/scene/scene_desc.h>
+#include <sph/solver/simulation.h>
+
+namespace sph {
+
+/// The format version this build writes and reads.
+inline constexpr std::uint32_t kCheckpointVersion = 1;
+/// The checkpoint's file name in a run's output directory.
+inline constexpr const char* kCheckpointFile = "checkpoint.sphc";
+
+/// Writes the checkpoint of a run (its simulation and its output's frame list and totals) to
+/// DIR/checkpoint.sphc, replacing the previous one atomically. Throws sph::Error on I/O failure
+/// (the previous checkpoint is then kept).
+/// `checkpoint_every` (the run's --checkpoint-every, 0 if none) is recorded, so that a resumed
+/// run goes on writing checkpoints as often.
+template <int D, std::floating_point R>
+void write_checkpoint(const std::filesystem::path& dir, const SceneDesc& desc, const Simulation<D, R>& sim,
+                      RunOutput<D, R>& output, double wall_seconds, std::int64_t checkpoint_every);
+
+/// What a checkpoint says about the run before its state.
+struct CheckpointHeader {
+  std::string sph_version;  ///< version of the sph that wrote it
+  int dimension = 0;
+  Precision precision = Precision::Double;
+  std::int64_t step = 0;   ///< steps done when it was written
+  std::string scene_json;    ///< the effective scene of the run
+  std::string scene_source;  ///< the scene file the run started from
+  bool audit = false;        ///< the run audits its lists (sph run --audit)
+  std::int64_t checkpoint_every = 0;  ///< the run's --checkpoint-every (0: none)
+};
+
+/// An open checkpoint. The constructor refuses, with an sph::Error naming the file and what is
+/// wrong, a missing file, a file that is not a checkpoint, another format version or byte
+/// order, a truncated file and a checksum mismatch; then it reads the header.
+class CheckpointReader {
+ public:
+  explicit CheckpointReader(std::filesystem::path file);
+  ~CheckpointReader();
+  const CheckpointHeader& header() const { return header_; }
+  /// Restores `sim` (made from header().scene_json) and `output` (not begun), then checks that
+  /// the whole payload was read. Returns RunOutput::resume's warning ("" if none).
+  template <int D, std::floating_point R>
+  std::string restore(Simulation<D, R>& sim, RunOutput<D, R>& output);
+
+ private:
+  std::filesystem::path file_;
+  std::ifstream in_;
+  std::uint64_t payload_ = 0, checksum_ = 0;
+  std::unique_ptr<StateReader> reader_;
+  CheckpointHeader header_;
+};
+
+}  // namespace sph

@@ -161,16 +161,17 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesyste
 
 /// `sph run --resume DIR`: continues the run whose checkpoint is in DIR.
 int resume(RunOptions opt) {
-  const char* conflict = !opt.scene.empty()     ? "a SCENE file"
-                         : !opt.output.empty()  ? "-o/--output"
-                         : !opt.sets.empty()    ? "--set"
+  const char* conflict = !opt.scene.empty()       ? "a SCENE file"
+                         : !opt.output.empty()    ? "-o/--output"
+                         : !opt.sets.empty()      ? "--set"
                          : !opt.neighbors.empty() ? "--neighbors"
-                         : opt.audit            ? "--audit"
-                                                : nullptr;
+                         : opt.audit              ? "--audit"
+                                                  : nullptr;
   if (conflict)
-    throw Error(fmt::format("--resume continues a run with the scene and settings it started with; {} cannot be "
-                            "given with it (allowed: --steps, --threads, --checkpoint-every, --no-progress)",
-                            conflict));
+    throw Error(
+        fmt::format("--resume continues a run with the scene and settings it started with; {} cannot be "
+                    "given with it (allowed: --steps, --threads, --checkpoint-every, --no-progress)",
+                    conflict));
   const std::filesystem::path dir(opt.resume);
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec))
@@ -205,7 +206,8 @@ int resume(RunOptions opt) {
 int run(const RunOptions& opt) {
   if (!opt.resume.empty()) return resume(opt);
   if (opt.scene.empty())
-    throw Error("sph run needs a scene file: sph run SCENE.json (or --resume DIR to continue a run); see sph run --help");
+    throw Error(
+        "sph run needs a scene file: sph run SCENE.json (or --resume DIR to continue a run); see sph run --help");
   std::vector<std::string> sets = opt.sets;
   if (!opt.neighbors.empty()) sets.push_back("Configuration.neighbors=\"" + opt.neighbors + "\"");
   if (opt.steps > 0) sets.push_back("Configuration.numberOfSteps=" + std::to_string(opt.steps));

@@ -22,8 +22,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using sph::test::CommandResult;
-using sph::test::SphProcess;
 using sph::test::slurp;
+using sph::test::SphProcess;
 using sph::test::TempDir;
 
 const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
@@ -68,8 +68,7 @@ class Resume : public testing::Test {
     std::sort(names_b.begin(), names_b.end());
     ASSERT_EQ(names, names_b);
     ASSERT_GE(names.size(), 2u);
-    for (const auto& n : names)
-      EXPECT_TRUE(slurp(a / "frames" / n) == slurp(b / "frames" / n)) << n << " differs";
+    for (const auto& n : names) EXPECT_TRUE(slurp(a / "frames" / n) == slurp(b / "frames" / n)) << n << " differs";
     EXPECT_EQ(slurp(a / "frames.pvd"), slurp(b / "frames.pvd"));
   }
 
@@ -94,9 +93,9 @@ TEST_F(Resume, CheckpointEveryThenResumeGivesTheFramesOfAnUninterruptedRun) {
   for (const std::string mode : {"adaptive", "verlet", "standard"}) {
     SCOPED_TRACE(mode);
     const std::string full = "full_" + mode, part = "part_" + mode;
-    ASSERT_EQ(sph({"run", kTank, "--neighbors", mode, "--steps", "300", "--threads", "2", "--no-progress", "-o", full})
-                  .code,
-              0);
+    ASSERT_EQ(
+        sph({"run", kTank, "--neighbors", mode, "--steps", "300", "--threads", "2", "--no-progress", "-o", full}).code,
+        0);
     CommandResult r = sph({"run", kTank, "--neighbors", mode, "--steps", "150", "--threads", "2", "--no-progress",
                            "--checkpoint-every", "40", "-o", part});
     ASSERT_EQ(r.code, 0) << r.err;
@@ -182,9 +181,9 @@ TEST_F(Resume, KillNineAtAnyMomentLeavesOnlyWholeFilesAndTheRunResumes) {
     ASSERT_EQ(r.code, 0) << r.err;
     for (const auto& e : fs::directory_iterator(at(dir)))
       EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << "stale temporary " << e.path();
-    ASSERT_EQ(sph({"run", kDamBreak, "--neighbors", "verlet", "--steps", total, "--no-progress", "-o", dir + "full"})
-                  .code,
-              0);
+    ASSERT_EQ(
+        sph({"run", kDamBreak, "--neighbors", "verlet", "--steps", total, "--no-progress", "-o", dir + "full"}).code,
+        0);
     expect_same_frames(at(dir + "full"), at(dir));
   }
 }
@@ -192,7 +191,8 @@ TEST_F(Resume, KillNineAtAnyMomentLeavesOnlyWholeFilesAndTheRunResumes) {
 // --- Mistakes -------------------------------------------------------------------------------
 
 TEST_F(Resume, MistakesAreRefusedWithOneMessageAndExitCode2) {
-  ASSERT_EQ(sph({"run", kDamBreak, "--steps", "20", "--checkpoint-every", "10", "--no-progress", "-o", "done"}).code, 0);
+  ASSERT_EQ(sph({"run", kDamBreak, "--steps", "20", "--checkpoint-every", "10", "--no-progress", "-o", "done"}).code,
+            0);
   ASSERT_EQ(sph({"run", kDamBreak, "--steps", "5", "--no-progress", "-o", "nock"}).code, 0);
   const std::string before = slurp(at("done") / "summary.json");
   struct Case {

@@ -123,9 +123,9 @@ TEST(ParticleSetState, RoundTripsEveryFieldAndTheNextId) {
 TEST(ParticleSetState, RefusesFieldsOfDifferentLengths) {
   std::stringstream buf;
   StateWriter w(buf);
-  w.put(std::uint64_t{2});                       // next id
-  w.put(std::vector<Vec<2, double>>(2));         // position
-  w.put(std::vector<Vec<2, double>>(1));         // velocity: one short
+  w.put(std::uint64_t{2});                // next id
+  w.put(std::vector<Vec<2, double>>(2));  // position
+  w.put(std::vector<Vec<2, double>>(1));  // velocity: one short
   for (int k = 0; k < 2; ++k) w.put(std::vector<Vec<2, double>>(2));
   for (int k = 0; k < 3; ++k) w.put(std::vector<double>(2));
   w.put(std::vector<std::uint64_t>{0, 1});

@@ -32,9 +32,9 @@ struct ThreadCount {
 };
 
 SceneDesc scene(const std::string& file, const std::string& mode, const std::string& precision, int steps) {
-  return read_scene_file(file, {"Configuration.neighbors=\"" + mode + "\"",
-                                "Configuration.precision=\"" + precision + "\"",
-                                "Configuration.numberOfSteps=" + std::to_string(steps)});
+  return read_scene_file(file,
+                         {"Configuration.neighbors=\"" + mode + "\"", "Configuration.precision=\"" + precision + "\"",
+                          "Configuration.numberOfSteps=" + std::to_string(steps)});
 }
 
 /// Runs desc for `stop` steps writing a checkpoint, resumes it in a new simulation with another

@@ -1,7 +1,9 @@
 // A corpus of realistic user mistakes: every tests/scene/bad/NAME.json holds one mistake and
-// must be refused with an sph::Error (never another exception, never accepted). NAME.expect lists
-// what the message must say: one substring per non-empty line, all required (a sidecar file,
-// because the strict reader refuses any extra key in the scene itself).
+// must be refused (by the reader, or when the simulation is built from it) with an sph::Error
+// (never another exception, never accepted). NAME.expect lists what the message must say: one
+// substring per non-empty line, all required (a sidecar file, because the strict reader
+// refuses any extra key in the scene itself). tests/app/bad_input_test.cpp gives every file to
+// `sph run` too.
 
 #include <algorithm>
 #include <cctype>
@@ -14,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include <sph/core/error.h>
+#include <sph/scene/builders.h>
 #include <sph/scene/scene_reader.h>
 
 namespace {
@@ -66,11 +69,18 @@ TEST_P(BadScene, IsRefusedWithTheExpectedMessage) {
   const auto expected = expected_substrings(kBadDir / (GetParam() + ".expect"));
   ASSERT_FALSE(expected.empty());
   try {
-    sph::read_scene_file(scene.string());
+    // Refused by the reader, or else when the particles are built (as `sph run` does).
+    const sph::SceneDesc desc = sph::read_scene_file(scene.string());
+    const bool f = desc.precision == sph::Precision::Float;
+    if (desc.dimension == 2)
+      f ? (void)sph::make_simulation<2, float>(desc) : (void)sph::make_simulation<2, double>(desc);
+    else
+      f ? (void)sph::make_simulation<3, float>(desc) : (void)sph::make_simulation<3, double>(desc);
     FAIL() << scene << " was accepted";
   } catch (const sph::Error& e) {
     const std::string what = e.what();
-    for (const auto& s : expected) EXPECT_NE(what.find(s), std::string::npos) << "expected \"" << s << "\" in: " << what;
+    for (const auto& s : expected)
+      EXPECT_NE(what.find(s), std::string::npos) << "expected \"" << s << "\" in: " << what;
   } catch (const std::exception& e) {
     FAIL() << scene << " threw " << typeid(e).name() << " instead of sph::Error: " << e.what();
   }

@@ -5,6 +5,9 @@
 #include <cstdio>
 #include <random>
 
+#include <algorithm>
+#include <limits>
+
 #include <gtest/gtest.h>
 
 #include <sph/core/error.h>
@@ -213,6 +216,31 @@ TEST(Simulation, BlowUpIsReportedWithStepAndParticle) {
     EXPECT_NE(m.find("step 0"), std::string::npos) << m;
     EXPECT_NE(m.find("particle id 0"), std::string::npos) << m;
     EXPECT_NE(m.find("speed"), std::string::npos) << m;
+  }
+}
+
+TEST(Simulation, NonFiniteValuesAreReportedInTheStepTheyAppear) {
+  SimulationParams<2> p = water_params<2>(0.01);
+  p.container.lo = Vec<2, double>::filled(0);
+  p.container.hi = Vec<2, double>::filled(1);
+  ParticleSet<2, double> ps;
+  ps.add({{0.5, 0.5}}, {}, p.particle_mass);
+  ps.add({{0.2, 0.2}}, {}, p.particle_mass);
+  Simulation<2, double> sim(p, std::move(ps));
+  for (int s = 0; s < 3; ++s) sim.step();
+  // A NaN appearing in particle id 1's velocity (as an overflow would leave it). Its index is
+  // looked up: the Morton reorder of step 0 may have moved it.
+  auto& ps1 = const_cast<ParticleSet<2, double>&>(sim.particles());
+  const auto at = static_cast<std::size_t>(std::find(ps1.id.begin(), ps1.id.end(), 1u) - ps1.id.begin());
+  ps1.velocity[at][0] = std::numeric_limits<double>::quiet_NaN();
+  try {
+    sim.step();
+    FAIL() << "expected a blow-up error";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("step 3"), std::string::npos) << m;
+    EXPECT_NE(m.find("particle id 1"), std::string::npos) << m;
+    EXPECT_NE(m.find("position is not finite"), std::string::npos) << m;
   }
 }
 

@@ -97,8 +97,8 @@ void ParticleSet<D, R>::load(StateReader& in) {
   in.get(mass);
   in.get(id);
   const std::size_t n = position.size();
-  in.expect(velocity.size() == n && acceleration.size() == n && initial_position.size() == n &&
-                density.size() == n && pressure.size() == n && mass.size() == n && id.size() == n,
+  in.expect(velocity.size() == n && acceleration.size() == n && initial_position.size() == n && density.size() == n &&
+                pressure.size() == n && mass.size() == n && id.size() == n,
             "particle fields of different lengths");
   for (std::uint64_t i : id) in.expect(i < next_id_, "a particle id at or above the next id");
 }

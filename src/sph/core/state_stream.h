@@ -51,12 +51,10 @@ class StateWriter {
     written_ += size;
   }
   template <class T>
-    requires std::is_trivially_copyable_v<T>
-  void put(const T& value) {
-    bytes(&value, sizeof(T));
-  }
+  requires std::is_trivially_copyable_v<T>
+  void put(const T& value) { bytes(&value, sizeof(T)); }
   template <class T>
-    requires std::is_trivially_copyable_v<T>
+  requires std::is_trivially_copyable_v<T>
   void put(std::span<const T> values) {
     put(static_cast<std::uint64_t>(values.size()));
     bytes(values.data(), values.size_bytes());
@@ -86,19 +84,16 @@ class StateReader {
 
   void bytes(void* data, std::size_t size);
   template <class T>
-    requires std::is_trivially_copyable_v<T>
-  T get() {
+  requires std::is_trivially_copyable_v<T> T get() {
     T value;
     bytes(&value, sizeof(T));
     return value;
   }
   template <class T>
-    requires std::is_trivially_copyable_v<T>
-  void get(T& value) {
-    bytes(&value, sizeof(T));
-  }
+  requires std::is_trivially_copyable_v<T>
+  void get(T& value) { bytes(&value, sizeof(T)); }
   template <class T>
-    requires std::is_trivially_copyable_v<T>
+  requires std::is_trivially_copyable_v<T>
   void get(std::vector<T>& values) {
     values.resize(count(sizeof(T)));
     bytes(values.data(), values.size() * sizeof(T));

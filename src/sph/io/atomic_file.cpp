@@ -14,8 +14,8 @@ namespace sph {
 namespace {
 std::filesystem::path temp_name(const std::filesystem::path& path) {
   static std::atomic<unsigned> counter{0};
-  return path.parent_path() / ("." + path.filename().string() + ".tmp" + std::to_string(::getpid()) + "-" +
-                               std::to_string(counter++));
+  return path.parent_path() /
+         ("." + path.filename().string() + ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
 }
 }  // namespace
 

@@ -24,8 +24,8 @@ constexpr std::uint64_t kHeaderBytes = 16, kTrailerBytes = 24;
 }  // namespace
 
 template <int D, std::floating_point R>
-void write_checkpoint(const fs::path& dir, const SceneDesc& desc, const Simulation<D, R>& sim,
-                      RunOutput<D, R>& output, double wall_seconds, std::int64_t checkpoint_every) {
+void write_checkpoint(const fs::path& dir, const SceneDesc& desc, const Simulation<D, R>& sim, RunOutput<D, R>& output,
+                      double wall_seconds, std::int64_t checkpoint_every) {
   AtomicFile file(dir / kCheckpointFile);
   std::ofstream& os = file.stream();
   os.write(kMagic.data(), kMagic.size());
@@ -55,9 +55,10 @@ CheckpointReader::CheckpointReader(fs::path file) : file_(std::move(file)) {
   const std::string where = file_.string();
   std::error_code ec;
   if (!fs::exists(file_, ec))
-    throw Error("no checkpoint here; a run writes one with --checkpoint-every N, or when it is interrupted "
-                "(Ctrl-C, SIGTERM)",
-                where);
+    throw Error(
+        "no checkpoint here; a run writes one with --checkpoint-every N, or when it is interrupted "
+        "(Ctrl-C, SIGTERM)",
+        where);
   if (!fs::is_regular_file(file_, ec)) throw Error("is not a file; expected a checkpoint file", where);
   const std::uint64_t size = fs::file_size(file_, ec);
   in_.open(file_, std::ios::binary);
@@ -85,9 +86,10 @@ CheckpointReader::CheckpointReader(fs::path file) : file_(std::move(file)) {
   in_.read(reinterpret_cast<char*>(&checksum_), sizeof checksum_);
   in_.read(end_magic.data(), end_magic.size());
   if (!in_ || end_magic != kEndMagic || payload_ != size - kHeaderBytes - kTrailerBytes)
-    throw Error("the checkpoint is truncated or was cut short while written (its end marker is missing); it cannot "
-                "be resumed",
-                where);
+    throw Error(
+        "the checkpoint is truncated or was cut short while written (its end marker is missing); it cannot "
+        "be resumed",
+        where);
   in_.seekg(static_cast<std::streamoff>(kHeaderBytes));
   {
     Checksum sum;
@@ -135,9 +137,9 @@ std::string CheckpointReader::restore(Simulation<D, R>& sim, RunOutput<D, R>& ou
   return warning;
 }
 
-#define SPH_CHECKPOINT_INSTANTIATE(D, R)                                                                        \
-  template void write_checkpoint<D, R>(const fs::path&, const SceneDesc&, const Simulation<D, R>&,           \
-                                       RunOutput<D, R>&, double, std::int64_t);                                        \
+#define SPH_CHECKPOINT_INSTANTIATE(D, R)                                                                             \
+  template void write_checkpoint<D, R>(const fs::path&, const SceneDesc&, const Simulation<D, R>&, RunOutput<D, R>&, \
+                                       double, std::int64_t);                                                        \
   template std::string CheckpointReader::restore<D, R>(Simulation<D, R>&, RunOutput<D, R>&);
 SPH_CHECKPOINT_INSTANTIATE(2, float)
 SPH_CHECKPOINT_INSTANTIATE(2, double)

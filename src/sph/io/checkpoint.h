@@ -5,7 +5,8 @@
 /// Layout (docs/reliability.md):
 ///   header   8 bytes "SPHCKPT" + NUL, u32 format version, u32 byte-order mark 0x01020304
 ///   payload  written by StateWriter: sph version, dimension, precision, step, the effective
-///            scene (JSON text) and its file name, the audit flag, --checkpoint-every, Simulation::save_state, RunOutput::save_state
+///            scene (JSON text) and its file name, the audit flag, --checkpoint-every, Simulation::save_state,
+///            RunOutput::save_state
 ///   trailer  u64 payload length, u64 payload checksum (Checksum), 8 bytes "SPHCKEND"
 /// The file is written under a temporary name, synced to disk and renamed over the previous
 /// checkpoint: at any moment the directory holds the old checkpoint or the new one, whole.
@@ -41,10 +42,10 @@ struct CheckpointHeader {
   std::string sph_version;  ///< version of the sph that wrote it
   int dimension = 0;
   Precision precision = Precision::Double;
-  std::int64_t step = 0;   ///< steps done when it was written
-  std::string scene_json;    ///< the effective scene of the run
-  std::string scene_source;  ///< the scene file the run started from
-  bool audit = false;        ///< the run audits its lists (sph run --audit)
+  std::int64_t step = 0;              ///< steps done when it was written
+  std::string scene_json;             ///< the effective scene of the run
+  std::string scene_source;           ///< the scene file the run started from
+  bool audit = false;                 ///< the run audits its lists (sph run --audit)
   std::int64_t checkpoint_every = 0;  ///< the run's --checkpoint-every (0: none)
 };
 

@@ -52,8 +52,7 @@ void remove_stale_temporaries(const fs::path& dir) {
 void prepare_resume_directory(const fs::path& dir) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec))
-    throw Error("no such directory; expected the output directory of an earlier run (sph run -o DIR)",
-                dir.string());
+    throw Error("no such directory; expected the output directory of an earlier run (sph run -o DIR)", dir.string());
   check_writable(dir);
   remove_stale_temporaries(dir);
   remove_stale_temporaries(dir / "frames");
@@ -176,9 +175,10 @@ std::string RunOutput<D, R>::resume(const Simulation<D, R>& sim, StateReader& in
   stats_ << rows;
   output_seconds_ += w.lap();
   if (count < steps)
-    return fmt::format("stats.csv held only the first {} of the {} steps before the checkpoint; the rows of "
-                       "steps {} to {} are missing from it",
-                       count, steps, count, steps - 1);
+    return fmt::format(
+        "stats.csv held only the first {} of the {} steps before the checkpoint; the rows of "
+        "steps {} to {} are missing from it",
+        count, steps, count, steps - 1);
   return {};
 }
 

@@ -56,7 +56,8 @@ void NeighborLists::load(StateReader& in) {
   chunks_.resize(chunk_count(n));
   for (std::size_t c = 0; c < chunks_.size(); ++c) {
     const std::size_t first = c * kChunkSize, last = std::min(n, first + kChunkSize) - 1;
-    for (std::size_t i = first + 1; i <= last; ++i) in.expect(end_[i - 1] <= end_[i], "neighbor list offsets go backwards");
+    for (std::size_t i = first + 1; i <= last; ++i)
+      in.expect(end_[i - 1] <= end_[i], "neighbor list offsets go backwards");
     std::vector<std::uint32_t>& chunk = chunks_[c];
     in.get(chunk);
     in.expect(chunk.size() == end_[last], "a neighbor list chunk of the wrong length");

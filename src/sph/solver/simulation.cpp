@@ -269,8 +269,7 @@ void Simulation<D, R>::save_state(StateWriter& out) const {
 
 template <int D, std::floating_point R>
 void Simulation<D, R>::load_state(StateReader& in) {
-  in.expect(in.get<std::uint8_t>() == static_cast<std::uint8_t>(params_.neighbors),
-            "written in another neighbor mode");
+  in.expect(in.get<std::uint8_t>() == static_cast<std::uint8_t>(params_.neighbors), "written in another neighbor mode");
   in.get(steps_);
   in.expect(steps_ >= 0, "a negative step count");
   in.get(emitters_);

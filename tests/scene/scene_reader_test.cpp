@@ -62,11 +62,11 @@ std::string error_of(const json& j, const std::vector<std::string>& overrides = 
   return error_of(j.dump(2), overrides);
 }
 
-#define EXPECT_CONTAINS(haystack, needle)                                                     \
-  do {                                                                                        \
-    const std::string h_ = (haystack);                                                        \
-    const std::string n_ = (needle);                                                          \
-    EXPECT_TRUE(h_.find(n_) != std::string::npos) << "expected \"" << n_ << "\" in: " << h_;      \
+#define EXPECT_CONTAINS(haystack, needle)                                                    \
+  do {                                                                                       \
+    const std::string h_ = (haystack);                                                       \
+    const std::string n_ = (needle);                                                         \
+    EXPECT_TRUE(h_.find(n_) != std::string::npos) << "expected \"" << n_ << "\" in: " << h_; \
   } while (false)
 
 // ---------------------------------------------------------------------------------------------
@@ -493,7 +493,6 @@ TEST(SceneReaderOverrides, EffectiveSceneShowsOverrides) {
   EXPECT_EQ(json::parse(text)["Fluid"]["stiffness"], 2000);
 }
 
-
 // ---------------------------------------------------------------------------------------------
 // Mistakes that once gave a crash or a misleading message; each comment says what happened
 // before the fix, each test checks the fixed behaviour.
@@ -561,6 +560,25 @@ TEST(SceneReaderRobustness, DeeplyNestedValueDoesNotCrash) {
         std::exit(1);
       },
       testing::ExitedWithCode(0), "");
+}
+
+TEST(MemoryEstimate, CountsBlocksAndEmitterBudgetsAndGrowsWithPrecisionAndSkin) {
+  const std::string dir = SPH_SOURCE_DIR "/scenes/paper/";
+  const sph::SceneDesc dam = sph::read_scene_file(dir + "dam_break_2d.json");
+  const sph::SceneDesc tank = sph::read_scene_file(dir + "tank_fill_3d.json");
+  EXPECT_EQ(sph::max_particles(dam), 3200u);
+  EXPECT_EQ(sph::max_particles(tank), 8000u) << "the tank starts empty: its emitter's budget";
+  const double d = sph::estimated_run_bytes(dam);
+  // 2D double: 4 vectors (64 bytes), 3 scalars (24), an id (8); 4 pi neighbors of 4 bytes with
+  // 1/16 room and an end offset (57); the grid's coordinates, cell and index (24): 177 bytes.
+  EXPECT_GT(d / 3200, 170.0);
+  EXPECT_LT(d / 3200, 185.0);
+  const sph::SceneDesc dam_float =
+      sph::read_scene_file(dir + "dam_break_2d.json", {"Configuration.precision=\"float\""});
+  EXPECT_LT(sph::estimated_run_bytes(dam_float), d);
+  const sph::SceneDesc dam_verlet =
+      sph::read_scene_file(dir + "dam_break_2d.json", {"Configuration.neighbors=\"verlet\""});
+  EXPECT_GT(sph::estimated_run_bytes(dam_verlet), d) << "verlet lists reach h + skin";
 }
 
 }  // namespace

@@ -69,10 +69,44 @@ Simulation<D, R> make_simulation(const SceneDesc& desc) {
   }
 }
 
+namespace {
+template <int D>
+std::size_t max_particles_of(const SceneBody<D>& body) {
+  std::size_t n = count_block_particles<D>(body);
+  for (const auto& e : body.sim.emitters) n += static_cast<std::size_t>(e.max_particles);
+  return n;
+}
+
+template <int D>
+double estimated_bytes_of(const SceneBody<D>& body, std::size_t real_bytes) {
+  const SimulationParams<D>& p = body.sim;
+  const double n = static_cast<double>(max_particles_of<D>(body));
+  double radius = p.kernel_radius;
+  if (p.neighbors == NeighborMode::Verlet)
+    radius += p.verlet_skin > 0 ? p.verlet_skin : kDefaultSkinFraction * p.kernel_radius;
+  // Lattice neighbors within the list radius: the area or volume of its ball over dx^D.
+  const double q = radius / (2.0 * p.particle_radius);
+  const double neighbors = D == 2 ? 3.14159265358979 * q * q : 4.18879020478639 * q * q * q;
+  const double fields = 4.0 * D * real_bytes + 3.0 * real_bytes + 8.0;  // 4 vectors, 3 scalars, id
+  const double lists = 4.0 * neighbors * (17.0 / 16.0) + 4.0;           // entries + spare room, end offset
+  const double grid = D * real_bytes + 8.0;                             // coordinates in cell order, cell, index
+  return n * (fields + lists + grid);
+}
+}  // namespace
+
+std::size_t max_particles(const SceneDesc& desc) {
+  return desc.dimension == 2 ? max_particles_of<2>(desc.body2) : max_particles_of<3>(desc.body3);
+}
+
+double estimated_run_bytes(const SceneDesc& desc) {
+  const std::size_t real = desc.precision == Precision::Float ? sizeof(float) : sizeof(double);
+  return desc.dimension == 2 ? estimated_bytes_of<2>(desc.body2, real) : estimated_bytes_of<3>(desc.body3, real);
+}
+
 template std::size_t count_block_particles<2>(const SceneBody<2>&);
 template std::size_t count_block_particles<3>(const SceneBody<3>&);
-#define SPH_INSTANTIATE(D, R)                                                     \
-  template ParticleSet<D, R> build_particles<D, R>(const SceneBody<D>&);          \
+#define SPH_INSTANTIATE(D, R)                                            \
+  template ParticleSet<D, R> build_particles<D, R>(const SceneBody<D>&); \
   template Simulation<D, R> make_simulation<D, R>(const SceneDesc&);
 SPH_INSTANTIATE(2, float)
 SPH_INSTANTIATE(2, double)

@@ -17,6 +17,16 @@ ParticleSet<D, R> build_particles(const SceneBody<D>& body);
 template <int D>
 std::size_t count_block_particles(const SceneBody<D>& body);
 
+/// The most particles a run of the scene holds: the blocks' plus every emitter's budget.
+std::size_t max_particles(const SceneDesc& desc);
+
+/// About how many bytes a run of the scene needs when it holds max_particles(): the particle
+/// fields, the neighbor lists (neighbors per particle from the list radius over the spacing,
+/// with the builder's 1/16 spare room) and the grid's copies of the coordinates. Within about
+/// 20 % of the peak memory `sph bench` measures (docs/performance.md); used to refuse, before
+/// allocating anything, a scene that cannot fit in the machine's memory.
+double estimated_run_bytes(const SceneDesc& desc);
+
 /// Builds the initial particles and the simulation of a scene of dimension D.
 template <int D, std::floating_point R>
 Simulation<D, R> make_simulation(const SceneDesc& desc);

@@ -26,6 +26,17 @@
 
 namespace sph::app {
 
+void check_fits_in_memory(const SceneDesc& desc) {
+  const double need = estimated_run_bytes(desc);
+  const std::int64_t have = machine_info().memory_bytes;
+  if (have > 0 && need > static_cast<double>(have))
+    throw Error(fmt::format("the scene holds up to {} particles, which need about {:.3g} GB (particle fields, "
+                            "neighbor lists, grid), more than this machine's {:.3g} GB of memory; use fewer "
+                            "particles (a larger Configuration.particleRadius, smaller blocks or emitter budgets)",
+                            max_particles(desc), need / 1e9, static_cast<double>(have) / 1e9),
+                desc.source);
+}
+
 namespace {
 
 struct RunOptions {
@@ -80,19 +91,6 @@ class StopSignals {
  private:
   struct sigaction old_int_ = {}, old_term_ = {};
 };
-
-/// Refuses, before anything is allocated, a scene whose particles cannot fit in this machine's
-/// memory (where the operating system would otherwise kill the run, or let it swap for hours).
-void check_fits_in_memory(const SceneDesc& desc) {
-  const double need = estimated_run_bytes(desc);
-  const std::int64_t have = machine_info().memory_bytes;
-  if (have > 0 && need > static_cast<double>(have))
-    throw Error(fmt::format("the scene holds up to {} particles, which need about {:.3g} GB (particle fields, "
-                            "neighbor lists, grid), more than this machine's {:.3g} GB of memory; use fewer "
-                            "particles (a larger Configuration.particleRadius, smaller blocks or emitter budgets)",
-                            max_particles(desc), need / 1e9, static_cast<double>(have) / 1e9),
-                desc.source);
-}
 
 /// Runs `desc` into `dir`: a new run, or (with `checkpoint`) the continuation of the run that
 /// wrote it.

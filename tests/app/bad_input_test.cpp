@@ -82,14 +82,17 @@ TEST(BadInputThroughTheProgram, OutputPathsNobodyCanWriteAreRefusedBeforeRunning
 TEST(BadInputThroughTheProgram, AParticleCountBeyondTheMachinesMemoryIsRefusedBeforeAllocating) {
   // 1.18e9 particles (below the reader's 2e9 cap): about 360 GB, more than any test machine has.
   TempDir tmp;
-  const CommandResult r = sph::test::run_sph(
-      {"run", SPH_SOURCE_DIR "/scenes/paper/block_3d.json", "--set", "Configuration.particleRadius=0.00015", "--set",
-       "Configuration.kernelRadius=0.0006", "--set", "Configuration.timeStepSize=1e-6", "--no-progress", "-o", "o"},
-      tmp.path(), tmp / "e.txt");
-  EXPECT_EQ(r.code, 2) << r.err;
-  EXPECT_CONTAINS(r.err, "the scene holds up to 1183408074 particles");
-  EXPECT_CONTAINS(r.err, "GB of memory");
-  EXPECT_FALSE(fs::exists(tmp / "o"));
+  for (const std::string cmd : {"run", "compare"}) {
+    SCOPED_TRACE(cmd);
+    const CommandResult r = sph::test::run_sph(
+        {cmd, SPH_SOURCE_DIR "/scenes/paper/block_3d.json", "--set", "Configuration.particleRadius=0.00015", "--set",
+         "Configuration.kernelRadius=0.0006", "--set", "Configuration.timeStepSize=1e-6", "--no-progress", "-o", "o"},
+        tmp.path(), tmp / "e.txt");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_CONTAINS(r.err, "the scene holds up to 1183408074 particles");
+    EXPECT_CONTAINS(r.err, "GB of memory");
+    EXPECT_FALSE(fs::exists(tmp / "o"));
+  }
 }
 
 TEST(BlowUp, StopsInTheStepNamingStepParticleAndQuantityAndKeepsTheFrames) {

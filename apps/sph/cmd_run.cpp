@@ -130,7 +130,7 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesyste
       const bool last = s + 1 == desc.steps;
       out.after_step(sim, step, last);
       progress.update(s + 1 - first, step.particles);
-      if (const int sig = g_stop_signal) {
+      if (const int sig = g_stop_signal; sig != 0 && !last) {  // (a signal in the last step lets it complete)
         write_checkpoint(dir, desc, sim, out, wall.elapsed(), opt.checkpoint_every);
         progress.finish();
         const char* name = sig == SIGINT ? "SIGINT" : "SIGTERM";

@@ -24,5 +24,7 @@ std::function<int()> add_run_command(CLI::App& app);
 std::function<int()> add_compare_command(CLI::App& app);
 /// Adds `sph bench`.
 std::function<int()> add_bench_command(CLI::App& app);
+/// Adds `sph validate`.
+std::function<int()> add_validate_command(CLI::App& app);
 
 }  // namespace sph::app

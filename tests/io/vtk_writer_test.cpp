@@ -69,7 +69,7 @@ struct Vtu {
     std::uint64_t bytes = 0;
     std::memcpy(&bytes, blob.data() + a.offset(), sizeof(bytes));
     std::vector<T> v(bytes / sizeof(T));
-    std::memcpy(v.data(), blob.data() + a.offset() + sizeof(bytes), bytes);
+    if (bytes > 0) std::memcpy(v.data(), blob.data() + a.offset() + sizeof(bytes), bytes);  // (null data if empty)
     return v;
   }
 };

@@ -217,15 +217,22 @@ Image render_plot(const PlotSpec& spec, int width, int height) {
   };
   auto sy_axis = [&](double v) { return py0 + ph - (v - y_axis.lo) / (y_axis.hi - y_axis.lo) * ph; };
 
+  // Pixel coordinate of a grid line or tick: a value range that overflows (e.g. -1e308 .. 1e308)
+  // gives NaN or inf, whose conversion to int is undefined; such lines are drawn off the image.
+  const auto to_pixel = [](double p) {
+    if (!std::isfinite(p)) return -1;
+    return static_cast<int>(std::floor(std::clamp(p, -1e6, 1e6)));
+  };
+
   Image img(width, height, kWhite);
 
   // Grid (minor first so that major lines stay on top).
   for (const Tick& t : y_axis.ticks) {
-    const int y = static_cast<int>(std::floor(sy_axis(t.value)));
+    const int y = to_pixel(sy_axis(t.value));
     img.fill_rect(left, y, plot_w, 1, t.minor ? kMinorGrid : kGrid);
   }
   for (const Tick& t : x_axis.ticks) {
-    const int x = static_cast<int>(std::floor(sx(t.value)));
+    const int x = to_pixel(sx(t.value));
     img.fill_rect(x, top, 1, plot_h, kGrid);
   }
 
@@ -247,7 +254,7 @@ Image render_plot(const PlotSpec& spec, int width, int height) {
   img.draw_rect(left - 1, top - 1, plot_w + 2, plot_h + 2, kFrame);
   for (const Tick& t : y_axis.ticks) {
     if (t.minor) continue;
-    const int y = static_cast<int>(std::floor(sy_axis(t.value)));
+    const int y = to_pixel(sy_axis(t.value));
     img.fill_rect(left - 1 - kTick, y, kTick, 1, kFrame);
     if (!t.label.empty())
       draw_text(img, left - 1 - kTick - pad / 2 - text_width(t.label, ts), y - text_height(ts) * 7 / 18, t.label, kInk,
@@ -255,7 +262,7 @@ Image render_plot(const PlotSpec& spec, int width, int height) {
   }
   const int x_label_top = top + plot_h + 1 + kTick + pad / 2;
   for (const Tick& t : x_axis.ticks) {
-    const int x = static_cast<int>(std::floor(sx(t.value)));
+    const int x = to_pixel(sx(t.value));
     img.fill_rect(x, top + plot_h + 1, 1, kTick, kFrame);
     draw_text(img, x - text_width(t.label, ts) / 2, x_label_top, t.label, kInk, ts);
   }

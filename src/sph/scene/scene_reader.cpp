@@ -177,6 +177,14 @@ class ObjectReader {
   std::set<std::string> allowed_;
 };
 
+/// JSON nested deeper than this is refused: copying, comparing and writing a json value recurse
+/// once per level, so a value nested some ten thousand levels deep overflows the stack (a --set
+/// value of 20,000 levels did).
+constexpr int kMaxDepth = 64;
+
+/// The largest kernel support h accepted, in particle spacings (2 * particleRadius).
+constexpr double kMaxKernelSpacings = 10;
+
 /// Parses JSON text; syntax errors and duplicate keys name the line and column.
 json parse_json(const std::string& text, const std::string& source) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos)
@@ -184,7 +192,6 @@ json parse_json(const std::string& text, const std::string& source) {
   // Duplicate keys would silently keep the last value: refuse them.
   std::vector<std::set<std::string>> keys;
   std::string duplicate;
-  constexpr int kMaxDepth = 64;
   json::parser_callback_t cb = [&](int depth, json::parse_event_t event, json& parsed) {
     if (depth > kMaxDepth) throw Error(fmt::format("the JSON is nested more than {} levels deep", kMaxDepth), source);
     if (event == json::parse_event_t::object_start) keys.emplace_back();
@@ -219,9 +226,52 @@ json parse_json(const std::string& text, const std::string& source) {
   }
 }
 
+/// The offset of the first byte of `s` that is not part of well-formed UTF-8 (no overlong
+/// forms, no surrogates, nothing above U+10FFFF), or npos if all of `s` is well-formed.
+std::size_t invalid_utf8_at(const std::string& s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    // The length of the sequence a lead byte starts, and the range its second byte must be in
+    // (narrower after E0, ED, F0 and F4: no overlong forms, surrogates or code points > 10FFFF).
+    std::size_t len = 0;
+    unsigned char lo = 0x80, hi = 0xBF;
+    if (c >= 0xC2 && c <= 0xDF) {
+      len = 2;
+    } else if (c >= 0xE0 && c <= 0xEF) {
+      len = 3;
+      if (c == 0xE0) lo = 0xA0;
+      if (c == 0xED) hi = 0x9F;
+    } else if (c >= 0xF0 && c <= 0xF4) {
+      len = 4;
+      if (c == 0xF0) lo = 0x90;
+      if (c == 0xF4) hi = 0x8F;
+    } else {
+      return i;
+    }
+    if (len > s.size() - i) return i;
+    for (std::size_t k = 1; k < len; ++k) {
+      const auto b = static_cast<unsigned char>(s[i + k]);
+      if (b < (k == 1 ? lo : 0x80) || b > (k == 1 ? hi : 0xBF)) return i;
+    }
+    i += len;
+  }
+  return std::string::npos;
+}
+
 /// Applies "a.b[2].c=VALUE" overrides to the JSON document.
 void apply_overrides(json& doc, const std::vector<std::string>& overrides, Context& ctx) {
   for (const std::string& o : overrides) {
+    // JSON text is UTF-8: a key or a plain-string value with other bytes could never be written
+    // back out (SceneDesc::effective_json), so it is refused here, without echoing the bytes.
+    if (const std::size_t bad = invalid_utf8_at(o); bad != std::string::npos)
+      throw Error(fmt::format("expected KEY=VALUE as UTF-8 text; byte {} (0x{:02X}) is not valid UTF-8", bad,
+                              static_cast<unsigned char>(o[bad])),
+                  "--set");
     const auto eq = o.find('=');
     if (eq == std::string::npos || eq == 0)
       throw Error("expected KEY=VALUE with KEY a key path such as Fluid.stiffness, got \"" + o + "\"", "--set");
@@ -229,7 +279,12 @@ void apply_overrides(json& doc, const std::vector<std::string>& overrides, Conte
     const std::string value_text = o.substr(eq + 1);
     json value;
     try {
-      value = json::parse(value_text);
+      const json::parser_callback_t depth_limit = [&](int depth, json::parse_event_t, json&) {
+        if (depth > kMaxDepth)
+          throw Error(fmt::format("the value is nested more than {} levels deep", kMaxDepth), "--set " + key);
+        return true;
+      };
+      value = json::parse(value_text, depth_limit);
     } catch (const json::parse_error&) {
       value = value_text;  // not JSON: a plain string such as adaptive
     } catch (const json::exception& e) {
@@ -315,6 +370,12 @@ Box<D> read_box(ObjectReader& r, const char* what) {
       r.ctx().fail(r.child("end"), fmt::format("must be greater than \"start\" in every coordinate; got start {} "
                                                "and end {}",
                                                vec_text<D>(b.lo), vec_text<D>(b.hi)));
+  // Corners near +-1.8e308 would make the size itself infinite (and every count built on it).
+  for (int d = 0; d < D; ++d)
+    if (!std::isfinite(b.hi[d] - b.lo[d]))
+      r.ctx().fail(r.child("end"), fmt::format("the {} from start {} to end {} is too large: its size overflows a "
+                                               "double in some coordinate",
+                                               what, vec_text<D>(b.lo), vec_text<D>(b.hi)));
   return b;
 }
 
@@ -341,6 +402,15 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
                    fmt::format("h = {:g} m must exceed the particle spacing 2 * particleRadius = {:g} m (typical: "
                                "4 * particleRadius)",
                                sim.kernel_radius, 2 * sim.particle_radius));
+    // Work per particle grows as (h / spacing)^D: the default particle mass sums the kernel over
+    // that many lattice sites, and every list would hold that many neighbors.
+    if (sim.kernel_radius > kMaxKernelSpacings * 2.0 * sim.particle_radius)
+      c.ctx().fail(c.child("kernelRadius"),
+                   fmt::format("h = {:g} m is more than {:g} particle spacings (2 * particleRadius = {:g} m): every "
+                               "particle would have thousands of neighbors; expected at most {:g} m (typical: 4 * "
+                               "particleRadius)",
+                               sim.kernel_radius, kMaxKernelSpacings, 2 * sim.particle_radius,
+                               kMaxKernelSpacings * 2.0 * sim.particle_radius));
     sim.gravity = c.vec<D>("gravitation", "the gravity acceleration in m/s^2", default_g);
     sim.neighbors = parse_neighbor_mode(
         c.choice("neighbors", {"standard", "adaptive", "verlet", "brute_force"}, "standard"), c.child("neighbors"));
@@ -371,9 +441,18 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
     sim.fluid.pressure_force = f.choice("pressureForce", {"paper", "symmetric"}, "paper") == "symmetric"
                                    ? PressureForce::Symmetric
                                    : PressureForce::Paper;
-    const double spacing = 2.0 * sim.particle_radius;
-    sim.particle_mass = f.positive("particleMass", "a positive particle mass in kg",
-                                   lattice_mass<D>(sim.fluid.rest_density, spacing, sim.kernel_radius));
+    if (f.find("particleMass")) {
+      sim.particle_mass = f.positive("particleMass", "a positive particle mass in kg");
+    } else {
+      // Extreme scales (h^9 in the kernel's normalization) can overflow to inf or NaN.
+      sim.particle_mass = lattice_mass<D>(sim.fluid.rest_density, 2.0 * sim.particle_radius, sim.kernel_radius);
+      if (!(std::isfinite(sim.particle_mass) && sim.particle_mass > 0))
+        f.ctx().fail(f.child("particleMass"),
+                     fmt::format("the default particle mass computed from density0 = {:g}, particleRadius = {:g} and "
+                                 "kernelRadius = {:g} is {:g}; expected a positive finite mass: give particleMass or "
+                                 "use less extreme values",
+                                 sim.fluid.rest_density, sim.particle_radius, sim.kernel_radius, sim.particle_mass));
+    }
   });
 
   {
@@ -397,12 +476,17 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
       b.ctx().fail(b.child("start"), fmt::format("the block {} .. {} is not inside the container {} .. {}",
                                                  vec_text<D>(blk.box.lo), vec_text<D>(blk.box.hi),
                                                  vec_text<D>(sim.container.lo), vec_text<D>(sim.container.hi)));
+    // Each axis on its own: a product taken first could be inf * 0 = NaN, which no comparison
+    // refuses (a block far longer than 2e9 spacings one way and thinner than one the other).
     double count = 1;
-    for (int d = 0; d < D; ++d) count *= std::floor((blk.box.hi[d] - blk.box.lo[d]) / dx + 1e-9);
-    if (count < 1)
-      b.ctx().fail(b.child("end"), fmt::format("the block is thinner than one particle spacing ({:g} m) in some "
-                                               "direction, so it holds no particle",
-                                               dx));
+    for (int d = 0; d < D; ++d) {
+      const double along = std::floor((blk.box.hi[d] - blk.box.lo[d]) / dx + 1e-9);
+      if (!(along >= 1))
+        b.ctx().fail(b.child("end"), fmt::format("the block is thinner than one particle spacing ({:g} m) in some "
+                                                 "direction, so it holds no particle",
+                                                 dx));
+      count *= along;
+    }
     total += count;
     body.blocks.push_back(blk);
   });
@@ -419,7 +503,13 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
     EmitterParams<D> em;
     em.origin = e.vec<D>("translation", "the center of the emitter nozzle in m");
     Vec<D, double> dir = e.vec<D>("direction", "the emission direction (any non-zero length)");
-    if (norm(dir) <= 0) e.ctx().fail(e.child("direction"), "expected a non-zero direction vector");
+    // Scaled by its largest component first: the squared length of [1e200, 1e200, 0] overflows
+    // (1 / inf = 0 made it a zero direction: particles emitted at rest, all on the nozzle) and
+    // that of [1e-200, 0, 0] underflows to 0 (a non-zero direction refused as zero).
+    double largest = 0;
+    for (int d = 0; d < D; ++d) largest = std::max(largest, std::abs(dir[d]));
+    if (!(largest > 0)) e.ctx().fail(e.child("direction"), "expected a non-zero direction vector");
+    for (int d = 0; d < D; ++d) dir[d] /= largest;  // divided, not multiplied by 1 / largest (1 / 1e-310 = inf)
     em.direction = dir * (1.0 / norm(dir));
     em.speed = e.positive("velocity", "a positive emission speed in m/s");
     em.width = static_cast<int>(e.integer("width", "a nozzle width of 1 to 10000 particles", 1, 10000));

@@ -232,6 +232,8 @@ void integrate_symplectic_euler(ParticleSet<D, R>& ps, R dt) {
 
 template <int D>
 double lattice_mass(double rest_density, double spacing, double h) {
+  // The scene reader keeps h within 10 spacings; the sum costs (2 h / spacing)^D terms.
+  SPH_CHECK(spacing > 0 && h > 0 && h / spacing <= 1000, "lattice_mass: h / spacing out of range");
   const Poly6Kernel<D, double> poly6(h);
   const int n = static_cast<int>(std::ceil(h / spacing)) + 1;
   double sum = 0;

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "support/expect.h"
 #include "support/run_sph.h"
 
 namespace {
@@ -23,13 +24,6 @@ using sph::test::TempDir;
 
 const fs::path kBadDir = fs::path(SPH_SOURCE_DIR) / "tests" / "scene" / "bad";
 const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
-
-#define EXPECT_CONTAINS(haystack, needle)                                                     \
-  do {                                                                                        \
-    const std::string h_ = (haystack);                                                        \
-    const std::string n_ = (needle);                                                          \
-    EXPECT_TRUE(h_.find(n_) != std::string::npos) << "expected \"" << n_ << "\" in:\n" << h_; \
-  } while (false)
 
 std::vector<std::string> lines(const std::string& text) {
   std::vector<std::string> out;

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "support/expect.h"
 #include "support/run_sph.h"
 
 namespace {
@@ -28,13 +29,6 @@ std::size_t count(const std::string& text, const std::string& what) {
   for (auto pos = text.find(what); pos != std::string::npos; pos = text.find(what, pos + what.size())) ++n;
   return n;
 }
-
-#define EXPECT_CONTAINS(haystack, needle)                                                     \
-  do {                                                                                        \
-    const std::string h_ = (haystack);                                                        \
-    const std::string n_ = (needle);                                                          \
-    EXPECT_TRUE(h_.find(n_) != std::string::npos) << "expected \"" << n_ << "\" in:\n" << h_; \
-  } while (false)
 
 using Result = sph::test::CommandResult;
 

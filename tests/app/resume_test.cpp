@@ -16,6 +16,7 @@
 
 #include <sph/io/checkpoint.h>
 
+#include "support/expect.h"
 #include "support/run_sph.h"
 
 namespace {
@@ -28,13 +29,6 @@ using sph::test::TempDir;
 
 const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
 const std::string kTank = SPH_SOURCE_DIR "/scenes/paper/tank_fill_3d.json";
-
-#define EXPECT_CONTAINS(haystack, needle)                                                     \
-  do {                                                                                        \
-    const std::string h_ = (haystack);                                                        \
-    const std::string n_ = (needle);                                                          \
-    EXPECT_TRUE(h_.find(n_) != std::string::npos) << "expected \"" << n_ << "\" in:\n" << h_; \
-  } while (false)
 
 class Resume : public testing::Test {
  protected:

@@ -14,6 +14,8 @@
 #include <sph/scene/builders.h>
 #include <sph/scene/scene_reader.h>
 
+#include "support/expect.h"
+
 namespace {
 
 using json = nlohmann::json;
@@ -61,13 +63,6 @@ std::string error_of(const std::string& text, const std::vector<std::string>& ov
 std::string error_of(const json& j, const std::vector<std::string>& overrides = {}) {
   return error_of(j.dump(2), overrides);
 }
-
-#define EXPECT_CONTAINS(haystack, needle)                                                    \
-  do {                                                                                       \
-    const std::string h_ = (haystack);                                                       \
-    const std::string n_ = (needle);                                                         \
-    EXPECT_TRUE(h_.find(n_) != std::string::npos) << "expected \"" << n_ << "\" in: " << h_; \
-  } while (false)
 
 // ---------------------------------------------------------------------------------------------
 // The paper scenes

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include <sph/analysis/labels.h>
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 #include <sph/core/version.h>
@@ -195,18 +196,6 @@ CompareResult run_all(const SceneDesc& desc, const CompareOptions& opt, const Co
 }
 
 // ---- Writing ----------------------------------------------------------------------------
-
-std::string slug(const std::string& label) {
-  std::string s;
-  for (char c : label) {
-    if (std::isalnum(static_cast<unsigned char>(c)))
-      s += c;
-    else if (!s.empty() && s.back() != '_')
-      s += '_';
-  }
-  while (!s.empty() && s.back() == '_') s.pop_back();
-  return s;
-}
 
 double mean_of(const std::vector<StepRecord>& v, std::uint64_t StepRecord::*field) {
   if (v.empty()) return 0;

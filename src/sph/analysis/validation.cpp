@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include <sph/analysis/labels.h>
 #include <sph/core/error.h>
 #include <sph/core/kernels.h>
 #include <sph/core/parallel.h>
@@ -347,6 +348,29 @@ class RunProgress {
   std::int64_t steps_, shown_ = 0;
 };
 
+/// Runs `sim` for `steps` steps, calling sample() before the first, every `every` steps and
+/// after the last. A blow-up ends the run and is recorded in `failure` (the samples so far are
+/// kept). Returns the wall seconds of the run.
+template <class Sim, class Sample>
+double run_sampled(Sim& sim, std::int64_t steps, std::int64_t every, Sample&& sample,
+                   const ValidationProgress& progress, std::string label, std::string& failure) {
+  RunProgress rp(progress, std::move(label), steps);
+  Stopwatch watch;
+  sample();
+  try {
+    for (std::int64_t k = 1; k <= steps; ++k) {
+      sim.step();
+      if (k % every == 0 || k == steps) sample();
+      rp.at(k);
+    }
+  } catch (const Error& e) {
+    failure = e.what();
+  }
+  const double seconds = watch.elapsed();
+  rp.done(seconds, failure);
+  return seconds;
+}
+
 // ---- Martin & Moyce runs -----------------------------------------------------------------
 
 /// The dam break at a / `resolution` in `mode`, derived from the scene (written at some base
@@ -405,20 +429,7 @@ FrontRun run_front(const SceneDesc& desc, int resolution, const std::string& mod
         run.Z.push_back((front - p.container.lo[0]) / kMartinMoyceA);
         run.energy.push_back(energy(s, model));
       };
-      RunProgress rp(progress, case_name + ": " + run.label, desc.steps);
-      Stopwatch watch;
-      sample();
-      try {
-        for (std::int64_t k = 1; k <= desc.steps; ++k) {
-          sim.step();
-          if (k % every == 0 || k == desc.steps) sample();
-          rp.at(k);
-        }
-      } catch (const Error& e) {
-        run.failure = e.what();
-      }
-      run.seconds = watch.elapsed();
-      rp.done(run.seconds, run.failure);
+      run.seconds = run_sampled(sim, desc.steps, every, sample, progress, case_name + ": " + run.label, run.failure);
     }
   });
   // A front can be NaN at a sample (no particle with neighbors on the floor: never in practice);
@@ -477,20 +488,7 @@ HydrostaticRun run_hydrostatic(const std::filesystem::path& dir, int dimension, 
       run.surface.push_back(free_surface_height(s, run.spacing));
       run.energy.push_back(energy(s, model));
     };
-    RunProgress rp(progress, "hydrostatic: " + run.label, desc.steps);
-    Stopwatch watch;
-    sample();
-    try {
-      for (std::int64_t k = 1; k <= desc.steps; ++k) {
-        sim.step();
-        if (k % every == 0 || k == desc.steps) sample();
-        rp.at(k);
-      }
-    } catch (const Error& e) {
-      run.failure = e.what();
-    }
-    run.seconds = watch.elapsed();
-    rp.done(run.seconds, run.failure);
+    run.seconds = run_sampled(sim, desc.steps, every, sample, progress, "hydrostatic: " + run.label, run.failure);
     HydrostaticModel m;
     for (int d = 0; d < D; ++d) m.box_lo[d] = p.container.lo[d], m.box_hi[d] = p.container.hi[d];
     m.gravity = run.gravity;
@@ -549,20 +547,7 @@ MomentumRun run_momentum(const std::filesystem::path& dir, const std::string& mo
       run.drift.push_back(std::sqrt(d2) / run.scale);
       run.max_drift = std::max(run.max_drift, run.drift.back());
     };
-    RunProgress rp(progress, "conservation: momentum " + run.label, desc.steps);
-    Stopwatch watch;
-    sample();
-    try {
-      for (std::int64_t k = 1; k <= desc.steps; ++k) {
-        sim.step();
-        sample();
-        rp.at(k);
-      }
-    } catch (const Error& e) {
-      run.failure = e.what();
-    }
-    run.seconds = watch.elapsed();
-    rp.done(run.seconds, run.failure);
+    run.seconds = run_sampled(sim, desc.steps, 1, sample, progress, "conservation: momentum " + run.label, run.failure);
   });
   return run;
 }
@@ -699,18 +684,6 @@ ValidationResult run_validation(const ValidationOptions& opt, const ValidationPr
 // ---- Writing --------------------------------------------------------------------------------
 
 namespace {
-
-std::string slug(const std::string& label) {
-  std::string s;
-  for (char c : label) {
-    if (std::isalnum(static_cast<unsigned char>(c)))
-      s += c;
-    else if (!s.empty() && s.back() != '_')
-      s += '_';
-  }
-  while (!s.empty() && s.back() == '_') s.pop_back();
-  return s;
-}
 
 std::string g(double x, int digits = 3) {
   return std::isfinite(x) ? fmt::format("{:.{}g}", x, digits) : std::string("n/a");

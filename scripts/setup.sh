@@ -8,6 +8,9 @@ packages=(
   nlohmann-json3-dev libcli11-dev libfmt-dev libomp-dev
   libgtest-dev libgmock-dev libpng-dev
   python3 python3-vtk9 python3-numpy
+  # Readers and players the tests check our output with: meshio (PLY, VTK), ffmpeg/ffprobe
+  # (sph render --mp4), headless Chromium driven by Selenium through ChromeDriver (sph view).
+  python3-meshio ffmpeg chromium chromium-driver python3-selenium
   # scripts/sanitize.sh: clang, its sanitizer and libFuzzer runtimes, llvm-symbolizer for the
   # reports' stacks, and libomp with Archer (libarcher.so), which makes OpenMP visible to TSan.
   clang-14 libclang-rt-14-dev llvm-14 libomp-14-dev

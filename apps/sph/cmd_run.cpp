@@ -4,6 +4,7 @@
 #include <csignal>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,7 +51,61 @@ struct RunOptions {
   bool audit = false;
   std::int64_t checkpoint_every = 0;
   std::string resume;
+  std::optional<std::string> formats;  // --format vtu,ply
+  std::optional<std::string> fields;   // --fields velocity,density or none
+  std::optional<std::int64_t> every;   // --every N
+  std::optional<double> fps;           // --fps F
 };
+
+/// The comma-separated names of `list` as a JSON array of strings, each checked against
+/// `choices`; `none` (if given) stands for the empty list. Throws sph::Error naming `flag`.
+std::string name_list_json(const std::string& list, const std::vector<std::string>& choices, const std::string& flag,
+                           const char* none = nullptr) {
+  std::string expected;
+  for (const auto& c : choices) expected += (expected.empty() ? "" : ", ") + c;
+  if (none && list == none) return "[]";
+  std::vector<std::string> names;
+  std::size_t begin = 0;
+  while (true) {
+    const std::size_t comma = list.find(',', begin);
+    const std::string name = list.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+    if (std::find(choices.begin(), choices.end(), name) == choices.end())
+      throw Error(fmt::format("{}\"{}\" is not one of {}; expected a comma-separated list such as {},{}{}",
+                              name.empty() ? "an empty name in the list: " : "", name, expected, choices[0], choices[1],
+                              none ? fmt::format(" (or {} for none)", none) : std::string()),
+                  flag);
+    if (std::find(names.begin(), names.end(), name) != names.end())
+      throw Error("\"" + name + "\" is given twice; expected each name at most once", flag);
+    names.push_back(name);
+    if (comma == std::string::npos) break;
+    begin = comma + 1;
+  }
+  std::string json = "[";
+  for (const auto& n : names) json += (json.size() > 1 ? ",\"" : "\"") + n + "\"";
+  return json + "]";
+}
+
+/// The --set overrides that --format, --fields, --every and --fps stand for (so that they land
+/// in scene.json and in checkpoints like any scene value).
+std::vector<std::string> output_overrides(const RunOptions& opt) {
+  std::vector<std::string> sets;
+  if (opt.every && opt.fps)
+    throw Error("--every and --fps both choose when frames are written; give one of them", "--every/--fps");
+  // Each replaces the other schedule, whatever the scene chose.
+  if (opt.every)
+    sets.push_back("Configuration.outputFps=0"),
+        sets.push_back(fmt::format("Configuration.outputEveryNSteps={}", *opt.every));
+  if (opt.fps)
+    sets.push_back("Configuration.outputEveryNSteps=0"),
+        sets.push_back(fmt::format("Configuration.outputFps={}", *opt.fps));
+  if (opt.formats)
+    sets.push_back("Configuration.outputFormats=" + name_list_json(*opt.formats, {"vtu", "vtk", "ply"}, "--format"));
+  if (opt.fields)
+    sets.push_back(
+        "Configuration.outputFields=" +
+        name_list_json(*opt.fields, {std::begin(kFrameFieldNames), std::end(kFrameFieldNames)}, "--fields", "none"));
+  return sets;
+}
 
 /// `word` as one shell word: unchanged if it is plain, else in single quotes.
 std::string shell_word(const std::string& word) {
@@ -91,6 +146,22 @@ class StopSignals {
  private:
   struct sigaction old_int_ = {}, old_term_ = {};
 };
+
+/// The lines of the closing message that say where the frames are.
+std::string frames_hint(const OutputDesc& output, const std::filesystem::path& dir) {
+  std::string s;
+  for (FrameFormat f : output.formats) {
+    if (f == FrameFormat::Vtu)
+      s +=
+          fmt::format("  {}/frames.pvd   open in ParaView (Filters > Point Gaussian to see particles)\n", dir.string());
+    if (f == FrameFormat::Vtk)
+      s += fmt::format("  {}/frames/*.vtk legacy VTK frames (ParaView, VisIt, meshio)\n", dir.string());
+    if (f == FrameFormat::Ply)
+      s += fmt::format("  {}/frames/*.ply point clouds (Blender: File > Import > Stanford PLY; Houdini: File node)\n",
+                       dir.string());
+  }
+  return s;
+}
 
 /// Runs `desc` into `dir`: a new run, or (with `checkpoint`) the continuation of the run that
 /// wrote it.
@@ -158,11 +229,12 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesyste
   const std::int64_t ran = desc.steps - first;
   fmt::print(stderr,
              "sph: done: {} steps, {} particles, {:.2f} s ({:.3f} ms/step). {} {} frames.\n"
-             "  {}/frames.pvd   open in ParaView (Filters > Point Gaussian to see particles)\n"
+             "{}"
              "  {}/stats.csv    per-step energy, neighbors and phase timings\n"
              "  {}/summary.json totals\n",
              ran, sim.particles().size(), seconds, 1e3 * seconds / static_cast<double>(std::max<std::int64_t>(ran, 1)),
-             checkpoint ? "The run now has" : "Wrote", out.frames_written(), dir.string(), dir.string(), dir.string());
+             checkpoint ? "The run now has" : "Wrote", out.frames_written(), frames_hint(desc.output, dir),
+             dir.string(), dir.string());
   if (opt.audit)
     fmt::print(stderr,
                "sph: audit: {} pairs within h were missing from the lists, in {} of {} steps; the deepest miss "
@@ -179,6 +251,10 @@ int resume(RunOptions opt) {
                          : !opt.sets.empty()      ? "--set"
                          : !opt.neighbors.empty() ? "--neighbors"
                          : opt.audit              ? "--audit"
+                         : opt.formats            ? "--format"
+                         : opt.fields             ? "--fields"
+                         : opt.every              ? "--every"
+                         : opt.fps                ? "--fps"
                                                   : nullptr;
   if (conflict)
     throw Error(
@@ -222,6 +298,7 @@ int run(const RunOptions& opt) {
     throw Error(
         "sph run needs a scene file: sph run SCENE.json (or --resume DIR to continue a run); see sph run --help");
   std::vector<std::string> sets = opt.sets;
+  for (std::string& o : output_overrides(opt)) sets.push_back(std::move(o));
   if (!opt.neighbors.empty()) sets.push_back("Configuration.neighbors=\"" + opt.neighbors + "\"");
   if (opt.steps > 0) sets.push_back("Configuration.numberOfSteps=" + std::to_string(opt.steps));
   if (opt.threads > 0) set_num_threads(opt.threads);
@@ -241,7 +318,7 @@ int run(const RunOptions& opt) {
 
 std::function<int()> add_run_command(CLI::App& app) {
   auto opt = std::make_shared<RunOptions>();
-  CLI::App* cmd = app.add_subcommand("run", "Run a scene file and write frames (VTK), stats.csv and summary.json");
+  CLI::App* cmd = app.add_subcommand("run", "Run a scene file and write frames (VTK, PLY), stats.csv and summary.json");
   cmd->add_option("scene", opt->scene, "Scene file (JSON; see docs/scene-format.md); required unless --resume");
   cmd->add_option("-o,--output", opt->output, "Output directory (default: out/<scene name>)");
   cmd->add_option("--neighbors", opt->neighbors, "Neighbor strategy, overriding the scene's Configuration.neighbors")
@@ -253,6 +330,23 @@ std::function<int()> add_run_command(CLI::App& app) {
                   "Override a scene value by its key path, e.g. --set Fluid.stiffness=2000 "
                   "--set FluidBlocks[0].end=[0.5,1.0] (repeatable; VALUE is JSON or a plain string)")
       ->type_name("KEY=VALUE");
+  cmd->add_option("--format", opt->formats,
+                  "Frame formats, a comma-separated list of vtu (ParaView), vtk (legacy VTK) and ply (Blender, "
+                  "Houdini), overriding Configuration.outputFormats (default: vtu)")
+      ->type_name("LIST");
+  cmd->add_option("--fields", opt->fields,
+                  "Point fields of each frame besides the positions, a comma-separated list of velocity, density, "
+                  "pressure, id and initial_position, or none; overrides Configuration.outputFields (default: all)")
+      ->type_name("LIST");
+  cmd->add_option("--every", opt->every,
+                  "A frame every N steps (0: no frames), overriding Configuration.outputEveryNSteps and outputFps")
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{1'000'000'000'000}))
+      ->type_name("N");
+  cmd->add_option("--fps", opt->fps,
+                  "F frames per simulated second (frame k at the first step whose time reaches k / F), overriding "
+                  "Configuration.outputFps and outputEveryNSteps")
+      ->check(CLI::PositiveNumber)
+      ->type_name("F");
   cmd->add_flag("--audit", opt->audit,
                 "Check the lists every step against exact lists and record the pairs within h they miss "
                 "(stats.csv columns missed_pairs, particles_missing, max_missed_penetration; costs about one "
@@ -265,7 +359,8 @@ std::function<int()> add_run_command(CLI::App& app) {
       ->type_name("N");
   cmd->add_option("--resume", opt->resume,
                   "Continue the run in DIR from its checkpoint, bitwise identically to a run never interrupted; "
-                  "only --steps (a new total), --threads, --checkpoint-every and --no-progress may be given with it")
+                  "only --steps (a new total), --threads, --checkpoint-every and --no-progress may be given with it "
+                  "(the frame settings are the run's)")
       ->type_name("DIR");
   cmd->add_flag("--no-progress", opt->no_progress,
                 "No progress output (default: a bar with ETA on a terminal, a line every 10 % otherwise)");

@@ -2,12 +2,14 @@
 // does not do) to the output directory. Each test runs the built binary from its own temporary
 // directory.
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include <unistd.h>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -84,7 +86,8 @@ TEST_F(Cli, TopLevelHelp) {
 TEST_F(Cli, RunHelp) {
   const Result r = sph({"run", "--help"});
   EXPECT_EQ(r.code, 0) << r.err;
-  for (const char* opt : {"--neighbors", "--set", "--steps", "--threads", "--output", "--no-progress"})
+  for (const char* opt : {"--neighbors", "--set", "--steps", "--threads", "--output", "--no-progress", "--format",
+                          "--fields", "--every", "--fps"})
     EXPECT_CONTAINS(r.out, opt);
   EXPECT_CONTAINS(r.out, "Fluid.stiffness=2000");
 }
@@ -144,6 +147,77 @@ TEST_F(Cli, UnknownNeighborModeFlag) {
   EXPECT_CONTAINS(r.err, "bogus");
   EXPECT_EQ(count(r.err, "sph: error:"), 1u) << r.err;
   EXPECT_FALSE(fs::exists(work_ / "o"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Frame formats, fields and schedule
+
+TEST_F(Cli, FormatFieldsAndFpsFlagsChooseTheFrames) {
+  // dt = 1.5e-4 s, 1000 frames/s: frames at steps 0, 7, 14, 20, 27 and the last, 30.
+  const Result r = sph({"run", kDamBreak, "--steps", "30", "--format", "vtk,ply", "--fields", "velocity,id", "--fps",
+                        "1000", "--no-progress", "-o", "o"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(work_ / "o" / "frames")) files.push_back(e.path().filename().string());
+  std::sort(files.begin(), files.end());
+  std::vector<std::string> want;
+  for (int k = 0; k < 6; ++k)
+    for (const char* ext : {"ply", "vtk"}) want.push_back(fmt::format("frame_{:06d}.{}", k, ext));
+  EXPECT_EQ(files, want);
+  EXPECT_FALSE(fs::exists(work_ / "o" / "frames.pvd")) << "no .vtu frames, no ParaView collection";
+  EXPECT_CONTAINS(r.err, "Blender: File > Import > Stanford PLY");
+  EXPECT_EQ(r.err.find("frames.pvd"), std::string::npos) << r.err;
+  const std::string ply = read_file(work_ / "o" / "frames" / "frame_000003.ply");
+  EXPECT_CONTAINS(ply, fmt::format("comment time {}\n", 20 * 1.5e-4));  // step 20, as the run computes it
+  EXPECT_CONTAINS(ply, "property float vz\nproperty uint id\nend_header\n");
+  EXPECT_EQ(ply.find("density"), std::string::npos);
+  // The flags are scene overrides: scene.json and summary.json record them.
+  const auto scene = nlohmann::json::parse(read_file(work_ / "o" / "scene.json"));
+  EXPECT_EQ(scene["Configuration"]["outputFormats"], nlohmann::json({"vtk", "ply"}));
+  EXPECT_EQ(scene["Configuration"]["outputFields"], nlohmann::json({"velocity", "id"}));
+  EXPECT_EQ(scene["Configuration"]["outputFps"], 1000);
+  EXPECT_EQ(scene["Configuration"]["outputEveryNSteps"], 0) << "--fps replaces the scene's outputEveryNSteps";
+  const auto summary = nlohmann::json::parse(read_file(work_ / "o" / "summary.json"));
+  EXPECT_EQ(summary["frames"], 6);
+  EXPECT_EQ(summary["frame_formats"], nlohmann::json({"vtk", "ply"}));
+
+  // --every and --fields none: positions only, every 10 steps (0, 10, 20 and the last, 25).
+  const Result e = sph({"run", kDamBreak, "--steps", "25", "--every", "10", "--fields", "none", "--format", "ply",
+                        "--no-progress", "-o", "e"});
+  ASSERT_EQ(e.code, 0) << e.err;
+  EXPECT_TRUE(fs::exists(work_ / "e" / "frames" / "frame_000003.ply"));
+  EXPECT_FALSE(fs::exists(work_ / "e" / "frames" / "frame_000004.ply"));
+  const std::string pos = read_file(work_ / "e" / "frames" / "frame_000000.ply");
+  EXPECT_CONTAINS(pos, "property float z\nend_header\n");
+}
+
+TEST_F(Cli, BadFrameFlagsAreOneErrorAndExitCode2) {
+  struct Case {
+    std::vector<std::string> flags;
+    std::string expect;
+  };
+  const std::vector<Case> cases{
+      {{"--format", "vtu,obj"}, "--format: \"obj\" is not one of vtu, vtk, ply"},
+      {{"--format", "vtu,,ply"}, "--format: an empty name"},
+      {{"--format", "ply,ply"}, "\"ply\" is given twice"},
+      {{"--fields", "velocity,temperature"}, "--fields: \"temperature\" is not one of velocity"},
+      {{"--fields", ""}, "--fields"},
+      {{"--every", "5", "--fps", "30"}, "--every and --fps both choose"},
+      {{"--fps", "0"}, "--fps"},
+      {{"--fps", "-3"}, "--fps"},
+      {{"--every", "-1"}, "--every"},
+      {{"--set", "Configuration.outputFps=30"}, "outputEveryNSteps = 100 and outputFps = 30"},
+  };
+  for (const auto& c : cases) {
+    std::vector<std::string> args{"run", kDamBreak, "--steps", "5", "--no-progress", "-o", "o"};
+    args.insert(args.end(), c.flags.begin(), c.flags.end());
+    const Result r = sph(args);
+    EXPECT_EQ(r.code, 2) << c.flags[0] << "\n" << r.err;
+    EXPECT_CONTAINS(r.err, c.expect);
+    EXPECT_EQ(count(r.err, "sph: error:"), 1u) << r.err;
+    EXPECT_FALSE(fs::exists(work_ / "o")) << c.flags[0];
+    fs::remove_all(work_ / "o");
+  }
 }
 
 TEST_F(Cli, EveryNeighborModeRunsAndAuditFillsTheAuditColumns) {

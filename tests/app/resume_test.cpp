@@ -119,6 +119,31 @@ TEST_F(Resume, CheckpointEveryThenResumeGivesTheFramesOfAnUninterruptedRun) {
   }
 }
 
+// Frames by simulated time in the legacy VTK and PLY formats: the schedule's state lives in the
+// checkpoint. dt = 1.5e-4 s at 1000 frames/s: step 60 is on the schedule (tick 9), step 50 is
+// not, so the run that stopped at 50 wrote a frame there that the longer run must not have.
+TEST_F(Resume, FramesBySimulatedTimeInEveryFormatResumeBitwise) {
+  const std::vector<std::string> frames{"--format", "vtk,ply,vtu", "--fields", "velocity,id,pressure", "--fps", "1000"};
+  const auto run = [&](std::vector<std::string> args) {
+    args.insert(args.begin(), {"run", kDamBreak, "--threads", "2", "--no-progress"});
+    args.insert(args.end(), frames.begin(), frames.end());
+    return sph(args);
+  };
+  ASSERT_EQ(run({"--steps", "120", "-o", "full"}).code, 0);
+  for (const std::string stop : {"50", "60"}) {
+    SCOPED_TRACE("stopped at " + stop);
+    const std::string part = "part" + stop;
+    CommandResult r = run({"--steps", stop, "--checkpoint-every", "20", "-o", part});
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(at(part) / "frames" / "frame_000008.ply")) << "the last step's frame";
+    r = sph({"run", "--resume", part, "--steps", "120", "--threads", "1", "--no-progress"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    expect_same_frames(at("full"), at(part));
+    EXPECT_EQ(nlohmann::json::parse(slurp(at(part) / "summary.json")).at("frames"),
+              nlohmann::json::parse(slurp(at("full") / "summary.json")).at("frames"));
+  }
+}
+
 class StopSignal : public Resume, public testing::WithParamInterface<int> {};
 
 TEST_P(StopSignal, FinishesTheStepWritesACheckpointAndResumesBitwise) {
@@ -198,6 +223,10 @@ TEST_F(Resume, MistakesAreRefusedWithOneMessageAndExitCode2) {
       {{"run", "--resume", "done", "--set", "Fluid.viscosity=2"}, "--set cannot be given with it"},
       {{"run", "--resume", "done", "--neighbors", "verlet"}, "--neighbors cannot be given"},
       {{"run", "--resume", "done", "-o", "elsewhere"}, "-o/--output cannot be given"},
+      {{"run", "--resume", "done", "--format", "ply"}, "--format cannot be given"},
+      {{"run", "--resume", "done", "--fields", "id"}, "--fields cannot be given"},
+      {{"run", "--resume", "done", "--every", "3"}, "--every cannot be given"},
+      {{"run", "--resume", "done", "--fps", "30"}, "--fps cannot be given"},
       {{"run", "--resume", "missing_dir"}, "missing_dir: no such directory"},
       {{"run", "--resume", "nock"}, "no checkpoint here"},
       {{"run", "--resume", "done"}, "already did all its 20 steps"},

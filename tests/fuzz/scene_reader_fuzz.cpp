@@ -68,7 +68,7 @@ template <int D>
 void check_accepted(const sph::SceneDesc& desc) {
   const sph::SceneBody<D>& body = desc.body<D>();
   const sph::SimulationParams<D>& p = body.sim;
-  promise(desc.steps >= 1 && desc.output_every_steps >= 0, "step counts");
+  promise(desc.steps >= 1 && desc.output.every_steps >= 0, "step counts");
   promise(positive_finite(p.time_step), "time step > 0");
   promise(positive_finite(p.particle_radius), "particle radius > 0");
   promise(positive_finite(p.kernel_radius) && p.kernel_radius > 2 * p.particle_radius, "h > spacing");

@@ -2,6 +2,7 @@
 // neighbor mode, an emitter scene, a Morton reorder after the checkpoint, another thread
 // count), and a corrupt, truncated or foreign file is refused with a message saying so.
 
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -197,7 +198,17 @@ TEST_F(BadCheckpoint, AnotherFormatVersion) {
   std::string bad = good_;
   bad[8] = static_cast<char>(bad[8] + 1);
   test::spit(file_, bad);
-  expect_refused("format version 2");
+  expect_refused("format version " + std::to_string(kCheckpointVersion + 1));
+}
+
+TEST_F(BadCheckpoint, AnOlderFormatVersionSaysSo) {
+  // Version 1 kept a list of .vtu files where version 2 keeps the frame schedule.
+  std::string bad = good_;
+  const std::uint32_t v1 = 1;
+  std::memcpy(bad.data() + 8, &v1, sizeof v1);
+  test::spit(file_, bad);
+  expect_refused("format version 1; this sph");
+  expect_refused("written by an older sph");
 }
 
 TEST_F(BadCheckpoint, AnotherByteOrder) {

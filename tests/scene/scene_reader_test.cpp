@@ -577,3 +577,63 @@ TEST(MemoryEstimate, CountsBlocksAndEmitterBudgetsAndGrowsWithPrecisionAndSkin) 
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Frame output: Configuration.outputEveryNSteps, outputFps, outputFormats, outputFields
+
+TEST(SceneReaderOutput, Defaults) {
+  const sph::SceneDesc d = parse(valid_scene());  // 10 steps
+  EXPECT_EQ(d.output.every_steps, 1) << "max(1, steps / 100)";
+  EXPECT_EQ(d.output.fps, 0.0);
+  EXPECT_EQ(d.output.formats, std::vector<sph::FrameFormat>{sph::FrameFormat::Vtu});
+  EXPECT_EQ(d.output.fields,
+            (std::vector<std::string>{"velocity", "density", "pressure", "id", "initial_position"}));
+  json j = valid_scene();
+  j["Configuration"]["numberOfSteps"] = 1000;
+  EXPECT_EQ(parse(j).output.every_steps, 10);
+}
+
+TEST(SceneReaderOutput, FpsReplacesTheDefaultStepInterval) {
+  json j = valid_scene();
+  j["Configuration"]["outputFps"] = 24.5;
+  const sph::SceneDesc d = parse(j);
+  EXPECT_EQ(d.output.fps, 24.5);
+  EXPECT_EQ(d.output.every_steps, 0);
+  // Both, one of them 0: fine.
+  j["Configuration"]["outputEveryNSteps"] = 0;
+  EXPECT_EQ(parse(j).output.fps, 24.5);
+  j["Configuration"]["outputEveryNSteps"] = 3;
+  j["Configuration"]["outputFps"] = 0;
+  EXPECT_EQ(parse(j).output.every_steps, 3);
+  EXPECT_EQ(parse(j).output.fps, 0.0);
+  j["Configuration"]["outputFps"] = 30;
+  const std::string m = error_of(j);
+  EXPECT_CONTAINS(m, "outputEveryNSteps = 3");
+  EXPECT_CONTAINS(m, "outputFps = 30");
+  // Through --set, the message names the override.
+  EXPECT_CONTAINS(error_of(valid_scene(), {"Configuration.outputEveryNSteps=2", "Configuration.outputFps=10"}),
+                  "--set Configuration.output");
+}
+
+TEST(SceneReaderOutput, FormatsAndFieldsInTheirCanonicalOrder) {
+  json j = valid_scene();
+  j["Configuration"]["outputFormats"] = {"ply", "vtu"};
+  j["Configuration"]["outputFields"] = {"id", "velocity"};
+  const sph::SceneDesc d = parse(j);
+  EXPECT_EQ(d.output.formats, (std::vector<sph::FrameFormat>{sph::FrameFormat::Ply, sph::FrameFormat::Vtu}));
+  EXPECT_EQ(d.output.fields, (std::vector<std::string>{"velocity", "id"}));
+  j["Configuration"]["outputFields"] = json::array();
+  EXPECT_TRUE(parse(j).output.fields.empty()) << "positions only";
+  // The effective scene keeps the keys, so that a checkpoint's scene reproduces them.
+  const sph::SceneDesc again = sph::parse_scene(d.effective_json, "again.json");
+  EXPECT_EQ(again.output.formats, d.output.formats);
+  EXPECT_EQ(again.output.fields, d.output.fields);
+}
+
+TEST(SceneReaderOutput, MistakesNameTheKey) {
+  EXPECT_CONTAINS(error_of(valid_scene(), {"Configuration.outputFormats=[\"vtu\",\"stl\"]"}),
+                  "Configuration.outputFormats[1]: unknown value \"stl\"");
+  EXPECT_CONTAINS(error_of(valid_scene(), {"Configuration.outputFormats=[]"}), "at least one frame format");
+  EXPECT_CONTAINS(error_of(valid_scene(), {"Configuration.outputFields=velocity"}), "an array of");
+  EXPECT_CONTAINS(error_of(valid_scene(), {"Configuration.outputFps=-1"}), "frame rate >= 0");
+}

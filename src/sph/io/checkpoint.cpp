@@ -75,8 +75,12 @@ CheckpointReader::CheckpointReader(fs::path file) : file_(std::move(file)) {
   if (bom != kByteOrderMark)
     throw Error("the checkpoint was written on a machine with another byte order; it cannot be resumed here", where);
   if (version != kCheckpointVersion)
-    throw Error(fmt::format("the checkpoint has format version {}; this sph ({}) reads version {} only", version,
-                            kVersion, kCheckpointVersion),
+    throw Error(fmt::format("the checkpoint has format version {}; this sph ({}) reads version {} only{}", version,
+                            kVersion, kCheckpointVersion,
+                            version < kCheckpointVersion
+                                ? ": it was written by an older sph; finish the run with that version, or start it "
+                                  "again with this one"
+                                : ""),
                 where);
 
   // Trailer: the length must account for the whole file and the checksum must match.

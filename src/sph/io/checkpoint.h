@@ -23,8 +23,10 @@
 
 namespace sph {
 
-/// The format version this build writes and reads.
-inline constexpr std::uint32_t kCheckpointVersion = 1;
+/// The format version this build writes and reads. Version 2 (frame formats and the fps
+/// schedule) keeps the frames' times and the schedule's next tick instead of version 1's .vtu
+/// file list.
+inline constexpr std::uint32_t kCheckpointVersion = 2;
 /// The checkpoint's file name in a run's output directory.
 inline constexpr const char* kCheckpointFile = "checkpoint.sphc";
 

@@ -69,13 +69,18 @@ void prepare_output_directory(const fs::path& dir) {
     fs::remove(dir / name, ec);
   for (const auto& entry : fs::directory_iterator(dir / "frames", ec)) {
     const std::string f = entry.path().filename().string();
-    if (f.rfind("frame_", 0) == 0 && entry.path().extension() == ".vtu") fs::remove(entry.path(), ec);
+    const std::string ext = entry.path().extension().string();
+    if (f.rfind("frame_", 0) == 0 && (ext == ".vtu" || ext == ".vtk" || ext == ".ply")) fs::remove(entry.path(), ec);
   }
 }
 
 template <int D, std::floating_point R>
 RunOutput<D, R>::RunOutput(fs::path dir, const SceneDesc& desc, RunInfo info)
-    : dir_(std::move(dir)), desc_(desc), info_(std::move(info)), stats_tmp_(dir_ / ".stats.csv.partial") {}
+    : dir_(std::move(dir)),
+      desc_(desc),
+      info_(std::move(info)),
+      frames_(dir_, desc.output),
+      stats_tmp_(dir_ / ".stats.csv.partial") {}
 
 template <int D, std::floating_point R>
 void RunOutput<D, R>::open_stats() {
@@ -94,19 +99,11 @@ RunOutput<D, R>::~RunOutput() {
 }
 
 template <int D, std::floating_point R>
-void RunOutput<D, R>::write_frame(const Simulation<D, R>& sim) {
-  const std::string file = fmt::format("frames/frame_{:06d}.vtu", pvd_.size());
-  write_vtu(dir_ / file, sim.particles());
-  pvd_.push_back({sim.time(), file});
-  write_pvd(dir_ / "frames.pvd", pvd_);
-}
-
-template <int D, std::floating_point R>
 void RunOutput<D, R>::begin(const Simulation<D, R>& sim) {
   Stopwatch w;
   open_stats();
   write_file_atomic(dir_ / "scene.json", desc_.effective_json + "\n");
-  if (desc_.output_every_steps > 0) write_frame(sim);
+  frames_.write_due(sim, false);  // frame 0, if the run writes frames
   output_seconds_ += w.lap();
 }
 
@@ -136,12 +133,9 @@ std::pair<std::string, std::int64_t> stats_rows_before(const fs::path& file, std
 template <int D, std::floating_point R>
 std::string RunOutput<D, R>::resume(const Simulation<D, R>& sim, StateReader& in) {
   Stopwatch w;
-  const std::size_t frames = in.count(sizeof(double));
-  pvd_.resize(frames);
-  for (PvdEntry& e : pvd_) {
-    in.get(e.time);
-    in.get(e.file);
-  }
+  // Also removes the frames the interrupted run wrote after the checkpoint: the resumed run
+  // writes them again.
+  frames_.load_state(in);
   in.get(totals_);
   in.get(totals_lists_rebuilt_);
   in.get(audit_);
@@ -153,15 +147,7 @@ std::string RunOutput<D, R>::resume(const Simulation<D, R>& sim, StateReader& in
   const std::int64_t steps = sim.steps_done();
   resumed_at_.push_back(steps);
   write_file_atomic(dir_ / "scene.json", desc_.effective_json + "\n");
-
-  // Frames the interrupted run wrote after the checkpoint: the resumed run writes them again.
   std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(dir_ / "frames", ec)) {
-    const std::string f = entry.path().filename().string();
-    unsigned index = 0;
-    if (std::sscanf(f.c_str(), "frame_%u.vtu", &index) == 1 && index >= pvd_.size()) fs::remove(entry.path(), ec);
-  }
-  if (!pvd_.empty()) write_pvd(dir_ / "frames.pvd", pvd_);
   fs::remove(dir_ / "summary.json", ec);
 
   // Stats rows of the steps before the checkpoint: from the partial file of a killed run if it
@@ -186,11 +172,7 @@ template <int D, std::floating_point R>
 void RunOutput<D, R>::save_state(StateWriter& out, const Simulation<D, R>& sim, double wall_seconds) {
   stats_.flush();
   if (!stats_) throw Error("writing stats.csv failed (disk full?)", dir_.string());
-  out.put(static_cast<std::uint64_t>(pvd_.size()));
-  for (const PvdEntry& e : pvd_) {
-    out.put(e.time);
-    out.put(e.file);
-  }
+  frames_.save_state(out);
   out.put(totals_);
   out.put(totals_lists_rebuilt_);
   out.put(audit_);
@@ -205,8 +187,7 @@ void RunOutput<D, R>::save_state(StateWriter& out, const Simulation<D, R>& sim, 
 template <int D, std::floating_point R>
 double RunOutput<D, R>::after_step(const Simulation<D, R>& sim, const StepInfo& info, bool last) {
   Stopwatch w;
-  const std::int64_t every = desc_.output_every_steps;
-  if (every > 0 && (sim.steps_done() % every == 0 || last)) write_frame(sim);
+  const bool wrote = frames_.write_due(sim, last);
   const double t_output = w.lap();
   totals_ += info.seconds;
   output_seconds_ += t_output;
@@ -226,7 +207,7 @@ double RunOutput<D, R>::after_step(const Simulation<D, R>& sim, const StepInfo& 
     audit_steps_with_misses_ += info.audit.missed_pairs > 0 ? 1 : 0;
   }
   totals_lists_rebuilt_ += info.neighbors.lists_rebuilt;
-  if (last || (every > 0 && sim.steps_done() % every == 0)) stats_.flush();
+  if (last || wrote) stats_.flush();
   return t_output;
 }
 
@@ -257,7 +238,10 @@ void RunOutput<D, R>::finish(const Simulation<D, R>& sim, const std::string& sta
   s["simulated_time"] = sim.time();
   s["time_step"] = sim.params().time_step;
   s["particles"] = sim.particles().size();
-  s["frames"] = pvd_.size();
+  s["frames"] = frames_.frames_written();
+  nlohmann::ordered_json formats = nlohmann::ordered_json::array();
+  for (FrameFormat f : desc_.output.formats) formats.push_back(frame_format_name(f));
+  s["frame_formats"] = formats;
   s["wall_seconds"] = earlier_wall_seconds_ + wall_seconds;
   if (!resumed_at_.empty()) s["resumed_at_steps"] = resumed_at_;
   if (last_checkpoint_step_ >= 0) s["last_checkpoint_step"] = last_checkpoint_step_;

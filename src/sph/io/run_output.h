@@ -1,8 +1,10 @@
 #pragma once
 /// \file RunOutput: everything a run writes to its output directory.
 ///
-///   DIR/frames.pvd             time series for ParaView (rewritten after every frame)
-///   DIR/frames/frame_NNNNNN.vtu  particle frames (see write_vtu)
+///   DIR/frames.pvd             time series of the .vtu frames for ParaView (when vtu is among
+///                              the formats; rewritten after every frame)
+///   DIR/frames/frame_NNNNNN.EXT  particle frames in each format of Configuration.outputFormats
+///                              (.vtu, .vtk, .ply; see FrameWriter)
 ///   DIR/stats.csv              one row per step (see kStatsColumns)
 ///   DIR/summary.json           written at the end: scene, mode, steps, timings, status
 ///   DIR/scene.json             the effective scene (after --set overrides)
@@ -15,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include <sph/io/frame_writer.h>
 #include <sph/io/vtk.h>
 #include <sph/scene/scene_desc.h>
 #include <sph/solver/simulation.h>
@@ -63,14 +66,15 @@ class RunOutput {
   void save_state(StateWriter& out, const Simulation<D, R>& sim, double wall_seconds);
   /// Wall seconds of the run's earlier sessions (before the checkpoint it resumed from).
   double earlier_wall_seconds() const { return earlier_wall_seconds_; }
-  /// After each step: writes a frame if one is due (every output_every_steps steps and at the
-  /// last step), then the step's stats row. Returns the seconds spent writing.
+  /// After each step: writes a frame if one is due (FrameSchedule: every output.every_steps
+  /// steps or at output.fps frames per simulated second, and at the last step), then the
+  /// step's stats row. Returns the seconds spent writing.
   double after_step(const Simulation<D, R>& sim, const StepInfo& info, bool last);
   /// Closes stats.csv and writes summary.json with `status` ("completed" or an error message);
   /// `wall_seconds` of this session (earlier sessions of a resumed run are added).
   void finish(const Simulation<D, R>& sim, const std::string& status, double wall_seconds);
 
-  std::size_t frames_written() const { return pvd_.size(); }
+  std::size_t frames_written() const { return frames_.frames_written(); }
   /// Audit totals over the steps so far: missed pairs summed, deepest penetration (zero
   /// without auditing).
   const ListAudit& audit_totals() const { return audit_; }
@@ -78,13 +82,12 @@ class RunOutput {
   std::uint64_t audit_steps_with_misses() const { return audit_steps_with_misses_; }
 
  private:
-  void write_frame(const Simulation<D, R>& sim);
   void open_stats();
 
   std::filesystem::path dir_;
   const SceneDesc& desc_;
   RunInfo info_;
-  std::vector<PvdEntry> pvd_;
+  FrameWriter<D, R> frames_;
   std::ofstream stats_;
   std::filesystem::path stats_tmp_;
   PhaseTimes totals_;

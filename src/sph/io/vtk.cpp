@@ -2,10 +2,12 @@
 
 #include <bit>
 #include <cstdint>
+#include <cstring>
 #include <sstream>
 
 #include <fmt/format.h>
 
+#include <sph/core/error.h>
 #include <sph/io/atomic_file.h>
 
 namespace sph {
@@ -17,21 +19,27 @@ constexpr const char* kByteOrder = std::endian::native == std::endian::little ? 
 
 template <class T>
 const char* vtk_type() {
-  if constexpr (std::is_same_v<T, float>) return "Float32";
-  else if constexpr (std::is_same_v<T, double>) return "Float64";
-  else if constexpr (std::is_same_v<T, std::uint64_t>) return "UInt64";
-  else if constexpr (std::is_same_v<T, std::int64_t>) return "Int64";
-  else if constexpr (std::is_same_v<T, std::uint8_t>) return "UInt8";
+  if constexpr (std::is_same_v<T, float>)
+    return "Float32";
+  else if constexpr (std::is_same_v<T, double>)
+    return "Float64";
+  else if constexpr (std::is_same_v<T, std::uint64_t>)
+    return "UInt64";
+  else if constexpr (std::is_same_v<T, std::int64_t>)
+    return "Int64";
+  else if constexpr (std::is_same_v<T, std::uint8_t>)
+    return "UInt8";
 }
 
 /// Collects DataArray headers and their raw appended blocks.
 class Appended {
  public:
   template <class T>
-  std::string array(const std::string& name, int components, const std::vector<T>& data) {
+  std::string array(const std::string& name, int components, const std::vector<T>& data,
+                    const std::string& extra = "") {
     const std::string header =
-        fmt::format(R"(<DataArray type="{}"{} NumberOfComponents="{}" format="appended" offset="{}"/>)",
-                    vtk_type<T>(), name.empty() ? "" : " Name=\"" + name + "\"", components, blob_.size());
+        fmt::format(R"(<DataArray type="{}"{} NumberOfComponents="{}"{} format="appended" offset="{}"/>)",
+                    vtk_type<T>(), name.empty() ? "" : " Name=\"" + name + "\"", components, extra, blob_.size());
     const std::uint64_t bytes = data.size() * sizeof(T);
     blob_.append(reinterpret_cast<const char*>(&bytes), sizeof(bytes));
     blob_.append(reinterpret_cast<const char*>(data.data()), bytes);
@@ -51,10 +59,26 @@ std::vector<R> as3(const std::vector<Vec<D, R>>& v) {
   return out;
 }
 
+/// Appends `values` to `out` in big-endian byte order (the legacy VTK format's only one).
+template <class T>
+void append_big_endian(std::string& out, const std::vector<T>& values) {
+  const std::size_t at = out.size();
+  out.resize(at + values.size() * sizeof(T));
+  char* p = out.data() + at;
+  for (const T& v : values) {
+    unsigned char b[sizeof(T)];
+    std::memcpy(b, &v, sizeof(T));
+    if constexpr (std::endian::native == std::endian::little)
+      for (std::size_t k = 0; k < sizeof(T); ++k) *p++ = static_cast<char>(b[sizeof(T) - 1 - k]);
+    else
+      for (std::size_t k = 0; k < sizeof(T); ++k) *p++ = static_cast<char>(b[k]);
+  }
+}
+
 }  // namespace
 
 template <int D, std::floating_point R>
-void write_vtu(const std::filesystem::path& path, const ParticleSet<D, R>& ps) {
+void write_vtu(const std::filesystem::path& path, const ParticleSet<D, R>& ps, double time, FrameFieldMask fields) {
   const std::size_t n = ps.size();
   Appended app;
   std::ostringstream xml;
@@ -62,18 +86,24 @@ void write_vtu(const std::filesystem::path& path, const ParticleSet<D, R>& ps) {
       << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"" << kByteOrder
       << "\" header_type=\"UInt64\">\n"
       << "  <UnstructuredGrid>\n"
+      << "    <FieldData>\n"
+      << "      " << app.array("TimeValue", 1, std::vector<double>{time}, " NumberOfTuples=\"1\"") << "\n"
+      << "    </FieldData>\n"
       << "    <Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << n << "\">\n"
-      << "      <PointData Scalars=\"density\" Vectors=\"velocity\">\n";
-  xml << "        " << app.array("velocity", 3, as3(ps.velocity)) << "\n";
-  xml << "        " << app.array("density", 1, ps.density) << "\n";
-  xml << "        " << app.array("pressure", 1, ps.pressure) << "\n";
-  xml << "        " << app.array("id", 1, ps.id) << "\n";
-  xml << "        " << app.array("initial_position", 3, as3(ps.initial_position)) << "\n";
+      << "      <PointData" << ((fields & kFieldDensity) ? " Scalars=\"density\"" : "")
+      << ((fields & kFieldVelocity) ? " Vectors=\"velocity\"" : "") << ">\n";
+  if (fields & kFieldVelocity) xml << "        " << app.array("velocity", 3, as3(ps.velocity)) << "\n";
+  if (fields & kFieldDensity) xml << "        " << app.array("density", 1, ps.density) << "\n";
+  if (fields & kFieldPressure) xml << "        " << app.array("pressure", 1, ps.pressure) << "\n";
+  if (fields & kFieldId) xml << "        " << app.array("id", 1, ps.id) << "\n";
+  if (fields & kFieldInitialPosition)
+    xml << "        " << app.array("initial_position", 3, as3(ps.initial_position)) << "\n";
   xml << "      </PointData>\n      <Points>\n";
   xml << "        " << app.array("position", 3, as3(ps.position)) << "\n";
   xml << "      </Points>\n      <Cells>\n";
   std::vector<std::int64_t> conn(n), offsets(n);
-  for (std::size_t i = 0; i < n; ++i) conn[i] = static_cast<std::int64_t>(i), offsets[i] = static_cast<std::int64_t>(i + 1);
+  for (std::size_t i = 0; i < n; ++i)
+    conn[i] = static_cast<std::int64_t>(i), offsets[i] = static_cast<std::int64_t>(i + 1);
   const std::vector<std::uint8_t> types(n, 1);  // VTK_VERTEX
   xml << "        " << app.array("connectivity", 1, conn) << "\n";
   xml << "        " << app.array("offsets", 1, offsets) << "\n";
@@ -87,16 +117,78 @@ void write_vtu(const std::filesystem::path& path, const ParticleSet<D, R>& ps) {
   f.commit();
 }
 
+template <int D, std::floating_point R>
+void write_legacy_vtk(const std::filesystem::path& path, const ParticleSet<D, R>& ps, double time,
+                      FrameFieldMask fields) {
+  const std::size_t n = ps.size();
+  // Cells hold 32-bit indices in this format.
+  if (n > 0x7fffffffu) throw Error("too many particles for a legacy VTK file (at most 2^31 - 1)", path.string());
+  constexpr const char* real = std::is_same_v<R, float> ? "float" : "double";
+  std::string s;
+  s.reserve(64 + n * (3 * sizeof(R) + 12));
+  s += fmt::format("# vtk DataFile Version 4.2\nsph frame, time {} s\nBINARY\nDATASET UNSTRUCTURED_GRID\n", time);
+  s += "FIELD FieldData 1\nTimeValue 1 1 double\n";
+  append_big_endian(s, std::vector<double>{time});
+  s += fmt::format("\nPOINTS {} {}\n", n, real);
+  append_big_endian(s, as3(ps.position));
+  s += fmt::format("\nCELLS {} {}\n", n, 2 * n);
+  std::vector<std::int32_t> cells(2 * n);
+  for (std::size_t i = 0; i < n; ++i) cells[2 * i] = 1, cells[2 * i + 1] = static_cast<std::int32_t>(i);
+  append_big_endian(s, cells);
+  s += fmt::format("\nCELL_TYPES {}\n", n);
+  append_big_endian(s, std::vector<std::int32_t>(n, 1));  // VTK_VERTEX
+  // The point fields as one FIELD block: readers load every array of it, whereas of SCALARS
+  // and VECTORS sections VTK's reader loads only the first of each unless asked for all.
+  const int arrays = std::popcount(fields & kAllFrameFields);
+  s += fmt::format("\nPOINT_DATA {}\nFIELD FieldData {}\n", n, arrays);
+  const auto field = [&](const char* name, int components, const char* type) {
+    s += fmt::format("{} {} {} {}\n", name, components, n, type);
+  };
+  if (fields & kFieldVelocity) {
+    field("velocity", 3, real);
+    append_big_endian(s, as3(ps.velocity));
+    s += "\n";
+  }
+  if (fields & kFieldDensity) {
+    field("density", 1, real);
+    append_big_endian(s, ps.density);
+    s += "\n";
+  }
+  if (fields & kFieldPressure) {
+    field("pressure", 1, real);
+    append_big_endian(s, ps.pressure);
+    s += "\n";
+  }
+  if (fields & kFieldId) {
+    // 32 bits: ids stay below the 2e9 particles a scene may hold, and every reader knows
+    // unsigned_int (64-bit types are spelt differently by VTK versions).
+    std::vector<std::uint32_t> id(n);
+    for (std::size_t i = 0; i < n; ++i) id[i] = static_cast<std::uint32_t>(ps.id[i]);
+    field("id", 1, "unsigned_int");
+    append_big_endian(s, id);
+    s += "\n";
+  }
+  if (fields & kFieldInitialPosition) {
+    field("initial_position", 3, real);
+    append_big_endian(s, as3(ps.initial_position));
+    s += "\n";
+  }
+  write_file_atomic(path, s);
+}
+
 void write_pvd(const std::filesystem::path& path, const std::vector<PvdEntry>& entries) {
-  std::string s = fmt::format("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"{}\">\n  <Collection>\n",
-                              kByteOrder);
+  std::string s = fmt::format(
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"{}\">\n  <Collection>\n",
+      kByteOrder);
   for (const auto& e : entries)
     s += fmt::format("    <DataSet timestep=\"{:.9g}\" group=\"\" part=\"0\" file=\"{}\"/>\n", e.time, e.file);
   s += "  </Collection>\n</VTKFile>\n";
   write_file_atomic(path, s);
 }
 
-#define SPH_INSTANTIATE(D, R) template void write_vtu<D, R>(const std::filesystem::path&, const ParticleSet<D, R>&);
+#define SPH_INSTANTIATE(D, R)                                                                                    \
+  template void write_vtu<D, R>(const std::filesystem::path&, const ParticleSet<D, R>&, double, FrameFieldMask); \
+  template void write_legacy_vtk<D, R>(const std::filesystem::path&, const ParticleSet<D, R>&, double, FrameFieldMask);
 SPH_INSTANTIATE(2, float)
 SPH_INSTANTIATE(2, double)
 SPH_INSTANTIATE(3, float)

@@ -2,6 +2,7 @@
 /// \file SceneDesc: a scene file's content as plain structs (no JSON types), SI units.
 
 #include <cstdint>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,24 @@
 namespace sph {
 
 enum class Precision { Float, Double };
+
+/// File formats for particle frames: VTK XML (.vtu, ParaView), legacy VTK (.vtk, binary) and
+/// PLY (.ply, binary point clouds for Blender and Houdini).
+enum class FrameFormat { Vtu, Vtk, Ply };
+
+/// The point fields a frame may hold besides the positions (all by default).
+inline constexpr const char* kFrameFieldNames[] = {"velocity", "density", "pressure", "id", "initial_position"};
+
+/// What a run writes as frames and when (Configuration.outputEveryNSteps, outputFps,
+/// outputFormats, outputFields).
+struct OutputDesc {
+  std::int64_t every_steps = 0;  ///< a frame every this many steps (0: none, unless fps > 0)
+  /// Frames per simulated second (0: use every_steps): frame k is written at the first step
+  /// whose time reaches k / fps.
+  double fps = 0;
+  std::vector<FrameFormat> formats{FrameFormat::Vtu};  ///< each frame in each of these formats
+  std::vector<std::string> fields{std::begin(kFrameFieldNames), std::end(kFrameFieldNames)};  ///< in kFrameFieldNames order
+};
 
 /// A box of fluid filled with particles on a lattice of spacing 2 * particleRadius.
 template <int D>
@@ -33,7 +52,7 @@ struct SceneDesc {
   int dimension = 3;
   Precision precision = Precision::Double;
   std::int64_t steps = 0;               ///< number of time steps to run
-  std::int64_t output_every_steps = 0;  ///< write a frame every this many steps (0: none)
+  OutputDesc output;                    ///< frame formats, fields and schedule
   SceneBody<2> body2;  ///< filled when dimension == 2
   SceneBody<3> body3;  ///< filled when dimension == 3
   std::string effective_json;           ///< the scene as read, after --set overrides (pretty JSON)

@@ -379,6 +379,58 @@ Box<D> read_box(ObjectReader& r, const char* what) {
   return b;
 }
 
+/// An optional array of distinct strings, each one of `choices`, at `key`; nullopt if absent.
+std::optional<std::vector<std::string>> string_set(ObjectReader& c, const std::string& key,
+                                                   const std::vector<std::string>& choices, const std::string& what) {
+  const json* v = c.find(key);
+  if (!v) return std::nullopt;
+  std::string list;
+  for (const auto& ch : choices) list += (list.empty() ? "\"" : ", \"") + ch + "\"";
+  if (!v->is_array())
+    c.ctx().fail(c.child(key), "expected " + what + ": an array of " + list + ", got " + describe(*v));
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < v->size(); ++i) {
+    const json& e = (*v)[i];
+    const std::string at = fmt::format("{}[{}]", c.child(key), i);
+    if (!e.is_string()) c.ctx().fail(at, "expected one of " + list + ", got " + describe(e));
+    const std::string name = e.get<std::string>();
+    if (std::find(choices.begin(), choices.end(), name) == choices.end())
+      c.ctx().fail(at, "unknown value \"" + name + "\"; expected one of " + list);
+    if (std::find(out.begin(), out.end(), name) != out.end())
+      c.ctx().fail(at, "\"" + name + "\" appears twice; expected each at most once");
+    out.push_back(name);
+  }
+  return out;
+}
+
+/// Configuration.outputEveryNSteps, outputFps, outputFormats, outputFields.
+void read_output(ObjectReader& c, SceneDesc& desc) {
+  OutputDesc& out = desc.output;
+  out.fps = c.positive("outputFps", "a frame rate >= 0 in frames per simulated second (0: frames by outputEveryNSteps)",
+                       0.0, true);
+  // Frames by time replace the default frames by steps; both given is a contradiction.
+  out.every_steps = c.integer("outputEveryNSteps", "a frame interval in steps (0: no frames)", 0, 1'000'000'000'000LL,
+                              out.fps > 0 ? 0 : std::max<std::int64_t>(1, desc.steps / 100));
+  if (out.fps > 0 && out.every_steps > 0)
+    c.ctx().fail(c.child("outputFps"),
+                 fmt::format("outputEveryNSteps = {} and outputFps = {:g} both choose when frames are written; give "
+                             "one of them (or set the other to 0)",
+                             out.every_steps, out.fps));
+  if (auto formats = string_set(c, "outputFormats", {"vtu", "vtk", "ply"}, "the frame formats")) {
+    if (formats->empty())
+      c.ctx().fail(c.child("outputFormats"), "expected at least one frame format of \"vtu\", \"vtk\", \"ply\"");
+    out.formats.clear();
+    for (const std::string& f : *formats)
+      out.formats.push_back(f == "vtu" ? FrameFormat::Vtu : f == "vtk" ? FrameFormat::Vtk : FrameFormat::Ply);
+  }
+  const std::vector<std::string> all(std::begin(kFrameFieldNames), std::end(kFrameFieldNames));
+  if (auto fields = string_set(c, "outputFields", all, "the point fields of each frame (empty: positions only)")) {
+    out.fields.clear();
+    for (const std::string& name : all)  // in kFrameFieldNames order, whatever the file's
+      if (std::find(fields->begin(), fields->end(), name) != fields->end()) out.fields.push_back(name);
+  }
+}
+
 template <int D>
 void read_body(ObjectReader& root, SceneDesc& desc) {
   SceneBody<D>& body = desc.body<D>();
@@ -388,7 +440,8 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
 
   root.object("Configuration",
               {"precision", "timeStepSize", "numberOfSteps", "particleRadius", "kernelRadius", "gravitation",
-               "neighbors", "fullRebuildPeriod", "verletSkin", "reorderPeriod", "outputEveryNSteps"},
+               "neighbors", "fullRebuildPeriod", "verletSkin", "reorderPeriod", "outputEveryNSteps", "outputFps",
+               "outputFormats", "outputFields"},
               [&](ObjectReader& c) {
     const std::string prec = c.choice("precision", {"double", "float"}, "double");
     desc.precision = prec == "float" ? Precision::Float : Precision::Double;
@@ -426,8 +479,7 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
                    fmt::format("a skin of {:g} m is more than twice h = {:g} m: lists would hold over 27 times the "
                                "pairs needed in 3D; expected a skin between 0.05 h and 0.5 h",
                                sim.verlet_skin, sim.kernel_radius));
-    desc.output_every_steps = c.integer("outputEveryNSteps", "a frame interval in steps (0: no frames)", 0,
-                                        1'000'000'000'000LL, std::max<std::int64_t>(1, desc.steps / 100));
+    read_output(c, desc);
   });
 
   root.object("Fluid", {"density0", "stiffness", "viscosity", "negativePressure", "pressureForce", "particleMass"},

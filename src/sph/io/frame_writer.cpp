@@ -1,0 +1,125 @@
+#include <sph/io/frame_writer.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <fmt/format.h>
+
+#include <sph/io/ply.h>
+#include <sph/io/vtk.h>
+
+namespace sph {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Round-off allowed when comparing t * fps with a frame index (relative).
+constexpr double kTickTolerance = 1e-9;
+
+std::string frame_name(std::size_t index, FrameFormat f) {
+  return fmt::format("frames/frame_{:06d}.{}", index, frame_format_name(f));
+}
+
+}  // namespace
+
+bool FrameSchedule::due(std::int64_t step, double time, bool last) const {
+  if (every_ > 0) return step % every_ == 0 || last;
+  if (fps_ > 0) return last || time * fps_ >= static_cast<double>(next_tick_) * (1 - kTickTolerance);
+  return false;
+}
+
+void FrameSchedule::written(double time) {
+  if (fps_ <= 0) return;
+  // The first k with k (1 - tol) > t * fps: frames of ticks this frame already covers are not
+  // written late.
+  const double k = std::floor(time * fps_ / (1 - kTickTolerance)) + 1;
+  // (Clamped: an absurd fps times a long run must not overflow the conversion.)
+  next_tick_ = std::max(next_tick_, k < 9e18 ? static_cast<std::int64_t>(k) : std::int64_t{9'000'000'000'000'000'000});
+}
+
+template <int D, std::floating_point R>
+FrameWriter<D, R>::FrameWriter(fs::path dir, OutputDesc output)
+    : dir_(std::move(dir)), output_(std::move(output)), fields_(frame_field_mask(output_.fields)), schedule_(output_) {}
+
+template <int D, std::floating_point R>
+bool FrameWriter<D, R>::write_due(const Simulation<D, R>& sim, bool last) {
+  if (!schedule_.due(sim.steps_done(), sim.time(), last)) return false;
+  const bool on_schedule = schedule_.due(sim.steps_done(), sim.time(), false);
+  write(sim);
+  last_off_schedule_ = !on_schedule;
+  return true;
+}
+
+template <int D, std::floating_point R>
+void FrameWriter<D, R>::write(const Simulation<D, R>& sim) {
+  const std::size_t index = times_.size();
+  for (FrameFormat f : output_.formats) {
+    const fs::path path = dir_ / frame_name(index, f);
+    switch (f) {
+      case FrameFormat::Vtu:
+        write_vtu(path, sim.particles(), sim.time(), fields_);
+        break;
+      case FrameFormat::Vtk:
+        write_legacy_vtk(path, sim.particles(), sim.time(), fields_);
+        break;
+      case FrameFormat::Ply:
+        write_ply(path, sim.particles(), sim.time(), fields_);
+        break;
+    }
+  }
+  times_.push_back(sim.time());
+  schedule_.written(sim.time());
+  last_off_schedule_ = false;
+  write_index();
+}
+
+template <int D, std::floating_point R>
+void FrameWriter<D, R>::write_index() const {
+  if (std::find(output_.formats.begin(), output_.formats.end(), FrameFormat::Vtu) == output_.formats.end()) return;
+  std::vector<PvdEntry> entries;
+  entries.reserve(times_.size());
+  for (std::size_t i = 0; i < times_.size(); ++i) entries.push_back({times_[i], frame_name(i, FrameFormat::Vtu)});
+  write_pvd(dir_ / "frames.pvd", entries);
+}
+
+template <int D, std::floating_point R>
+void FrameWriter<D, R>::save_state(StateWriter& out) const {
+  out.put(times_);
+  out.put(schedule_.next_tick());
+  out.put(static_cast<std::uint8_t>(last_off_schedule_));
+}
+
+template <int D, std::floating_point R>
+void FrameWriter<D, R>::load_state(StateReader& in) {
+  in.get(times_);
+  std::int64_t tick = 0;
+  in.get(tick);
+  in.expect(tick >= 0, "a negative frame tick");
+  schedule_.set_next_tick(tick);
+  const auto off = in.get<std::uint8_t>();
+  in.expect(off <= 1 && (off == 0 || !times_.empty()), "a bad frame flag");
+  // A frame the run wrote only because its step was the last: a run that goes on past that
+  // step does not have it (an uninterrupted run of more steps writes no frame there), so it goes.
+  if (off) times_.pop_back();
+  last_off_schedule_ = false;
+  // Frames the interrupted run wrote after the checkpoint, in any format.
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir_ / "frames", ec)) {
+    const std::string f = entry.path().filename().string();
+    unsigned index = 0;
+    char ext[4] = {};
+    if (std::sscanf(f.c_str(), "frame_%u.%3s", &index, ext) == 2 && parse_frame_format(ext) &&
+        f == fmt::format("frame_{:06d}.{}", index, ext) && index >= times_.size())
+      fs::remove(entry.path(), ec);
+  }
+  if (!times_.empty()) write_index();  // (a run without frames has no frames.pvd)
+}
+
+template class FrameWriter<2, float>;
+template class FrameWriter<2, double>;
+template class FrameWriter<3, float>;
+template class FrameWriter<3, double>;
+
+}  // namespace sph

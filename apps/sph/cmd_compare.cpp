@@ -14,6 +14,7 @@
 #include <sph/core/parallel.h>
 #include <sph/core/timer.h>
 #include <sph/io/atomic_file.h>
+#include <sph/io/frames.h>
 #include <sph/scene/scene_reader.h>
 
 #include "commands.h"
@@ -35,6 +36,7 @@ struct CompareCliOptions {
   std::vector<std::string> sets;
   bool no_audit = false;
   bool no_progress = false;
+  bool no_run_frames = false;
 };
 
 std::vector<NeighborMode> parse_modes(const std::string& list) {
@@ -67,7 +69,8 @@ void prepare_compare_directory(const fs::path& dir) {
     const std::string f = entry.path().filename().string();
     // Files whose set depends on the options: images of other steps, the audit's plot.
     const bool frame = f.rfind("frame_", 0) == 0 && entry.path().extension() == ".png";
-    if (frame || f == "missed_pairs.png") fs::remove(entry.path(), ec);
+    // runs.txt too: with --no-run-frames an earlier comparison's run directories must not be shown.
+    if (frame || f == "missed_pairs.png" || f == kRunListFile) fs::remove(entry.path(), ec);
   }
 }
 
@@ -87,6 +90,7 @@ int compare(const CompareCliOptions& opt) {
   for (const auto& w : desc.warnings) fmt::print(stderr, "sph: warning: {}\n", w);
   const fs::path dir = opt.output.empty() ? fs::path("out") / (desc.name + "_compare") : fs::path(opt.output);
   prepare_compare_directory(dir);
+  if (!opt.no_run_frames) co.runs_dir = dir;
 
   fmt::print(stderr, "sph: compare {} ({}D, {} steps, {} thread{}) -> {}\n", desc.name, desc.dimension, desc.steps,
              num_threads(), num_threads() == 1 ? "" : "s", dir.string());
@@ -151,6 +155,9 @@ std::function<int()> add_compare_command(CLI::App& app) {
   cmd->add_option("--set", opt->sets, "Override a scene value by its key path (repeatable), as in sph run")
       ->type_name("KEY=VALUE");
   cmd->add_flag("--no-audit", opt->no_audit, "Do not audit the lists for missed pairs (the audit is never timed)");
+  cmd->add_flag("--no-run-frames", opt->no_run_frames,
+                "Do not write each mode's frames to DIR/<mode>/ (by default they are written on the scene's "
+                "output schedule, for sph render and sph view)");
   cmd->add_flag("--no-progress", opt->no_progress, "No progress lines");
   return [opt, cmd]() -> int {
     if (!cmd->parsed()) return kBadInput;

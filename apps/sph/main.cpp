@@ -70,7 +70,9 @@ int main(int argc, char** argv) {
       "  sph bench [--suite neighbors,steps,tank|all] [--size small|medium|large|full] [--threads 1,2]\n"
       "                     [-o DIR]   benchmark suites: tables, DIR/bench.json and CSVs\n"
       "  sph validate [--cases martin_moyce,resolution,hydrostatic,conservation|all] [--quick] [-o DIR]\n"
-      "                     validate against experiment and physics: report, plots, CSVs (exit 1 on a miss)\n\n"
+      "                     validate against experiment and physics: report, plots, CSVs (exit 1 on a miss)\n"
+      "  sph render DIR [--color-by speed|kinetic_energy|density|pressure|initial_position] [--mp4]\n"
+      "                     PNG images (and an MP4) of a run's frames; a comparison's runs side by side\n\n"
       "Example: sph run scenes/paper/dam_break_2d.json -o out/dam_break_2d\n"
       "         then open out/dam_break_2d/frames.pvd in ParaView.",
       "sph"};
@@ -80,6 +82,7 @@ int main(int argc, char** argv) {
   std::function<int()> compare_cmd = add_compare_command(app);
   std::function<int()> bench_cmd = add_bench_command(app);
   std::function<int()> validate_cmd = add_validate_command(app);
+  std::function<int()> render_cmd = add_render_command(app);
 
   try {
     app.parse(argc, argv);
@@ -98,7 +101,8 @@ int main(int argc, char** argv) {
     // Point at the help of the subcommand the user typed, if any.
     std::string sub = "run";
     for (int i = 1; i < argc; ++i)
-      if (const std::string a = argv[i]; a == "run" || a == "compare" || a == "bench" || a == "validate") {
+      if (const std::string a = argv[i]; a == "run" || a == "compare" || a == "bench" || a == "validate" ||
+                                             a == "render") {
         sub = a;
         break;
       }
@@ -109,6 +113,7 @@ int main(int argc, char** argv) {
   try {
     if (app.got_subcommand("bench")) return bench_cmd();
     if (app.got_subcommand("validate")) return validate_cmd();
+    if (app.got_subcommand("render")) return render_cmd();
     return app.got_subcommand("compare") ? compare_cmd() : run_cmd();
   } catch (const sph::Error& e) {
     fmt::print(stderr, "sph: error: {}\n", e.what());

@@ -14,32 +14,15 @@
 #include <sph/core/error.h>
 #include <sph/render/png.h>
 
+#include "support/png_decode.h"
+
 namespace sph {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Decoded {
-  int width = 0, height = 0;
-  bool rgb8 = false;  ///< the file itself is 8-bit RGB without alpha
-  std::vector<std::uint8_t> rgb;
-};
-
-Decoded decode(const std::string& bytes) {
-  png_image image{};
-  image.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_memory(&image, bytes.data(), bytes.size()))
-    throw std::runtime_error(std::string("libpng: ") + image.message);
-  Decoded d;
-  d.width = static_cast<int>(image.width);
-  d.height = static_cast<int>(image.height);
-  d.rgb8 = image.format == PNG_FORMAT_RGB;
-  image.format = PNG_FORMAT_RGB;
-  d.rgb.resize(PNG_IMAGE_SIZE(image));
-  if (!png_image_finish_read(&image, nullptr, d.rgb.data(), 0, nullptr))
-    throw std::runtime_error(std::string("libpng: ") + image.message);
-  return d;
-}
+using Decoded = sph::test::DecodedPng;
+Decoded decode(const std::string& bytes) { return sph::test::decode_png(bytes); }
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);

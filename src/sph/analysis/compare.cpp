@@ -4,14 +4,20 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include <sph/analysis/labels.h>
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 #include <sph/core/version.h>
 #include <sph/io/atomic_file.h>
+#include <sph/io/frame_writer.h>
+#include <sph/io/frames.h>
+#include <sph/io/run_output.h>
+#include <sph/render/color_by.h>
 #include <sph/render/colormap.h>
 #include <sph/render/compose.h>
 #include <sph/render/particles.h>
@@ -81,6 +87,17 @@ RunRecord run_one(const SceneDesc& base, NeighborMode mode, bool perturbed, cons
   Simulation<D, R> sim = make_simulation<D, R>(desc);
   const double amplitude = opt.perturbation * sim.params().kernel_radius;
   if (perturbed) sim.perturb_positions(0, amplitude, kPerturbationSeed);
+  std::optional<FrameWriter<D, R>> frames;
+  if (!opt.runs_dir.empty() && !perturbed) {
+    const std::filesystem::path dir = opt.runs_dir / slug(rec.label);
+    prepare_output_directory(dir);
+    // The run's own scene: the comparison's with this run's mode, as `sph run --neighbors` writes it.
+    nlohmann::ordered_json scene = nlohmann::ordered_json::parse(desc.effective_json);
+    scene["Configuration"]["neighbors"] = std::string(to_string(mode));
+    write_file_atomic(dir / "scene.json", scene.dump(2) + "\n");
+    frames.emplace(dir, desc.output);
+    frames->write_due(sim, false);
+  }
 
   const std::int64_t every = std::max<std::int64_t>(1, steps / std::max(1, opt.samples));
   const auto is_image = [&](std::int64_t s) { return std::find(images.begin(), images.end(), s) != images.end(); };
@@ -105,6 +122,7 @@ RunRecord run_one(const SceneDesc& base, NeighborMode mode, bool perturbed, cons
       rec.steps.push_back(r);
       rec.totals += info.seconds;
       if (s % every == 0 || s == steps || is_image(s)) rec.samples.push_back(snapshot(sim, is_image(s)));
+      if (frames) frames->write_due(sim, s == steps);
       if (progress && (s % report_every == 0 || s == steps)) progress(rec.label, index, count, s, steps);
     }
   } catch (const Error& e) {
@@ -187,6 +205,11 @@ CompareResult run_all(const SceneDesc& desc, const CompareOptions& opt, const Co
   int index = 0;
   for (NeighborMode m : modes)
     res.runs.push_back(run_one<D, R>(desc, m, false, opt, res.steps, res.image_steps, index++, count, progress));
+  if (!opt.runs_dir.empty()) {
+    std::vector<std::string> names;
+    for (NeighborMode m : modes) names.push_back(slug(std::string(to_string(m))));
+    write_run_list(opt.runs_dir, names);
+  }
   if (opt.perturbation > 0)
     res.runs.push_back(
         run_one<D, R>(desc, NeighborMode::Standard, true, opt, res.steps, res.image_steps, index++, count, progress));
@@ -324,13 +347,7 @@ Image frame_image(const CompareResult& res, std::int64_t step, double mass) {
           colors.push_back(
               colormap(Colormap::Turbo, 0.5 * mass * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]), 0.0, ke_max));
         } else if (by_initial) {
-          const auto& x0 = snap->initial[id];
-          std::array<std::uint8_t, 3> c{};
-          for (int d = 0; d < 3; ++d) {
-            const double t = (x0[d] - res.box_lo[d]) / std::max(1e-300, res.box_hi[d] - res.box_lo[d]);
-            c[d] = static_cast<std::uint8_t>(std::clamp(40.0 + 215.0 * t, 0.0, 255.0));
-          }
-          colors.push_back(Rgb{c[0], c[1], c[2]});
+          colors.push_back(initial_position_color(snap->initial[id], res.box_lo, res.box_hi));
         } else {
           colors.push_back(colormap(Colormap::Viridis, static_cast<double>(id), 0.0, static_cast<double>(ids)));
         }

@@ -26,6 +26,11 @@ struct CompareOptions {
   /// h when they appear (0: no chaos run).
   double perturbation = 1e-9;
   bool audit = true;  ///< audit every run's lists (not counted in the timings)
+  /// When not empty, each mode's run (not the chaos-floor run) also writes its frames, as
+  /// `sph run -o DIR` would, to runs_dir/<mode>/ (scene.json with the mode, frames/ on the
+  /// scene's output schedule, formats and fields), and runs_dir/runs.txt lists them in order,
+  /// so that `sph render` and `sph view` show the modes side by side. Writing is not timed.
+  std::filesystem::path runs_dir;
 };
 
 /// One step of one run.

@@ -11,15 +11,13 @@
 
 namespace sph {
 
-namespace {
-std::filesystem::path temp_name(const std::filesystem::path& path) {
+std::filesystem::path temporary_path(const std::filesystem::path& path) {
   static std::atomic<unsigned> counter{0};
   return path.parent_path() /
          ("." + path.filename().string() + ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
 }
-}  // namespace
 
-AtomicFile::AtomicFile(std::filesystem::path path) : path_(std::move(path)), tmp_(temp_name(path_)) {
+AtomicFile::AtomicFile(std::filesystem::path path) : path_(std::move(path)), tmp_(temporary_path(path_)) {
   out_.open(tmp_, std::ios::binary | std::ios::trunc);
   if (!out_) throw Error("cannot create a file in this directory (is it writable?)", tmp_.parent_path().string());
 }

@@ -31,6 +31,10 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+/// A fresh temporary name next to `path` (".NAME.tmpPID-N"), for files another program writes
+/// before they are renamed into place; prepare_output_directory removes such names left behind.
+std::filesystem::path temporary_path(const std::filesystem::path& path);
+
 /// Writes `content` to `path` atomically.
 void write_file_atomic(const std::filesystem::path& path, std::string_view content);
 

@@ -55,6 +55,10 @@ bool encode_rows(png_bytep* rows, int width, int height, std::string* out, Error
     return false;
   }
   png_set_write_fn(png, out, on_png_write, on_png_flush);
+  // Fast zlib level and one cheap filter: 2.3x faster than libpng's defaults for rendered frames
+  // (the default's adaptive filtering and level 6 took 80 % of sph render) for 7 % larger files.
+  png_set_compression_level(png, 1);
+  png_set_filter(png, 0, PNG_FILTER_SUB);
   png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8, PNG_COLOR_TYPE_RGB,
                PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_set_rows(png, info, rows);

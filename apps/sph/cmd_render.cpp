@@ -1,0 +1,268 @@
+// `sph render DIR`: PNG images (and an MP4) of a run's frames, or of a compare directory's runs
+// side by side.
+
+#include <algorithm>
+#include <exception>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+#include <sph/core/error.h>
+#include <sph/core/parallel.h>
+#include <sph/core/timer.h>
+#include <sph/io/atomic_file.h>
+#include <sph/io/frames.h>
+#include <sph/render/frame_image.h>
+#include <sph/render/png.h>
+#include <sph/render/video.h>
+
+#include "commands.h"
+#include "progress.h"
+
+namespace sph::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RenderCliOptions {
+  std::string dir;
+  std::string output;
+  std::string color_by = "speed";
+  std::string colormap;
+  std::string range;
+  std::string frames = "all";
+  std::string size;
+  std::string format;
+  double azimuth = 30, elevation = 20;
+  bool mp4 = false, no_png = false, flat = false, no_progress = false;
+  double video_fps = 30;
+  int threads = 0;
+};
+
+/// "W x H" in pixels, e.g. 1280x720.
+std::pair<int, int> parse_size(const std::string& s) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  std::istringstream in(s);
+  if (!(in >> w >> x >> h) || (x != 'x' && x != 'X') || (in >> extra) || w < 16 || h < 16 || w > 8192 || h > 8192)
+    throw Error(fmt::format("\"{}\" is not an image size; expected WIDTHxHEIGHT in pixels, 16 to 8192 a side, "
+                            "e.g. 1280x720",
+                            s),
+                "--size");
+  return {w, h};
+}
+
+/// "LO,HI" with LO < HI.
+std::pair<double, double> parse_range(const std::string& s) {
+  double lo = 0, hi = 0;
+  char comma = 0, extra = 0;
+  std::istringstream in(s);
+  if (!(in >> lo >> comma >> hi) || comma != ',' || (in >> extra) || !std::isfinite(lo) || !std::isfinite(hi) ||
+      !(lo < hi))
+    throw Error(fmt::format("\"{}\" is not a color range; expected LO,HI with LO < HI, e.g. 0,2.5", s), "--range");
+  return {lo, hi};
+}
+
+/// The frame indices to render: "all", "first", "last", or a comma list of indices (negative
+/// ones count from the end: -1 is the last).
+std::vector<std::size_t> parse_frames(const std::string& s, std::size_t count) {
+  std::vector<std::size_t> out;
+  if (s == "all") {
+    for (std::size_t k = 0; k < count; ++k) out.push_back(k);
+    return out;
+  }
+  std::stringstream ss(s == "first" ? std::string("0") : s == "last" ? std::string("-1") : s);
+  for (std::string item; std::getline(ss, item, ',');) {
+    long long k = 0;
+    std::size_t used = 0;
+    try {
+      k = std::stoll(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size())
+      throw Error(fmt::format("\"{}\" is not a frame list; expected all, first, last or frame numbers separated by "
+                              "commas (negative ones count from the end), e.g. 0,50,-1",
+                              s),
+                  "--frames");
+    const long long n = static_cast<long long>(count);
+    if (k < -n || k >= n)
+      throw Error(fmt::format("frame {} does not exist: the run has frames 0 to {} (or -{} to -1 from the end)", k,
+                              n - 1, n),
+                  "--frames");
+    out.push_back(static_cast<std::size_t>(k < 0 ? n + k : k));
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+/// Creates `dir` if needed, checks that it is writable and removes the images and movie of an
+/// earlier render, so that two renders are never mixed.
+void prepare_render_directory(const fs::path& dir) {
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw Error("exists and is not a directory; expected a directory for the images", dir.string());
+  fs::create_directories(dir, ec);
+  if (ec) throw Error("cannot create the output directory: " + ec.message(), dir.string());
+  { AtomicFile probe(dir / ".write-test"); }
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string f = entry.path().filename().string();
+    if ((f.rfind("frame_", 0) == 0 && entry.path().extension() == ".png") || f == "movie.mp4")
+      fs::remove(entry.path(), ec);
+  }
+}
+
+int render(const RenderCliOptions& opt) {
+  // Everything that can be refused is checked before anything is written.
+  const auto by = color_by_from_name(opt.color_by);
+  if (!by)
+    throw Error(fmt::format("unknown quantity \"{}\"; expected one of: {}", opt.color_by, color_by_names()),
+                "--color-by");
+  std::optional<Colormap> map;
+  if (!opt.colormap.empty() && !(map = colormap_from_name(opt.colormap)))
+    throw Error(fmt::format("unknown color map \"{}\"; expected viridis, coolwarm or turbo", opt.colormap),
+                "--colormap");
+  std::optional<FrameFormat> format;
+  if (!opt.format.empty()) {
+    if (opt.format == "vtu") format = FrameFormat::Vtu;
+    else if (opt.format == "vtk") format = FrameFormat::Vtk;
+    else if (opt.format == "ply") format = FrameFormat::Ply;
+    else throw Error(fmt::format("unknown frame format \"{}\"; expected vtu, vtk or ply", opt.format), "--format");
+  }
+  if (opt.no_png && !opt.mp4) throw Error("--no-png leaves nothing to write; give --mp4 with it", "--no-png");
+  if (opt.threads > 0) set_num_threads(opt.threads);
+
+  std::vector<RunDirectory> runs;
+  for (const fs::path& d : run_directories(opt.dir)) runs.push_back(open_run_directory(d, format));
+  std::size_t count = runs[0].frames.size();
+  for (const RunDirectory& r : runs) count = std::min(count, r.frames.size());
+  for (const RunDirectory& r : runs)
+    if (r.frames.size() != count)
+      fmt::print(stderr, "sph: warning: {} has {} frames, fewer than the others; rendering the first {} of each\n",
+                 r.dir.string(), r.frames.size(), count);
+  const std::vector<std::size_t> frames = parse_frames(opt.frames, count);
+
+  FrameStyle style;
+  const bool several = runs.size() > 1;
+  const auto [w, h] = opt.size.empty() ? (several ? std::pair{640, 480} : std::pair{1280, 720}) : parse_size(opt.size);
+  style.view = default_particle_view(runs[0].dimension, w, h);
+  if (runs[0].dimension == 3) style.view.azimuth_deg = opt.azimuth, style.view.elevation_deg = opt.elevation;
+  style.view.shaded = !opt.flat;
+  style.color.by = *by;
+  style.color.map = map.value_or(default_colormap(*by));
+  if (!opt.range.empty()) {
+    std::tie(style.color.lo, style.color.hi) = parse_range(opt.range);
+  } else if (color_by_is_scalar(*by)) {
+    std::tie(style.color.lo, style.color.hi) = run_color_range(runs, *by);
+  }
+
+  // A field the frames lack is refused before anything is written (the range above found it
+  // for scalars; initial position needs the first frame read).
+  if (!color_by_is_scalar(*by))
+    for (const RunDirectory& r : runs) particle_colors(read_frame(r.frames[frames.front()]), style.color, r);
+
+  const fs::path out = opt.output.empty() ? fs::path(opt.dir) / "render" : fs::path(opt.output);
+  prepare_render_directory(out);
+  std::unique_ptr<VideoWriter> video;
+  Stopwatch wall;
+  fmt::print(stderr, "sph: render {} frame{} of {} ({}, colored by {}) -> {}\n", frames.size(),
+             frames.size() == 1 ? "" : "s", opt.dir, several ? fmt::format("{} runs side by side", runs.size())
+                                                           : fmt::format("{}D", runs[0].dimension),
+             opt.color_by, out.string());
+  Progress progress(static_cast<std::int64_t>(frames.size()),
+                    opt.no_progress ? Progress::Mode::Off
+                                    : (::isatty(STDERR_FILENO) ? Progress::Mode::Bar : Progress::Mode::Lines),
+                    stderr);
+
+  // Frames are rendered in parallel, a batch at a time, and handed to the movie in order.
+  const std::size_t batch = 2 * static_cast<std::size_t>(num_threads());
+  std::vector<Image> images(batch);
+  std::vector<std::string> errors(batch);
+  for (std::size_t first = 0; first < frames.size(); first += batch) {
+    const std::size_t n = std::min(batch, frames.size() - first);
+    parallel_for(n, [&](std::size_t k) {
+      try {
+        const std::size_t index = frames[first + k];
+        std::vector<FrameData> data;
+        for (const RunDirectory& r : runs) data.push_back(read_frame(r.frames[index]));
+        images[k] = render_frame(runs, data, style);
+        if (!opt.no_png) write_png(out / fmt::format("frame_{:06d}.png", index), images[k]);
+      } catch (const std::exception& e) {
+        errors[k] = e.what();
+      }
+    });
+    for (std::size_t k = 0; k < n; ++k)
+      if (!errors[k].empty()) throw Error(errors[k]);
+    if (opt.mp4) {
+      if (!video) video = std::make_unique<VideoWriter>(out / "movie.mp4", images[0].width(), images[0].height(),
+                                                        opt.video_fps);
+      for (std::size_t k = 0; k < n; ++k) video->add(images[k]);
+    }
+    progress.update(static_cast<std::int64_t>(first + n), 0);
+  }
+  if (video) video->finish();
+  progress.finish();
+  const double seconds = wall.elapsed();
+  fmt::print(stderr, "sph: done: {} frame{} in {:.2f} s ({:.1f} ms per frame).\n", frames.size(),
+             frames.size() == 1 ? "" : "s", seconds, 1e3 * seconds / static_cast<double>(frames.size()));
+  if (!opt.no_png)
+    fmt::print(stderr, "  {}/frame_{:06d}.png{}\n", out.string(), frames.front(),
+               frames.size() > 1 ? fmt::format(" ... frame_{:06d}.png", frames.back()) : "");
+  if (video) fmt::print(stderr, "  {}/movie.mp4 ({} frames at {} per second)\n", out.string(), video->frames(),
+                        opt.video_fps);
+  return kOk;
+}
+
+}  // namespace
+
+std::function<int()> add_render_command(CLI::App& app) {
+  auto opt = std::make_shared<RenderCliOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "render", "Render a run's frames to PNG images (and an MP4 movie); a compare directory's runs side by side");
+  cmd->add_option("dir", opt->dir, "A run's output directory (sph run -o DIR) or a comparison's (sph compare -o DIR)")
+      ->required();
+  cmd->add_option("-o,--output", opt->output,
+                  "Directory for the images and movie (default: DIR/render); earlier images there are replaced");
+  cmd->add_option("--color-by", opt->color_by,
+                  "Color particles by speed, kinetic_energy, density, pressure or initial_position")
+      ->default_str("speed");
+  cmd->add_option("--colormap", opt->colormap, "Color map: turbo, viridis or coolwarm (default: by quantity)");
+  cmd->add_option("--range", opt->range,
+                  "Color range LO,HI (default: over the whole run, 0 or the 0.5th to the 99.5th percentile)")
+      ->type_name("LO,HI");
+  cmd->add_option("--frames", opt->frames,
+                  "Frames to render: all, first, last, or numbers separated by commas (-1 is the last)")
+      ->default_str("all");
+  cmd->add_option("--size", opt->size, "Image size of each panel (default: 1280x720, 640x480 side by side)")
+      ->type_name("WxH");
+  cmd->add_option("--azimuth", opt->azimuth, "3D camera: turn about the vertical axis, degrees")
+      ->check(CLI::Range(-360.0, 360.0))
+      ->default_str("30");
+  cmd->add_option("--elevation", opt->elevation, "3D camera: look down from this angle, degrees")
+      ->check(CLI::Range(-90.0, 90.0))
+      ->default_str("20");
+  cmd->add_flag("--flat", opt->flat, "Flat discs instead of shaded spheres");
+  cmd->add_option("--format", opt->format, "Which frames to read when the run wrote several formats: vtu, vtk, ply");
+  cmd->add_flag("--mp4", opt->mp4, "Also encode the images as DIR/render/movie.mp4 (needs ffmpeg)");
+  cmd->add_option("--video-fps", opt->video_fps, "Frames per second of the movie")
+      ->check(CLI::Range(1.0, 240.0))
+      ->default_str("30");
+  cmd->add_flag("--no-png", opt->no_png, "Write only the movie, no PNG images");
+  cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
+  cmd->add_flag("--no-progress", opt->no_progress, "No progress output");
+  return [opt, cmd]() -> int {
+    if (!cmd->parsed()) return kBadInput;
+    return render(*opt);
+  };
+}
+
+}  // namespace sph::app

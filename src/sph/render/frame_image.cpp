@@ -1,0 +1,78 @@
+#include <sph/render/frame_image.h>
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include <sph/core/error.h>
+#include <sph/render/compose.h>
+#include <sph/render/font.h>
+
+namespace sph {
+
+namespace {
+
+constexpr Rgb kInk{40, 40, 40};
+
+/// `t = 0.125 s` with enough digits to tell frames apart at usual frame rates.
+std::string time_label(double t) { return fmt::format("t = {:.3f} s", t); }
+
+/// The positions of `frame` as `dim` coordinates per particle, as render_particles takes them.
+std::vector<double> coordinates(const FrameData& frame, int dim) {
+  if (dim == 3) return frame.position;
+  std::vector<double> xy(2 * frame.size);
+  for (std::size_t i = 0; i < frame.size; ++i) {
+    xy[2 * i] = frame.position[3 * i];
+    xy[2 * i + 1] = frame.position[3 * i + 1];
+  }
+  return xy;
+}
+
+}  // namespace
+
+std::pair<double, double> run_color_range(std::span<const RunDirectory> runs, ColorBy by, std::size_t max_frames,
+                                          std::size_t max_values) {
+  SPH_CHECK(max_frames >= 2 && max_values >= 1, "sample sizes");
+  std::vector<std::vector<double>> sampled;
+  for (const RunDirectory& run : runs) {
+    const std::size_t n = run.frames.size();
+    const std::size_t take = std::min(n, max_frames);
+    for (std::size_t k = 0; k < take; ++k) {
+      const std::size_t index = take == 1 ? 0 : k * (n - 1) / (take - 1);
+      const std::vector<double> values = color_values(read_frame(run.frames[index]), by, run);
+      const std::size_t stride = std::max<std::size_t>(1, values.size() / max_values);
+      std::vector<double>& out = sampled.emplace_back();
+      for (std::size_t i = 0; i < values.size(); i += stride) out.push_back(values[i]);
+    }
+  }
+  return color_range(by, sampled);
+}
+
+Image render_frame(std::span<const RunDirectory> runs, std::span<const FrameData> frames, const FrameStyle& style) {
+  SPH_CHECK(!runs.empty() && runs.size() == frames.size(), "one frame per run");
+  std::vector<Image> panels;
+  std::vector<std::string> captions;
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const RunDirectory& run = runs[k];
+    const FrameData& frame = frames[k];
+    SPH_CHECK(frame.position.size() == 3 * frame.size, "3 coordinates per particle");
+    const std::vector<Rgb> colors = particle_colors(frame, style.color, run);
+    const std::vector<double> xyz = coordinates(frame, run.dimension);
+    panels.push_back(
+        render_particles(xyz, run.dimension, colors, run.particle_radius, run.box_lo, run.box_hi, style.view));
+    if (runs.size() > 1) captions.push_back(run.label);
+  }
+  Image img = panels.size() == 1 ? std::move(panels[0]) : hstack(panels, captions, style.view.background);
+  const int scale = style.view.height >= 600 ? 2 : 1;
+  draw_text(img, 8 * scale, 6 * scale, time_label(frames[0].time), kInk, scale);
+  if (!style.legend) return img;
+  const int dim = runs[0].dimension;
+  if (color_by_is_scalar(style.color.by))
+    return add_colorbar(img, style.color.map, style.color.lo, style.color.hi, color_by_label(style.color.by, dim),
+                        style.view.background);
+  const std::string key = dim == 3 ? "color: initial x red, y green, z blue" : "color: initial x red, y green";
+  draw_text(img, 8 * scale, img.height() - text_height(scale) - 6 * scale, key, kInk, scale);
+  return img;
+}
+
+}  // namespace sph

@@ -1,0 +1,35 @@
+#pragma once
+/// \file Pictures of a run's frames for `sph render`: the particles colored by a quantity, the
+/// simulated time, a color bar, and for a compare directory every mode side by side.
+
+#include <span>
+#include <string>
+
+#include <sph/io/frames.h>
+#include <sph/render/color_by.h>
+#include <sph/render/image.h>
+#include <sph/render/particles.h>
+
+namespace sph {
+
+/// How frames look.
+struct FrameStyle {
+  ParticleView view;  ///< size and camera of each panel
+  ColorSpec color;
+  bool legend = true;  ///< a color bar for scalar quantities, a key for initial position
+};
+
+/// The color range for `by` over whole runs (color_range of every run's values together), from
+/// at most `max_frames` evenly spaced frames of each run (first and last included) and at most
+/// `max_values` evenly spaced particles of each frame: enough for percentiles, cheap for large
+/// runs. Throws sph::Error as read_frame and color_values do.
+std::pair<double, double> run_color_range(std::span<const RunDirectory> runs, ColorBy by, std::size_t max_frames = 60,
+                                          std::size_t max_values = 50000);
+
+/// One panel per run, side by side, each captioned with its run's label when there are several;
+/// `frames[k]` is a frame of `runs[k]`. The simulated time of the first frame is written in the
+/// top-left corner. Throws sph::Error as particle_colors and ParticleCamera do. Precondition:
+/// runs.size() == frames.size() >= 1.
+Image render_frame(std::span<const RunDirectory> runs, std::span<const FrameData> frames, const FrameStyle& style);
+
+}  // namespace sph

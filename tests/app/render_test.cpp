@@ -1,0 +1,161 @@
+// `sph render` as a user meets it: images of every frame with one color scale for the whole
+// run, a movie checked by ffprobe, compare directories side by side, and clear refusals.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "support/expect.h"
+#include "support/png_decode.h"
+#include "support/run_sph.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using sph::test::CommandResult;
+
+const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
+const std::string kBlock = SPH_SOURCE_DIR "/scenes/paper/block_3d.json";
+
+sph::test::DecodedPng load_png(const fs::path& p) { return sph::test::decode_png(sph::test::slurp(p)); }
+
+std::vector<std::string> pngs_in(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().extension() == ".png") names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+int error_lines(const std::string& err) {
+  int n = 0;
+  for (std::size_t p = err.find("sph: error:"); p != std::string::npos; p = err.find("sph: error:", p + 1)) ++n;
+  return n;
+}
+
+class Render : public testing::Test {
+ protected:
+  CommandResult sph(const std::vector<std::string>& args) {
+    return sph::test::run_sph(args, tmp_.path(), tmp_.path() / "stderr.txt");
+  }
+  /// A short run into tmp/NAME: frames every 50 of 200 steps (5 frames).
+  void run(const std::string& scene, const std::string& name, const std::vector<std::string>& extra = {}) {
+    std::vector<std::string> args{"run",      scene, "--steps", "200", "--set", "Configuration.outputEveryNSteps=50",
+                                  "--no-progress", "-o", name};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const CommandResult r = sph(args);
+    ASSERT_EQ(r.code, 0) << r.err;
+  }
+  /// Expects a refusal: exit 2, one error line containing `what`, and no DIR/render created.
+  void expect_refused(const std::vector<std::string>& args, const std::string& what, const fs::path& render_dir) {
+    const CommandResult r = sph(args);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(error_lines(r.err), 1) << r.err;
+    EXPECT_CONTAINS(r.err, what);
+    EXPECT_FALSE(fs::exists(render_dir)) << r.err;
+  }
+  sph::test::TempDir tmp_;
+};
+
+TEST_F(Render, EveryFrameBecomesAnImageWithOneColorScaleForTheRun) {
+  run(kDamBreak, "db");
+  const CommandResult r = sph({"render", "db", "--no-progress"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const fs::path out = tmp_.path() / "db" / "render";
+  EXPECT_EQ(pngs_in(out), (std::vector<std::string>{"frame_000000.png", "frame_000001.png", "frame_000002.png",
+                                                    "frame_000003.png", "frame_000004.png"}));
+  const auto first = load_png(out / "frame_000000.png");
+  const auto last = load_png(out / "frame_000004.png");
+  ASSERT_EQ(first.width, last.width);
+  ASSERT_EQ(first.height, 720);
+  EXPECT_GT(first.width, 1280);  // the color bar beside the 1280-pixel panel
+  EXPECT_NE(first.rgb, last.rgb);  // the fluid moved
+  // The color bar (the strip right of the panel) is the same in every frame: one scale.
+  auto strip = [](const sph::test::DecodedPng& d) {
+    std::vector<std::uint8_t> s;
+    for (int y = 0; y < d.height; ++y)
+      s.insert(s.end(), d.rgb.begin() + 3 * (y * d.width + 1280), d.rgb.begin() + 3 * (y * d.width + d.width));
+    return s;
+  };
+  EXPECT_EQ(strip(first), strip(last));
+  // Rendering fewer frames again replaces the earlier images.
+  const CommandResult again = sph({"render", "db", "--frames", "last", "--no-progress"});
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_EQ(pngs_in(out), (std::vector<std::string>{"frame_000004.png"}));
+}
+
+TEST_F(Render, TheChosenFieldCameraAndSizeAreUsed) {
+  run(kBlock, "block");
+  ASSERT_EQ(sph({"render", "block", "--frames", "-1", "--size", "320x240", "-o", "a", "--no-progress"}).code, 0);
+  ASSERT_EQ(sph({"render", "block", "--frames", "-1", "--size", "320x240", "--azimuth", "-60", "-o", "b",
+                 "--no-progress"})
+                .code,
+            0);
+  ASSERT_EQ(sph({"render", "block", "--frames", "-1", "--size", "320x240", "--color-by", "initial_position", "-o",
+                 "c", "--no-progress"})
+                .code,
+            0);
+  const auto a = load_png(tmp_.path() / "a" / "frame_000004.png");
+  const auto b = load_png(tmp_.path() / "b" / "frame_000004.png");
+  const auto c = load_png(tmp_.path() / "c" / "frame_000004.png");
+  EXPECT_EQ(a.height, 240);
+  EXPECT_EQ(a.width, b.width);
+  EXPECT_NE(a.rgb, b.rgb);    // another camera
+  EXPECT_EQ(c.width, 320);    // initial position: a key, no color bar
+}
+
+TEST_F(Render, AMovieHasOneFramePerImage) {
+  run(kDamBreak, "db");
+  const CommandResult r = sph({"render", "db", "--mp4", "--no-png", "--size", "320x240", "--no-progress"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const fs::path movie = tmp_.path() / "db" / "render" / "movie.mp4";
+  ASSERT_TRUE(fs::is_regular_file(movie)) << r.err;
+  EXPECT_TRUE(pngs_in(movie.parent_path()).empty());
+  const CommandResult probe = sph::test::run_sph({}, tmp_.path(), tmp_.path() / "probe_err.txt",
+                                                 "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                                                 "stream=codec_name,nb_read_frames -of csv=p=0 " +
+                                                     sph::test::shell_quote(movie.string()) + " #");
+  EXPECT_CONTAINS(probe.out, "h264,5");
+}
+
+TEST_F(Render, ACompareDirectoryShowsTheModesSideBySide) {
+  const CommandResult c = sph({"compare", kDamBreak, "--steps", "100", "--modes", "standard,adaptive", "--set",
+                               "Configuration.outputEveryNSteps=50", "--perturbation", "0", "--no-audit",
+                               "--no-progress", "-o", "cmp"});
+  ASSERT_EQ(c.code, 0) << c.err;
+  // Each mode's run directory, in run order, with its own mode in scene.json; not the chaos run.
+  EXPECT_EQ(sph::test::slurp(tmp_.path() / "cmp" / "runs.txt"), "standard\nadaptive\n");
+  EXPECT_CONTAINS(sph::test::slurp(tmp_.path() / "cmp" / "adaptive" / "scene.json"), "\"neighbors\": \"adaptive\"");
+  EXPECT_TRUE(fs::is_regular_file(tmp_.path() / "cmp" / "adaptive" / "frames" / "frame_000002.vtu"));
+  const CommandResult r = sph({"render", "cmp", "--frames", "last", "--size", "300x200", "--no-progress"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto img = load_png(tmp_.path() / "cmp" / "render" / "frame_000002.png");
+  EXPECT_GT(img.width, 600);   // two panels and the color bar
+  EXPECT_GT(img.height, 200);  // under a caption row
+}
+
+TEST_F(Render, MistakesAreRefusedBeforeAnythingIsWritten) {
+  run(kDamBreak, "db", {"--set", "Configuration.outputFields=[\"velocity\"]"});
+  const fs::path out = tmp_.path() / "db" / "render";
+  expect_refused({"render", "missing"}, "missing", tmp_.path() / "missing");
+  fs::create_directories(tmp_.path() / "empty");
+  expect_refused({"render", "empty"}, "empty", tmp_.path() / "empty" / "render");
+  expect_refused({"render", "db", "--color-by", "velocity"}, "expected one of: speed", out);
+  expect_refused({"render", "db", "--color-by", "density"}, "'density'", out);
+  expect_refused({"render", "db", "--color-by", "initial_position"}, "--fields", out);
+  expect_refused({"render", "db", "--size", "12x"}, "--size", out);
+  expect_refused({"render", "db", "--frames", "5"}, "frame 5 does not exist", out);
+  expect_refused({"render", "db", "--frames", "1,x"}, "--frames", out);
+  expect_refused({"render", "db", "--range", "2,1"}, "--range", out);
+  expect_refused({"render", "db", "--colormap", "jet"}, "--colormap", out);
+  expect_refused({"render", "db", "--no-png"}, "--mp4", out);
+  expect_refused({"render", "db", "--format", "ply"}, "ply", out);
+  sph::test::spit(tmp_.path() / "afile", "x");
+  const CommandResult r = sph({"render", "db", "-o", "afile/sub", "--no-progress"});
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_CONTAINS(r.err, "afile");
+}
+
+}  // namespace

@@ -231,10 +231,15 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesyste
              "sph: done: {} steps, {} particles, {:.2f} s ({:.3f} ms/step). {} {} frames.\n"
              "{}"
              "  {}/stats.csv    per-step energy, neighbors and phase timings\n"
-             "  {}/summary.json totals\n",
+             "  {}/summary.json totals\n"
+             "{}",
              ran, sim.particles().size(), seconds, 1e3 * seconds / static_cast<double>(std::max<std::int64_t>(ran, 1)),
              checkpoint ? "The run now has" : "Wrote", out.frames_written(), frames_hint(desc.output, dir),
-             dir.string(), dir.string());
+             dir.string(), dir.string(),
+             out.frames_written() > 0
+                 ? fmt::format("  look at it: sph render {0} --mp4 (PNG frames, a movie); sph view {0} (a web page)\n",
+                               shell_word(dir.string()))
+                 : std::string());
   if (opt.audit)
     fmt::print(stderr,
                "sph: audit: {} pairs within h were missing from the lists, in {} of {} steps; the deepest miss "

@@ -72,9 +72,13 @@ int main(int argc, char** argv) {
       "  sph validate [--cases martin_moyce,resolution,hydrostatic,conservation|all] [--quick] [-o DIR]\n"
       "                     validate against experiment and physics: report, plots, CSVs (exit 1 on a miss)\n"
       "  sph render DIR [--color-by speed|kinetic_energy|density|pressure|initial_position] [--mp4]\n"
-      "                     PNG images (and an MP4) of a run's frames; a comparison's runs side by side\n\n"
+      "                     PNG images (and an MP4) of a run's frames; a comparison's runs side by side\n"
+      "  sph view DIR [-o FILE.html] [--max-frames N] [--color-by LIST]\n"
+      "                     one HTML page that plays the run in 3D in a browser, offline\n\n"
       "Example: sph run scenes/paper/dam_break_2d.json -o out/dam_break_2d\n"
-      "         then open out/dam_break_2d/frames.pvd in ParaView.",
+      "         sph render out/dam_break_2d --mp4   (pictures and a movie in out/dam_break_2d/render/)\n"
+      "         sph view out/dam_break_2d           (out/dam_break_2d/view.html: open it in a browser)\n"
+      "         or open out/dam_break_2d/frames.pvd in ParaView.",
       "sph"};
   app.set_version_flag("--version", std::string("sph ") + sph::kVersion);
   app.require_subcommand(1);
@@ -83,6 +87,7 @@ int main(int argc, char** argv) {
   std::function<int()> bench_cmd = add_bench_command(app);
   std::function<int()> validate_cmd = add_validate_command(app);
   std::function<int()> render_cmd = add_render_command(app);
+  std::function<int()> view_cmd = add_view_command(app);
 
   try {
     app.parse(argc, argv);
@@ -102,7 +107,7 @@ int main(int argc, char** argv) {
     std::string sub = "run";
     for (int i = 1; i < argc; ++i)
       if (const std::string a = argv[i]; a == "run" || a == "compare" || a == "bench" || a == "validate" ||
-                                             a == "render") {
+                                             a == "render" || a == "view") {
         sub = a;
         break;
       }
@@ -114,6 +119,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("bench")) return bench_cmd();
     if (app.got_subcommand("validate")) return validate_cmd();
     if (app.got_subcommand("render")) return render_cmd();
+    if (app.got_subcommand("view")) return view_cmd();
     return app.got_subcommand("compare") ? compare_cmd() : run_cmd();
   } catch (const sph::Error& e) {
     fmt::print(stderr, "sph: error: {}\n", e.what());

@@ -69,7 +69,8 @@ TEST_F(Render, EveryFrameBecomesAnImageWithOneColorScaleForTheRun) {
   const auto first = load_png(out / "frame_000000.png");
   const auto last = load_png(out / "frame_000004.png");
   ASSERT_EQ(first.width, last.width);
-  ASSERT_EQ(first.height, 720);
+  ASSERT_GT(first.height, 720);  // the panel under a caption row with the time
+  ASSERT_LT(first.height, 800);
   EXPECT_GT(first.width, 1280);  // the color bar beside the 1280-pixel panel
   EXPECT_NE(first.rgb, last.rgb);  // the fluid moved
   // The color bar (the strip right of the panel) is the same in every frame: one scale.
@@ -100,7 +101,8 @@ TEST_F(Render, TheChosenFieldCameraAndSizeAreUsed) {
   const auto a = load_png(tmp_.path() / "a" / "frame_000004.png");
   const auto b = load_png(tmp_.path() / "b" / "frame_000004.png");
   const auto c = load_png(tmp_.path() / "c" / "frame_000004.png");
-  EXPECT_EQ(a.height, 240);
+  EXPECT_GT(a.height, 240);
+  EXPECT_LT(a.height, 300);
   EXPECT_EQ(a.width, b.width);
   EXPECT_NE(a.rgb, b.rgb);    // another camera
   EXPECT_EQ(c.width, 320);    // initial position: a key, no color bar

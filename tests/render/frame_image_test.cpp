@@ -72,17 +72,18 @@ TEST(FrameImage, TheParticleHasItsSpeedsColorWhereItIs) {
   // The color bar widens the image and holds the map's ends.
   EXPECT_GT(img.width(), 400);
   EXPECT_GT(count_color(img, colormap(Colormap::Turbo, 0.0), 400, 0, img.width(), 200), 5);
-  // The time label: ink in the top-left corner, where the empty box has none.
-  EXPECT_GT(count_dark(img, 0, 0, 120, 20), 20);
+  // The time in a caption row above the panel.
+  EXPECT_GT(img.height(), 200);
+  EXPECT_GT(count_dark(img, 150, 0, 250, img.height() - 200), 20);
 }
 
 TEST(FrameImage, InitialPositionHasAKeyInsteadOfAColorBar) {
   const std::vector<RunDirectory> runs{run2d("a")};
   const std::vector<FrameData> frames{one_particle(1.0, 0.5, 0.0, 0.0)};
   const Image img = render_frame(runs, frames, style(400, 200, ColorBy::InitialPosition));
-  EXPECT_EQ(img.width(), 400);
+  EXPECT_EQ(img.width(), 400);  // no color bar
   EXPECT_GT(count_color(img, Rgb{255, 255, 40}), 100);  // x and y at their high ends, z flat
-  EXPECT_GT(count_dark(img, 0, 180, 400, 200), 20);     // the key along the bottom
+  EXPECT_GT(count_dark(img, 0, img.height() - 20, 400, img.height()), 20);  // the key along the bottom
 }
 
 TEST(FrameImage, SeveralRunsSideBySideWithCaptions) {

@@ -60,16 +60,17 @@ Image render_frame(std::span<const RunDirectory> runs, std::span<const FrameData
     const std::vector<double> xyz = coordinates(frame, run.dimension);
     panels.push_back(
         render_particles(xyz, run.dimension, colors, run.particle_radius, run.box_lo, run.box_hi, style.view));
-    if (runs.size() > 1) captions.push_back(run.label);
+    // The time in a caption row above the panel, where it never covers particles or the box.
+    captions.push_back(runs.size() > 1 ? fmt::format("{}, {}", run.label, time_label(frame.time))
+                                       : time_label(frame.time));
   }
-  Image img = panels.size() == 1 ? std::move(panels[0]) : hstack(panels, captions, style.view.background);
-  const int scale = style.view.height >= 600 ? 2 : 1;
-  draw_text(img, 8 * scale, 6 * scale, time_label(frames[0].time), kInk, scale);
+  Image img = hstack(panels, captions, style.view.background);
   if (!style.legend) return img;
   const int dim = runs[0].dimension;
   if (color_by_is_scalar(style.color.by))
     return add_colorbar(img, style.color.map, style.color.lo, style.color.hi, color_by_label(style.color.by, dim),
                         style.view.background);
+  const int scale = style.view.height >= 380 ? 2 : 1;  // as add_colorbar chooses for its labels
   const std::string key = dim == 3 ? "color: initial x red, y green, z blue" : "color: initial x red, y green";
   draw_text(img, 8 * scale, img.height() - text_height(scale) - 6 * scale, key, kInk, scale);
   return img;

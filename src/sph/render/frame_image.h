@@ -26,9 +26,8 @@ struct FrameStyle {
 std::pair<double, double> run_color_range(std::span<const RunDirectory> runs, ColorBy by, std::size_t max_frames = 60,
                                           std::size_t max_values = 50000);
 
-/// One panel per run, side by side, each captioned with its run's label when there are several;
-/// `frames[k]` is a frame of `runs[k]`. The simulated time of the first frame is written in the
-/// top-left corner. Throws sph::Error as particle_colors and ParticleCamera do. Precondition:
+/// One panel per run, side by side, each under a caption with its frame's simulated time (and
+/// its run's label when there are several); `frames[k]` is a frame of `runs[k]`. Throws sph::Error as particle_colors and ParticleCamera do. Precondition:
 /// runs.size() == frames.size() >= 1.
 Image render_frame(std::span<const RunDirectory> runs, std::span<const FrameData> frames, const FrameStyle& style);
 

@@ -1,0 +1,520 @@
+#include <sph/render/viewer.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <optional>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <sph/core/error.h>
+#include <sph/io/frames.h>
+#include <sph/render/colormap.h>
+
+namespace sph {
+
+namespace detail {
+// The page's sources, compiled in by cmake/embed_files.cmake (viewer_assets.cpp, generated).
+std::string_view viewer_html();
+std::string_view viewer_css();
+std::string_view viewer_js();
+}  // namespace detail
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr char kBase64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+/// Base64 length of n bytes.
+constexpr std::size_t b64_size(std::size_t n) { return 4 * ((n + 2) / 3); }
+
+/// JSON text of a string, safe inside a <script> element: "</" would end the element, so '<' is
+/// written as its escape.
+std::string json_string(const std::string& s) {
+  std::string out;
+  for (char c : nlohmann::json(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)) {
+    if (c == '<')
+      out += "\\u003c";
+    else
+      out += c;
+  }
+  return out;
+}
+
+/// Text for HTML (element content or a quoted attribute).
+std::string html_escape(std::string_view s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+/// The number as JSON (finite values only; JSON has no NaN).
+std::string json_number(double x) { return std::isfinite(x) ? fmt::format("{}", x) : "0"; }
+
+/// Positions are quantized over the container grown by a tenth of its largest side, so that
+/// spray above the walls and particles pressed into the penalty walls keep their place.
+struct QuantBox {
+  std::array<double, 3> lo{}, hi{};
+};
+
+QuantBox quant_box(const RunDirectory& run) {
+  double extent = 0;
+  for (int d = 0; d < run.dimension; ++d) extent = std::max(extent, run.box_hi[d] - run.box_lo[d]);
+  if (!(extent > 0) || !std::isfinite(extent)) extent = 1;
+  QuantBox q;
+  for (int d = 0; d < 3; ++d) {
+    q.lo[d] = run.box_lo[d] - (d < run.dimension ? 0.1 * extent : 0.0);
+    q.hi[d] = run.box_hi[d] + (d < run.dimension ? 0.1 * extent : 0.0);
+    if (!(q.hi[d] > q.lo[d])) q.hi[d] = q.lo[d] + 1;  // z in 2D: never stored
+  }
+  return q;
+}
+
+/// One frame as the page stores it, before the scalars are quantized (their range is run-wide).
+struct EncodedFrame {
+  double time = 0;
+  std::size_t size = 0;
+  std::vector<std::uint16_t> position;     ///< dim per particle
+  std::vector<std::vector<float>> values;  ///< per offered scalar quantity
+  std::vector<std::uint8_t> rgb;           ///< initial-position colors, when per frame
+};
+
+struct EncodedRun {
+  std::string label;
+  std::vector<EncodedFrame> frames;
+  std::vector<std::uint8_t> rgb;  ///< initial-position colors by particle index, when shared
+  bool rgb_per_frame = false;
+};
+
+void append_b64(std::string& out, std::span<const std::uint8_t> bytes) {
+  const std::size_t n = bytes.size();
+  out.reserve(out.size() + b64_size(n));
+  std::size_t i = 0;
+  for (; i + 3 <= n; i += 3) {
+    const std::uint32_t v = (bytes[i] << 16) | (bytes[i + 1] << 8) | bytes[i + 2];
+    out += kBase64[v >> 18];
+    out += kBase64[(v >> 12) & 63];
+    out += kBase64[(v >> 6) & 63];
+    out += kBase64[v & 63];
+  }
+  if (i < n) {
+    const std::uint32_t v = (bytes[i] << 16) | (i + 1 < n ? bytes[i + 1] << 8 : 0);
+    out += kBase64[v >> 18];
+    out += kBase64[(v >> 12) & 63];
+    out += i + 1 < n ? kBase64[(v >> 6) & 63] : '=';
+    out += '=';
+  }
+}
+
+/// The uint16 values as little-endian bytes (what the page reads whatever this machine is).
+std::vector<std::uint8_t> little_endian(const std::vector<std::uint16_t>& v) {
+  std::vector<std::uint8_t> out(2 * v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    out[2 * i] = static_cast<std::uint8_t>(v[i] & 0xff);
+    out[2 * i + 1] = static_cast<std::uint8_t>(v[i] >> 8);
+  }
+  return out;
+}
+
+/// Replaces each @SPH_NAME@ marker of the template by its text, in one pass (inserted text is
+/// never scanned again, so data that happens to contain a marker is left alone).
+std::string fill_template(std::string_view tpl,
+                          const std::vector<std::pair<std::string_view, std::string_view>>& parts) {
+  std::size_t total = tpl.size();
+  for (const auto& p : parts) total += p.second.size();
+  std::string out;
+  out.reserve(total);
+  std::size_t at = 0;
+  while (true) {
+    const std::size_t m = tpl.find("@SPH_", at);
+    if (m == std::string_view::npos) break;
+    const std::size_t end = tpl.find('@', m + 1);
+    SPH_CHECK(end != std::string_view::npos, "unterminated marker in viewer.html");
+    const std::string_view name = tpl.substr(m + 1, end - m - 1);
+    const auto it = std::find_if(parts.begin(), parts.end(), [&](const auto& p) { return p.first == name; });
+    if (it == parts.end()) {  // not a marker (e.g. prose in a comment): keep it
+      out.append(tpl.substr(at, end - at));
+      at = end;
+      continue;
+    }
+    out.append(tpl.substr(at, m - at));
+    out.append(it->second);
+    at = end + 1;
+  }
+  out.append(tpl.substr(at));
+  return out;
+}
+
+/// Frames of each run the page keeps.
+std::vector<std::vector<std::size_t>> pick_frames(const std::vector<RunDirectory>& runs, std::size_t max_frames) {
+  std::vector<std::vector<std::size_t>> picks;
+  for (const RunDirectory& r : runs) picks.push_back(subsample_frames(r.frames.size(), max_frames));
+  return picks;
+}
+
+/// The quantities offered: those asked for (each must be in the frames), or all the frames hold.
+std::vector<ColorBy> offered_quantities(const std::vector<ColorBy>& asked, const std::vector<RunDirectory>& runs,
+                                        const std::vector<FrameData>& first_frames) {
+  const auto held = [&](ColorBy by) {
+    for (const FrameData& f : first_frames)
+      if (f.field(color_by_field(by)) == nullptr) return false;
+    return true;
+  };
+  std::vector<ColorBy> out;
+  if (!asked.empty()) {
+    for (ColorBy by : asked) {
+      if (!held(by)) {
+        std::size_t k = 0;
+        while (first_frames[k].field(color_by_field(by)) != nullptr) ++k;
+        throw Error(fmt::format("the frames of {} hold no '{}' field, which coloring by {} needs; run the scene with "
+                                "that field in Configuration.outputFields, or choose another quantity",
+                                runs[k].dir.string(), color_by_field(by), color_by_name(by)),
+                    "--color-by");
+      }
+      if (std::find(out.begin(), out.end(), by) == out.end()) out.push_back(by);
+    }
+    return out;
+  }
+  for (ColorBy by : kColorByAll)
+    if (held(by)) out.push_back(by);
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::size_t> subsample_frames(std::size_t total, std::size_t max_frames) {
+  SPH_CHECK(max_frames >= 2, "max_frames must be at least 2");
+  std::vector<std::size_t> idx;
+  if (total <= max_frames) {
+    idx.resize(total);
+    std::iota(idx.begin(), idx.end(), std::size_t{0});
+    return idx;
+  }
+  // Evenly spaced over [0, total - 1]: distinct, since the spacing exceeds 1.
+  for (std::size_t k = 0; k < max_frames; ++k)
+    idx.push_back(static_cast<std::size_t>(
+        std::llround(static_cast<double>(k) * static_cast<double>(total - 1) / static_cast<double>(max_frames - 1))));
+  return idx;
+}
+
+std::uint16_t quantize_position(double x, double lo, double hi) {
+  if (std::isnan(x)) return 0;
+  const double t = std::clamp((x - lo) / (hi - lo), 0.0, 1.0);
+  return static_cast<std::uint16_t>(std::lround(t * 65535.0));
+}
+
+std::uint8_t quantize_scalar(double x, double lo, double hi) {
+  if (std::isnan(x)) return 255;
+  const double t = std::clamp((x - lo) / (hi - lo), 0.0, 1.0);
+  return static_cast<std::uint8_t>(std::lround(t * 254.0));
+}
+
+std::string base64_encode(std::span<const std::uint8_t> bytes) {
+  std::string out;
+  append_b64(out, bytes);
+  return out;
+}
+
+std::vector<std::uint8_t> base64_decode(std::string_view text) {
+  if (text.size() % 4 != 0) throw Error("base64 text of a length that is not a multiple of 4");
+  std::vector<std::uint8_t> out;
+  out.reserve(text.size() / 4 * 3);
+  const auto value = [](char c) -> int {
+    const char* p = std::find(std::begin(kBase64), std::end(kBase64) - 1, c);
+    return p == std::end(kBase64) - 1 ? -1 : static_cast<int>(p - kBase64);
+  };
+  for (std::size_t i = 0; i < text.size(); i += 4) {
+    int v[4];
+    int pad = 0;
+    for (int k = 0; k < 4; ++k) {
+      const char c = text[i + k];
+      if (c == '=' && i + 4 == text.size() && k >= 2) {
+        v[k] = 0;
+        ++pad;
+        continue;
+      }
+      if (pad > 0 || (v[k] = value(c)) < 0) throw Error(fmt::format("bad base64 character at offset {}", i + k));
+    }
+    const std::uint32_t w = (v[0] << 18) | (v[1] << 12) | (v[2] << 6) | v[3];
+    out.push_back(static_cast<std::uint8_t>(w >> 16));
+    if (pad < 2) out.push_back(static_cast<std::uint8_t>((w >> 8) & 0xff));
+    if (pad < 1) out.push_back(static_cast<std::uint8_t>(w & 0xff));
+  }
+  return out;
+}
+
+std::string view_page_data(std::string_view html) {
+  const std::string_view open = "<script id=\"sph-data\" type=\"application/json\">";
+  const std::size_t a = html.find(open);
+  const std::size_t b = a == std::string_view::npos ? a : html.find("</script>", a);
+  if (b == std::string_view::npos) throw Error("not a page of sph view: it holds no sph-data block");
+  return std::string(html.substr(a + open.size(), b - a - open.size()));
+}
+
+ViewPage build_view_page(const fs::path& dir, const ViewOptions& options) {
+  if (options.max_frames < 2) throw Error("must be at least 2", "--max-frames");
+  std::vector<RunDirectory> runs;
+  for (const fs::path& d : run_directories(dir)) runs.push_back(open_run_directory(d));
+  const RunDirectory& run0 = runs.front();
+  const int dim = run0.dimension;
+  for (const RunDirectory& r : runs)
+    if (r.dimension != dim)
+      throw Error(fmt::format("its runs mix {}D and {}D scenes; expected runs of one scene", dim, r.dimension),
+                  dir.string());
+  const auto picks = pick_frames(runs, options.max_frames);
+
+  // First and last frames: the fields the runs hold, and particle counts for the size estimate
+  // (refused before the other frames are read; emitters only ever add particles).
+  std::vector<FrameData> first_frames;
+  std::size_t max_particles = 0;
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    first_frames.push_back(read_frame(runs[r].frames[picks[r].front()]));
+    max_particles = std::max(max_particles, first_frames.back().size);
+    if (picks[r].size() > 1) max_particles = std::max(max_particles, read_frame(runs[r].frames[picks[r].back()]).size);
+  }
+  const std::vector<ColorBy> quantities = offered_quantities(options.color_by, runs, first_frames);
+  std::vector<ColorBy> scalars;
+  bool with_rgb = false;
+  for (ColorBy by : quantities) {
+    if (color_by_is_scalar(by))
+      scalars.push_back(by);
+    else
+      with_rgb = true;
+  }
+  {
+    std::size_t frames = 0;
+    for (const auto& p : picks) frames += p.size();
+    const std::size_t per_particle = 2 * static_cast<std::size_t>(dim) + scalars.size();
+    const std::size_t estimate = b64_size(per_particle * max_particles) * frames + 100 * frames +
+                                 (with_rgb ? b64_size(3 * max_particles) * runs.size() : 0) +
+                                 detail::viewer_html().size() + detail::viewer_css().size() +
+                                 detail::viewer_js().size();
+    if (estimate > options.max_bytes) {
+      const std::size_t per_frame = std::max<std::size_t>(1, estimate / std::max<std::size_t>(1, frames));
+      const std::size_t fit = options.max_bytes / per_frame / runs.size();
+      throw Error(fmt::format("the page would be about {:.0f} MB ({} frames of up to {} particles), more than the "
+                              "limit of {:.0f} MB; use --max-frames {} (or fewer), fewer quantities with --color-by, "
+                              "or raise the limit with --max-size",
+                              static_cast<double>(estimate) / 1e6, frames, max_particles,
+                              static_cast<double>(options.max_bytes) / 1e6, std::max<std::size_t>(2, fit)),
+                  dir.string());
+    }
+  }
+
+  // Read every kept frame once: positions quantized now, scalars kept until their run-wide
+  // range is known. The range comes from a sample of at most ~4 million values per quantity
+  // (a percentile does not need them all).
+  std::size_t total_values = 0;
+  for (const auto& p : picks) total_values += p.size() * max_particles;
+  const std::size_t stride = std::max<std::size_t>(1, total_values / 4'000'000);
+  std::vector<std::vector<std::vector<double>>> samples(scalars.size());
+  std::vector<EncodedRun> encoded(runs.size());
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    const RunDirectory& run = runs[r];
+    const QuantBox qb = quant_box(run0);
+    EncodedRun& er = encoded[r];
+    er.label = run.label;
+    bool ids_dense = true;
+    std::vector<std::uint8_t> rgb_by_id;
+    for (std::size_t k = 0; k < picks[r].size(); ++k) {
+      const std::size_t index = picks[r][k];
+      FrameData frame = r < first_frames.size() && k == 0 ? std::move(first_frames[r]) : read_frame(run.frames[index]);
+      const std::size_t n = frame.size;
+      // Particles in id order: frames are written in the solver's (Morton) order, which changes.
+      std::vector<std::size_t> order(n);
+      std::iota(order.begin(), order.end(), std::size_t{0});
+      if (const FrameField* id = frame.field("id"); id != nullptr && id->values.size() == n) {
+        std::stable_sort(order.begin(), order.end(),
+                         [&](std::size_t a, std::size_t b) { return id->values[a] < id->values[b]; });
+        for (std::size_t i = 0; i < n && ids_dense; ++i) ids_dense = id->values[order[i]] == static_cast<double>(i);
+      } else {
+        ids_dense = false;
+      }
+      EncodedFrame ef;
+      ef.time = frame.time;
+      ef.size = n;
+      ef.position.resize(n * static_cast<std::size_t>(dim));
+      for (std::size_t i = 0; i < n; ++i)
+        for (int d = 0; d < dim; ++d)
+          ef.position[i * dim + d] = quantize_position(frame.position[3 * order[i] + d], qb.lo[d], qb.hi[d]);
+      for (std::size_t s = 0; s < scalars.size(); ++s) {
+        const std::vector<double> v = color_values(frame, scalars[s], run);
+        std::vector<float>& out = ef.values.emplace_back(n);
+        for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<float>(v[order[i]]);
+        std::vector<double>& sample = samples[s].emplace_back();
+        for (std::size_t i = 0; i < n; i += stride) sample.push_back(v[i]);
+      }
+      if (with_rgb) {
+        const std::vector<Rgb> c = particle_colors(frame, ColorSpec{ColorBy::InitialPosition}, run);
+        ef.rgb.resize(3 * n);
+        for (std::size_t i = 0; i < n; ++i) {
+          ef.rgb[3 * i] = c[order[i]].r;
+          ef.rgb[3 * i + 1] = c[order[i]].g;
+          ef.rgb[3 * i + 2] = c[order[i]].b;
+        }
+        if (ef.rgb.size() > rgb_by_id.size()) rgb_by_id = ef.rgb;
+      }
+      max_particles = std::max(max_particles, n);
+      er.frames.push_back(std::move(ef));
+    }
+    // A particle keeps its id, and so its initial position: when every frame holds ids 0..n-1,
+    // one color per id serves all frames.
+    if (with_rgb) {
+      er.rgb_per_frame = !ids_dense;
+      if (ids_dense) {
+        er.rgb = std::move(rgb_by_id);
+        for (EncodedFrame& f : er.frames) f.rgb.clear();
+      }
+    }
+  }
+
+  // The quantities' run-wide ranges, shared by every run of a compare directory so that a
+  // color means the same in every panel.
+  struct Offered {
+    ColorBy by;
+    double lo = 0, hi = 1;
+    bool clipped = false;
+  };
+  std::vector<Offered> offered;
+  for (std::size_t s = 0; s < scalars.size(); ++s) {
+    const auto [lo, hi] = color_range(scalars[s], samples[s]);
+    offered.push_back({scalars[s], lo, hi, false});
+    samples[s].clear();
+    samples[s].shrink_to_fit();
+  }
+
+  // The data block: frames first (the bulk), the small header around them.
+  std::string runs_json = "[";
+  for (std::size_t r = 0; r < encoded.size(); ++r) {
+    EncodedRun& er = encoded[r];
+    runs_json += (r ? ",{" : "{") + std::string("\"label\":") + json_string(er.label);
+    if (with_rgb && !er.rgb_per_frame) {
+      runs_json += ",\"rgb\":\"";
+      append_b64(runs_json, er.rgb);
+      runs_json += '"';
+    }
+    runs_json += ",\"frames\":[";
+    for (std::size_t k = 0; k < er.frames.size(); ++k) {
+      EncodedFrame& f = er.frames[k];
+      runs_json += fmt::format("{}{{\"t\":{},\"n\":{},\"pos\":\"", k ? "," : "", json_number(f.time), f.size);
+      append_b64(runs_json, little_endian(f.position));
+      runs_json += "\",\"f\":{";
+      for (std::size_t s = 0; s < offered.size(); ++s) {
+        std::vector<std::uint8_t> q(f.size);
+        for (std::size_t i = 0; i < f.size; ++i) {
+          q[i] = quantize_scalar(f.values[s][i], offered[s].lo, offered[s].hi);
+          offered[s].clipped = offered[s].clipped || f.values[s][i] > offered[s].hi;
+        }
+        runs_json += fmt::format("{}\"{}\":\"", s ? "," : "", color_by_name(offered[s].by));
+        append_b64(runs_json, q);
+        runs_json += '"';
+      }
+      runs_json += '}';
+      if (!f.rgb.empty()) {
+        runs_json += ",\"rgb\":\"";
+        append_b64(runs_json, f.rgb);
+        runs_json += '"';
+      }
+      runs_json += '}';
+      f = EncodedFrame{};  // free as we go
+    }
+    runs_json += "]}";
+  }
+  runs_json += ']';
+
+  ViewPage page;
+  page.runs = runs.size();
+  page.frames_total = run0.frames.size();
+  page.frames_shown = picks.front().size();
+  page.max_particles = max_particles;
+  if (page.frames_shown < page.frames_total)
+    page.notes.push_back(
+        fmt::format("Showing {} of the run's {} frames, evenly spaced (sph view --max-frames N "
+                    "keeps up to N).",
+                    page.frames_shown, page.frames_total));
+
+  std::string colors = "[";
+  for (const Offered& o : offered) {
+    std::vector<std::uint8_t> lut;
+    const Colormap map = default_colormap(o.by);
+    for (int i = 0; i < 256; ++i) {
+      const Rgb c = colormap(map, i / 255.0);
+      lut.insert(lut.end(), {c.r, c.g, c.b});
+    }
+    colors += fmt::format(
+        "{}{{\"name\":\"{}\",\"label\":{},\"scalar\":true,\"lo\":{},\"hi\":{},\"clipped\":{},"
+        "\"colormap\":\"{}\",\"lut\":\"{}\"}}",
+        colors.size() > 1 ? "," : "", color_by_name(o.by), json_string(color_by_label(o.by, dim)), json_number(o.lo),
+        json_number(o.hi), o.clipped ? "true" : "false", colormap_name(map), base64_encode(lut));
+  }
+  if (with_rgb)
+    colors += fmt::format("{}{{\"name\":\"{}\",\"label\":{},\"scalar\":false}}", colors.size() > 1 ? "," : "",
+                          color_by_name(ColorBy::InitialPosition),
+                          json_string(color_by_label(ColorBy::InitialPosition, dim)));
+  if (offered.empty() && !with_rgb) {
+    // Frames with positions only: one plain color (every particle at the middle of this map).
+    const std::vector<std::uint8_t> lut(3 * 256, 0);
+    std::vector<std::uint8_t> blue = lut;
+    for (int i = 0; i < 256; ++i) blue[3 * i] = 52, blue[3 * i + 1] = 110, blue[3 * i + 2] = 190;
+    colors += fmt::format(
+        "{{\"name\":\"uniform\",\"label\":\"one color (the frames hold no field to color by)\","
+        "\"scalar\":true,\"lo\":0,\"hi\":1,\"clipped\":false,\"lut\":\"{}\"}}",
+        base64_encode(blue));
+  }
+  colors += ']';
+
+  const QuantBox qb = quant_box(run0);
+  const auto vec3 = [](const std::array<double, 3>& v) {
+    return fmt::format("[{},{},{}]", json_number(v[0]), json_number(v[1]), json_number(v[2]));
+  };
+  std::string notes = "[";
+  for (const std::string& n : page.notes) notes += (notes.size() > 1 ? "," : "") + json_string(n);
+  notes += ']';
+  const std::string default_color =
+      !quantities.empty() ? std::string(color_by_name(quantities.front())) : std::string("uniform");
+  std::string data = fmt::format(
+      "{{\"format\":\"sph-view\",\"version\":1,\"title\":{},\"description\":{},\"dimension\":{},"
+      "\"box\":{{\"lo\":{},\"hi\":{}}},\"qbox\":{{\"lo\":{},\"hi\":{}}},\"radius\":{},\"colors\":{},"
+      "\"defaultColor\":\"{}\",\"notes\":{},\"runs\":",
+      json_string(run0.scene.name), json_string(run0.scene.description), dim, vec3(run0.box_lo), vec3(run0.box_hi),
+      vec3(qb.lo), vec3(qb.hi), json_number(run0.particle_radius), colors, default_color, notes);
+  data += runs_json;
+  runs_json.clear();
+  runs_json.shrink_to_fit();
+  data += '}';
+
+  const std::string html_title = html_escape(run0.scene.name) + " - sph view";
+  const std::string generator = html_escape(options.generator);
+  page.html = fill_template(detail::viewer_html(), {{"SPH_TITLE", html_title},
+                                                    {"SPH_GENERATOR", generator},
+                                                    {"SPH_CSS", detail::viewer_css()},
+                                                    {"SPH_DATA", data},
+                                                    {"SPH_JS", detail::viewer_js()}});
+  if (page.html.size() > options.max_bytes)
+    throw Error(fmt::format("the page is {:.0f} MB, more than the limit of {:.0f} MB; use a smaller --max-frames, "
+                            "fewer quantities with --color-by, or raise the limit with --max-size",
+                            static_cast<double>(page.html.size()) / 1e6, static_cast<double>(options.max_bytes) / 1e6),
+                dir.string());
+  return page;
+}
+
+}  // namespace sph

@@ -1,0 +1,215 @@
+// The page builder of `sph view`: base64 and quantization round trips, frame subsampling, the
+// data block read back against the frames it came from, and the errors a user can cause.
+// (tests/app/view_browser_test.py checks the page itself in a browser.)
+
+#include <sph/render/viewer.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sph/core/error.h>
+#include <sph/io/frames.h>
+
+#include "support/run_sph.h"
+#include "support/temp_dir.h"
+
+namespace sph {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(ViewerBase64, KnownVectorsAndRoundTrip) {
+  const auto enc = [](std::string_view s) {
+    return base64_encode({reinterpret_cast<const std::uint8_t*>(s.data()), s.size()});
+  };
+  EXPECT_EQ(enc(""), "");
+  EXPECT_EQ(enc("M"), "TQ==");
+  EXPECT_EQ(enc("Ma"), "TWE=");
+  EXPECT_EQ(enc("Man"), "TWFu");
+  std::mt19937 rng(7);
+  for (std::size_t n = 0; n < 70; ++n) {
+    std::vector<std::uint8_t> bytes(n);
+    for (auto& b : bytes) b = static_cast<std::uint8_t>(rng());
+    const std::string text = base64_encode(bytes);
+    EXPECT_EQ(text.size(), 4 * ((n + 2) / 3));
+    EXPECT_EQ(base64_decode(text), bytes) << n;
+  }
+}
+
+TEST(ViewerBase64, RejectsBadText) {
+  EXPECT_THROW(base64_decode("TWF"), Error);
+  EXPECT_THROW(base64_decode("TW<u"), Error);
+  EXPECT_THROW(base64_decode("T=Fu"), Error);
+  EXPECT_THROW(base64_decode("TQ==TQ=="), Error);
+}
+
+TEST(ViewerSubsample, KeepsAllWhenFewEnough) {
+  EXPECT_EQ(subsample_frames(0, 10), std::vector<std::size_t>{});
+  EXPECT_EQ(subsample_frames(3, 10), (std::vector<std::size_t>{0, 1, 2}));
+  EXPECT_EQ(subsample_frames(10, 10).size(), 10u);
+}
+
+TEST(ViewerSubsample, EvenlySpacedWithFirstAndLast) {
+  for (const auto& [total, max] :
+       std::vector<std::pair<std::size_t, std::size_t>>{{1001, 300}, {11, 2}, {101, 100}, {5000, 7}}) {
+    const auto idx = subsample_frames(total, max);
+    ASSERT_EQ(idx.size(), max);
+    EXPECT_EQ(idx.front(), 0u);
+    EXPECT_EQ(idx.back(), total - 1);
+    std::size_t lo = total, hi = 0;
+    for (std::size_t k = 1; k < idx.size(); ++k) {
+      ASSERT_GT(idx[k], idx[k - 1]);
+      lo = std::min(lo, idx[k] - idx[k - 1]);
+      hi = std::max(hi, idx[k] - idx[k - 1]);
+    }
+    EXPECT_LE(hi - lo, 1u) << total << " " << max;
+  }
+}
+
+TEST(ViewerQuantize, BoundsClampAndNan) {
+  EXPECT_EQ(quantize_position(0.0, 0.0, 2.0), 0);
+  EXPECT_EQ(quantize_position(2.0, 0.0, 2.0), 65535);
+  EXPECT_EQ(quantize_position(-5.0, 0.0, 2.0), 0);
+  EXPECT_EQ(quantize_position(7.0, 0.0, 2.0), 65535);
+  EXPECT_EQ(quantize_position(std::nan(""), 0.0, 2.0), 0);
+  EXPECT_NEAR(quantize_position(1.0, 0.0, 2.0) * 2.0 / 65535.0, 1.0, 2.0 / 65535.0);
+  EXPECT_EQ(quantize_scalar(0.0, 0.0, 1.0), 0);
+  EXPECT_EQ(quantize_scalar(1.0, 0.0, 1.0), 254);
+  EXPECT_EQ(quantize_scalar(9.0, 0.0, 1.0), 254);
+  EXPECT_EQ(quantize_scalar(std::nan(""), 0.0, 1.0), 255);
+}
+
+/// A short 2D dam break with 5 frames (shared by the tests below; run once).
+const fs::path& dam_run() {
+  static test::TempDir dir;
+  static const fs::path run = [] {
+    const fs::path out = dir.path() / "dam";
+    const auto r =
+        test::run_sph({"run", std::string(SPH_SOURCE_DIR) + "/scenes/paper/dam_break_2d.json", "-o", out.string(),
+                       "--steps", "400", "--set", "Configuration.outputEveryNSteps=100", "--no-progress"},
+                      dir.path(), dir.path() / "err.txt");
+    EXPECT_EQ(r.code, 0) << r.err;
+    return out;
+  }();
+  return run;
+}
+
+TEST(ViewerPage, DataRoundTripsTheFrames) {
+  const fs::path run_dir = dam_run();
+  const RunDirectory run = open_run_directory(run_dir);
+  ASSERT_EQ(run.frames.size(), 5u);
+  ViewOptions opt;
+  opt.max_frames = 3;
+  const ViewPage page = build_view_page(run_dir, opt);
+  EXPECT_EQ(page.runs, 1u);
+  EXPECT_EQ(page.frames_total, 5u);
+  EXPECT_EQ(page.frames_shown, 3u);
+  ASSERT_EQ(page.notes.size(), 1u);
+  EXPECT_NE(page.notes[0].find("--max-frames"), std::string::npos);
+  EXPECT_NE(page.html.find("<!DOCTYPE html>"), std::string::npos);
+  for (const char* marker : {"@SPH_TITLE@", "@SPH_GENERATOR@", "@SPH_CSS@", "@SPH_DATA@", "@SPH_JS@"})
+    EXPECT_EQ(page.html.find(marker), std::string::npos) << marker;
+
+  const auto data = nlohmann::json::parse(view_page_data(page.html));
+  EXPECT_EQ(data["dimension"], 2);
+  EXPECT_EQ(data["title"], "dam_break_2d");
+  std::vector<std::string> names;
+  for (const auto& c : data["colors"]) names.push_back(c["name"]);
+  EXPECT_EQ(names, (std::vector<std::string>{"speed", "kinetic_energy", "density", "pressure", "initial_position"}));
+  EXPECT_EQ(data["defaultColor"], "speed");
+  ASSERT_EQ(data["runs"].size(), 1u);
+  const auto& frames = data["runs"][0]["frames"];
+  ASSERT_EQ(frames.size(), 3u);
+
+  const double qlo[2] = {data["qbox"]["lo"][0], data["qbox"]["lo"][1]};
+  const double qhi[2] = {data["qbox"]["hi"][0], data["qbox"]["hi"][1]};
+  const auto& speed = data["colors"][0];
+  const double slo = speed["lo"], shi = speed["hi"];
+  EXPECT_EQ(base64_decode(speed["lut"].get<std::string>()).size(), 3u * 256u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const FrameData frame = read_frame(run.frames[2 * k]);  // frames 0, 2, 4 of 5
+    const auto& f = frames[k];
+    EXPECT_DOUBLE_EQ(f["t"].get<double>(), frame.time);
+    ASSERT_EQ(f["n"].get<std::size_t>(), frame.size);
+    // Particles are stored in id order.
+    const FrameField* id = frame.field("id");
+    ASSERT_NE(id, nullptr);
+    std::vector<std::size_t> by_id(frame.size);
+    for (std::size_t i = 0; i < frame.size; ++i) by_id[static_cast<std::size_t>(id->values[i])] = i;
+    const std::vector<std::uint8_t> pos = base64_decode(f["pos"].get<std::string>());
+    ASSERT_EQ(pos.size(), 2 * 2 * frame.size);
+    const std::vector<std::uint8_t> q = base64_decode(f["f"]["speed"].get<std::string>());
+    ASSERT_EQ(q.size(), frame.size);
+    const FrameField* vel = frame.field("velocity");
+    for (std::size_t j = 0; j < frame.size; ++j) {
+      const std::size_t i = by_id[j];
+      for (int d = 0; d < 2; ++d) {
+        const unsigned u = pos[4 * j + 2 * d] | (pos[4 * j + 2 * d + 1] << 8);  // little endian
+        const double x = qlo[d] + u * (qhi[d] - qlo[d]) / 65535.0;
+        ASSERT_NEAR(x, frame.position[3 * i + d], 0.51 * (qhi[d] - qlo[d]) / 65535.0) << "frame " << k;
+      }
+      const double s = std::hypot(vel->values[3 * i], vel->values[3 * i + 1], vel->values[3 * i + 2]);
+      ASSERT_NEAR(slo + q[j] * (shi - slo) / 254.0, std::clamp(s, slo, shi), 0.51 * (shi - slo) / 254.0);
+    }
+  }
+  // Initial-position colors: one per particle, shared by the frames (ids 0..n-1 throughout).
+  EXPECT_EQ(base64_decode(data["runs"][0]["rgb"].get<std::string>()).size(), 3 * frames[0]["n"].get<std::size_t>());
+  EXPECT_FALSE(frames[0].contains("rgb"));
+}
+
+TEST(ViewerPage, ChosenQuantitiesOnlyAndInOrder) {
+  ViewOptions opt;
+  opt.color_by = {ColorBy::Density, ColorBy::InitialPosition, ColorBy::Density};
+  const auto data = nlohmann::json::parse(view_page_data(build_view_page(dam_run(), opt).html));
+  ASSERT_EQ(data["colors"].size(), 2u);
+  EXPECT_EQ(data["colors"][0]["name"], "density");
+  EXPECT_EQ(data["colors"][1]["name"], "initial_position");
+  EXPECT_EQ(data["defaultColor"], "density");
+  EXPECT_FALSE(data["runs"][0]["frames"][0]["f"].contains("speed"));
+}
+
+TEST(ViewerPage, CompareDirectoryGivesOnePanelPerRun) {
+  test::TempDir dir;
+  for (const char* mode : {"standard", "adaptive"}) fs::copy(dam_run(), dir.path() / mode, fs::copy_options::recursive);
+  test::spit(dir.path() / "runs.txt", "standard\nadaptive\n");
+  const ViewPage page = build_view_page(dir.path(), ViewOptions{});
+  EXPECT_EQ(page.runs, 2u);
+  const auto data = nlohmann::json::parse(view_page_data(page.html));
+  ASSERT_EQ(data["runs"].size(), 2u);
+  EXPECT_EQ(data["runs"][0]["frames"].size(), 5u);
+  EXPECT_EQ(data["runs"][1]["frames"].size(), 5u);
+}
+
+TEST(ViewerPage, Errors) {
+  test::TempDir dir;
+  const auto message = [](const auto& f) {
+    try {
+      f();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  // Missing, not a run directory, no frames.
+  EXPECT_NE(message([&] { build_view_page(dir.path() / "missing", {}); }).find("no such directory"), std::string::npos);
+  EXPECT_NE(message([&] { build_view_page(dir.path(), {}); }).find("neither a run directory"), std::string::npos);
+  fs::create_directories(dir.path() / "empty");
+  fs::copy_file(dam_run() / "scene.json", dir.path() / "empty" / "scene.json");
+  EXPECT_NE(message([&] { build_view_page(dir.path() / "empty", {}); }).find("no frames"), std::string::npos);
+  // Too large: refused before the frames are read, naming the option that helps.
+  ViewOptions small;
+  small.max_bytes = 100'000;
+  const std::string too_big = message([&] { build_view_page(dam_run(), small); });
+  EXPECT_NE(too_big.find("--max-frames"), std::string::npos) << too_big;
+  ViewOptions one;
+  one.max_frames = 1;
+  EXPECT_NE(message([&] { build_view_page(dam_run(), one); }).find("--max-frames"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sph

@@ -59,12 +59,8 @@ std::vector<NeighborMode> parse_modes(const std::string& list) {
 
 /// Creates `dir`, checks it is writable and removes what an earlier comparison left there.
 void prepare_compare_directory(const fs::path& dir) {
+  make_writable_directory(dir, "the comparison's output");
   std::error_code ec;
-  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-    throw Error("exists and is not a directory; expected a directory for the comparison's output", dir.string());
-  fs::create_directories(dir, ec);
-  if (ec) throw Error("cannot create the output directory: " + ec.message(), dir.string());
-  { AtomicFile probe(dir / ".write-test"); }
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
     const std::string f = entry.path().filename().string();
     // Files whose set depends on the options: images of other steps, the audit's plot.

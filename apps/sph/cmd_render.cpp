@@ -108,12 +108,8 @@ std::vector<std::size_t> parse_frames(const std::string& s, std::size_t count) {
 /// Creates `dir` if needed, checks that it is writable and removes the images and movie of an
 /// earlier render, so that two renders are never mixed.
 void prepare_render_directory(const fs::path& dir) {
+  make_writable_directory(dir, "the images");
   std::error_code ec;
-  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-    throw Error("exists and is not a directory; expected a directory for the images", dir.string());
-  fs::create_directories(dir, ec);
-  if (ec) throw Error("cannot create the output directory: " + ec.message(), dir.string());
-  { AtomicFile probe(dir / ".write-test"); }
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
     const std::string f = entry.path().filename().string();
     if ((f.rfind("frame_", 0) == 0 && entry.path().extension() == ".png") || f == "movie.mp4")

@@ -59,12 +59,8 @@ std::vector<std::string> parse_cases(const std::string& list) {
 /// Creates `dir`, checks it is writable and removes the files an earlier validation left there
 /// (their set depends on the cases run), so the directory holds only this run's results.
 void prepare_validation_directory(const fs::path& dir) {
+  make_writable_directory(dir, "the validation's output");
   std::error_code ec;
-  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-    throw Error("exists and is not a directory; expected a directory for the validation's output", dir.string());
-  fs::create_directories(dir, ec);
-  if (ec) throw Error("cannot create the output directory: " + ec.message(), dir.string());
-  { AtomicFile probe(dir / ".write-test"); }
   ValidationResult every;
   every.cases.assign(kValidationCases.begin(), kValidationCases.end());
   every.front_runs.resize(1);

@@ -23,29 +23,15 @@ import numpy as np
 import vtk
 from vtk.util.numpy_support import vtk_to_numpy
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from checks import check, run_cases  # noqa: E402  (tests/support/checks.py)
+
 vtk.vtkOutputWindow.SetInstance(vtk.vtkStringOutputWindow())  # VTK's messages are checked, not printed
 vtk.vtkLogger.SetStderrVerbosity(vtk.vtkLogger.VERBOSITY_OFF)
 
 COMPONENTS = {"velocity": 3, "density": 1, "pressure": 1, "id": 1, "initial_position": 3}
 PLY_NAMES = {"velocity": ["vx", "vy", "vz"], "density": ["density"], "pressure": ["pressure"], "id": ["id"],
              "initial_position": ["x0", "y0", "z0"]}
-
-passed = 0
-failed = 0
-
-
-class CheckFailed(Exception):
-    pass
-
-
-def check(cond, msg):
-    global passed, failed
-    if cond:
-        passed += 1
-        return
-    failed += 1
-    print(f"FAIL: {msg}", flush=True)
-    raise CheckFailed(msg)
 
 
 def arrays_of(point_data):
@@ -196,22 +182,12 @@ def main():
              dim=2, precision="double", steps=12, dt=1.5e-4, frame_steps=every(6, 12),
              fields=["velocity", "id", "initial_position"], formats=["vtk"]),
     ]
-    failed_cases = []
-    for c in cases:
+    def run(c):
         print(f"== {c['what']}", flush=True)
-        try:
-            run_case(sph, os.path.join(scenes, c.pop("scene")), **c)
-        except CheckFailed:
-            failed_cases.append(c["what"])
-        except Exception as e:  # a crash of the test itself counts as a failure
-            global failed
-            failed += 1
-            failed_cases.append(c["what"])
-            print(f"FAIL: {c['what']}: {type(e).__name__}: {e}")
-    if failed_cases:
-        print(f"failed cases: {', '.join(failed_cases)}")
-    print(f"frame_formats_readback: {passed} passed, {failed} failed")
-    return 1 if failed else 0
+        c = dict(c)
+        run_case(sph, os.path.join(scenes, c.pop("scene")), **c)
+
+    return run_cases("frame_formats_readback", cases, run)
 
 
 if __name__ == "__main__":

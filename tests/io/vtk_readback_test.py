@@ -22,30 +22,15 @@ import numpy as np
 import vtk
 from vtk.util.numpy_support import vtk_to_numpy
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from checks import check, run_cases  # noqa: E402  (tests/support/checks.py)
+
 # Must equal kStatsColumns in src/sph/io/run_output.h.
 STATS_COLUMNS = ("step,time,particles,kinetic_energy,max_speed,mean_neighbors,lists_rebuilt,pairs_stored,"
                  "pairs_within_h,missed_pairs,particles_missing,max_missed_penetration,"
                  "t_grid,t_lists,t_density,t_forces,t_integrate,t_output")
 PHASES = ("grid", "lists", "density", "forces", "integrate", "output")
 POINT_FIELDS = {"velocity": 3, "density": 1, "pressure": 1, "id": 1, "initial_position": 3}
-
-passed = 0
-failed = 0
-
-
-class CheckFailed(Exception):
-    pass
-
-
-def check(cond, msg):
-    """Counts one check; on failure prints the message and raises (the current case stops)."""
-    global passed, failed
-    if cond:
-        passed += 1
-        return
-    failed += 1
-    print(f"FAIL: {msg}", flush=True)
-    raise CheckFailed(msg)
 
 
 # ---- VTK error capture ------------------------------------------------------------------------
@@ -299,8 +284,7 @@ def main():
         dict(what="tank_fill_3d", scene="tank_fill_3d.json", dim=3, precision="double", steps=40, every=10, dt=3e-4,
              extra=[], expected_particles=lambda s: 36 * ((s + 15) // 16)),
     ]
-    failed_cases = []
-    for c in cases:
+    def run(c):
         tmp = tempfile.mkdtemp(prefix=f"sph_vtk_{c['what'].split('(')[0]}_")
         try:
             out = os.path.join(tmp, "out")
@@ -310,20 +294,10 @@ def main():
             entries = check_run(out, what=c["what"], dim=c["dim"], precision=c["precision"], steps=c["steps"],
                                 every=c["every"], dt=c["dt"], expected_particles=c["expected_particles"])
             check_reader_catches_corruption(out, entries[-1][1], c["what"])
-        except CheckFailed:
-            failed_cases.append(c["what"])
-        except Exception as e:  # a crash of the test itself counts as a failure
-            global failed
-            failed += 1
-            failed_cases.append(c["what"])
-            print(f"FAIL: {c['what']}: {type(e).__name__}: {e}")
         finally:
             shutil.rmtree(tmp, ignore_errors=True)
 
-    if failed_cases:
-        print(f"failed cases: {', '.join(failed_cases)}")
-    print(f"vtk_readback: {passed} passed, {failed} failed")
-    return 1 if failed else 0
+    return run_cases("vtk_readback", cases, run)
 
 
 if __name__ == "__main__":

@@ -55,6 +55,15 @@ void AtomicFile::commit(bool sync) {
     throw Error("cannot flush the directory to disk", parent.string());
 }
 
+void make_writable_directory(const std::filesystem::path& dir, std::string_view purpose) {
+  std::error_code ec;
+  if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
+    throw Error("exists and is not a directory; expected a directory for " + std::string(purpose), dir.string());
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw Error("cannot create the output directory: " + ec.message(), dir.string());
+  AtomicFile probe(dir / ".write-test");  // removed unless committed
+}
+
 void write_file_atomic(const std::filesystem::path& path, std::string_view content) {
   AtomicFile f(path);
   f.write(content);

@@ -35,6 +35,11 @@ class AtomicFile {
 /// before they are renamed into place; prepare_output_directory removes such names left behind.
 std::filesystem::path temporary_path(const std::filesystem::path& path);
 
+/// Creates `dir` (and its parents) if needed and checks that files can be created in it (a
+/// temporary file is made and removed). Throws sph::Error naming `dir` if it exists and is not
+/// a directory ("expected a directory for `purpose`") or cannot be created or written.
+void make_writable_directory(const std::filesystem::path& dir, std::string_view purpose);
+
 /// Writes `content` to `path` atomically.
 void write_file_atomic(const std::filesystem::path& path, std::string_view content);
 

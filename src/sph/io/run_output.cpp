@@ -21,13 +21,8 @@ namespace {
 
 /// Checks that files can be created in dir and dir/frames (creating them if needed).
 void check_writable(const fs::path& dir) {
-  std::error_code ec;
-  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-    throw Error("exists and is not a directory; expected a directory for the run's output", dir.string());
-  fs::create_directories(dir / "frames", ec);
-  if (ec) throw Error("cannot create the output directory: " + ec.message(), dir.string());
-  { AtomicFile probe(dir / ".write-test"); }
-  { AtomicFile probe(dir / "frames" / ".write-test"); }
+  make_writable_directory(dir, "the run's output");
+  make_writable_directory(dir / "frames", "the run's frames");
 }
 
 /// Removes AtomicFile's temporary files (".NAME.tmpPID-N") that a killed process left in `dir`.

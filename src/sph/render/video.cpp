@@ -103,7 +103,7 @@ VideoWriter::VideoWriter(fs::path path, int width, int height, double fps)
   const std::vector<std::string> args = {
       "ffmpeg", "-hide_banner", "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s",
       fmt::format("{}x{}", even_width_, even_height_), "-framerate", fmt::format("{}", fps), "-i", "pipe:0", "-an",
-      "-c:v", "libx264", "-preset", "veryfast", "-crf", "20", "-pix_fmt", "yuv420p", "-movflags", "+faststart",
+      "-c:v", "libx264", "-preset", "superfast", "-crf", "20", "-pix_fmt", "yuv420p", "-movflags", "+faststart",
       "-f", "mp4", tmp_.string()};
   pid_ = spawn(args, fds[0], log_);
   ::close(fds[0]);

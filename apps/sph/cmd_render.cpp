@@ -177,7 +177,7 @@ int render(const RenderCliOptions& opt) {
   Progress progress(static_cast<std::int64_t>(frames.size()),
                     opt.no_progress ? Progress::Mode::Off
                                     : (::isatty(STDERR_FILENO) ? Progress::Mode::Bar : Progress::Mode::Lines),
-                    stderr);
+                    stderr, "frame");
 
   // Frames are rendered in parallel, a batch at a time, and handed to the movie in order.
   const std::size_t batch = 2 * static_cast<std::size_t>(num_threads());
@@ -248,7 +248,7 @@ std::function<int()> add_render_command(CLI::App& app) {
       ->default_str("20");
   cmd->add_flag("--flat", opt->flat, "Flat discs instead of shaded spheres");
   cmd->add_option("--format", opt->format, "Which frames to read when the run wrote several formats: vtu, vtk, ply");
-  cmd->add_flag("--mp4", opt->mp4, "Also encode the images as DIR/render/movie.mp4 (needs ffmpeg)");
+  cmd->add_flag("--mp4", opt->mp4, "Also encode the images as movie.mp4 in the output directory (needs ffmpeg)");
   cmd->add_option("--video-fps", opt->video_fps, "Frames per second of the movie")
       ->check(CLI::Range(1.0, 240.0))
       ->default_str("30");

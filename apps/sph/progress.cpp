@@ -14,28 +14,31 @@ std::string duration(double s) {
 }
 }  // namespace
 
-Progress::Progress(std::int64_t total_steps, Mode mode, std::FILE* out)
-    : total_(total_steps > 0 ? total_steps : 1), mode_(mode), out_(out) {}
+Progress::Progress(std::int64_t total_steps, Mode mode, std::FILE* out, const char* unit)
+    : total_(total_steps > 0 ? total_steps : 1), mode_(mode), out_(out), unit_(unit) {}
 
 void Progress::update(std::int64_t done, std::size_t particles) {
   if (mode_ == Mode::Off) return;
   const double t = watch_.elapsed();
   const double frac = static_cast<double>(done) / static_cast<double>(total_);
   const double eta = done > 0 ? t * (1.0 - frac) / frac : 0.0;
+  const auto count = [&] {  // formatted only when something is printed
+    return fmt::format("{} {}/{}{}", unit_, done, total_,
+                       particles ? fmt::format("  {} particles", particles) : std::string());
+  };
   if (mode_ == Mode::Bar) {
     if (t - last_draw_ < 0.1 && done < total_) return;  // redraw at most 10 times a second
     last_draw_ = t;
     constexpr int width = 30;
     const int filled = static_cast<int>(frac * width);
-    fmt::print(out_, "\r[{}{}] {:3.0f}%  step {}/{}  {} particles  {} elapsed  ETA {}   ", std::string(filled, '#'),
-               std::string(width - filled, ' '), 100.0 * frac, done, total_, particles, duration(t), duration(eta));
+    fmt::print(out_, "\r[{}{}] {:3.0f}%  {}  {} elapsed  ETA {}   ", std::string(filled, '#'),
+               std::string(width - filled, ' '), 100.0 * frac, count(), duration(t), duration(eta));
     std::fflush(out_);
   } else {
     const int decile = static_cast<int>(frac * 10.0);
     if (decile <= last_decile_) return;
     last_decile_ = decile;
-    fmt::print(out_, "progress: {:3d}%  step {}/{}  {} particles  {} elapsed  ETA {}\n", decile * 10, done, total_,
-               particles, duration(t), duration(eta));
+    fmt::print(out_, "progress: {:3d}%  {}  {} elapsed  ETA {}\n", decile * 10, count(), duration(t), duration(eta));
     std::fflush(out_);
   }
 }

@@ -57,9 +57,11 @@ ParticleSet<D, R> blob(const SimulationParams<D>& p, int n, unsigned seed) {
 }
 
 template <int D, class R>
-void check_momentum_conserved(int n, int steps, double tol, NeighborMode mode = NeighborMode::Standard) {
+void check_momentum_conserved(int n, int steps, double tol, NeighborMode mode = NeighborMode::Standard,
+                              GradientCorrection correction = GradientCorrection::None) {
   SimulationParams<D> p = water_params<D>(0.01);
   p.neighbors = mode;
+  p.fluid.gradient_correction = correction;
   p.fluid.negative_pressure = NegativePressure::Allow;  // both signs of pressure exercised
   p.container.lo = Vec<D, double>::filled(-100);
   p.container.hi = Vec<D, double>::filled(100);
@@ -79,6 +81,13 @@ void check_momentum_conserved(int n, int steps, double tol, NeighborMode mode = 
 TEST(Conservation, MomentumWithoutWallsOrGravity2D) { check_momentum_conserved<2, double>(20, 200, 1e-12); }
 TEST(Conservation, MomentumWithoutWallsOrGravity3D) { check_momentum_conserved<3, double>(10, 100, 1e-12); }
 TEST(Conservation, MomentumWithoutWallsOrGravity3DFloat) { check_momentum_conserved<3, float>(10, 100, 1e-5); }
+// The corrected gradient (L_i + L_j) / 2 grad W_ij keeps each pair's forces equal and opposite.
+TEST(Conservation, MomentumWithCorrectedGradient2D) {
+  check_momentum_conserved<2, double>(20, 200, 1e-12, NeighborMode::Standard, GradientCorrection::Renormalize);
+}
+TEST(Conservation, MomentumWithCorrectedGradient3D) {
+  check_momentum_conserved<3, double>(10, 100, 1e-12, NeighborMode::Standard, GradientCorrection::Renormalize);
+}
 TEST(Conservation, MomentumWithVerletLists2D) {
   check_momentum_conserved<2, double>(20, 200, 1e-12, NeighborMode::Verlet);
 }
@@ -90,10 +99,12 @@ TEST(Conservation, MomentumWithVerletLists3D) {
 /// two layers below the surface and one kernel radius away from the side walls; checks that
 /// the tank came to rest and that the interior density stays within 1 % of rho0.
 template <int D>
-double settled_pressure_ratio(PressureForce form, int columns, int layers) {
+double settled_pressure_ratio(PressureForce form, int columns, int layers,
+                              GradientCorrection correction = GradientCorrection::None, double density_tol = 0.01) {
   SimulationParams<D> p = water_params<D>(0.005);
   p.fluid.viscosity = 5.0;
   p.fluid.pressure_force = form;
+  p.fluid.gradient_correction = correction;
   p.gravity[1] = -9.81;
   const double dx = 2 * p.particle_radius;
   p.container.lo = Vec<D, double>::filled(0);
@@ -140,7 +151,7 @@ double settled_pressure_ratio(PressureForce form, int columns, int layers) {
     ++compared;
   }
   EXPECT_GT(compared, 10);
-  EXPECT_LT(rho_dev_max, 0.01) << "interior density deviates by " << rho_dev_max;
+  EXPECT_LT(rho_dev_max, density_tol) << "interior density deviates by " << rho_dev_max;
   ::testing::Test::RecordProperty("pressure_ratio", std::to_string(ratio_sum / compared));
   std::printf("settled p / (rho0 g depth) = %.3f over %d particles\n", ratio_sum / compared, compared);
   return ratio_sum / compared;
@@ -158,6 +169,21 @@ TEST(Hydrostatic, SymmetricFormSettlesToRho0GDepth3D) {
   const double r = settled_pressure_ratio<3>(PressureForce::Symmetric, 8, 10);
   EXPECT_GT(r, 0.95);
   EXPECT_LT(r, 1.3);
+}
+// With the gradient renormalized (GradientCorrection::Renormalize) the discrete gradient of a
+// linear pressure is exact in the interior, and the 15 % excess goes. The corrected force is not
+// the gradient of an energy, so the tank rings longer: after 1.5 s the 2D interior density still
+// strays by up to 1.1 % (docs/validation.md).
+TEST(Hydrostatic, CorrectedGradientSettlesToRho0GDepth2D) {
+  const double r =
+      settled_pressure_ratio<2>(PressureForce::Symmetric, 20, 20, GradientCorrection::Renormalize, 0.015);
+  EXPECT_GT(r, 0.95);
+  EXPECT_LT(r, 1.05);
+}
+TEST(Hydrostatic, CorrectedGradientSettlesToRho0GDepth3D) {
+  const double r = settled_pressure_ratio<3>(PressureForce::Symmetric, 8, 10, GradientCorrection::Renormalize);
+  EXPECT_GT(r, 0.95);
+  EXPECT_LT(r, 1.05);
 }
 // The paper's Eq. 5 form (p_i + p_j) / 2 approximates grad(p) / 2 in the interior, so the
 // pressure that holds the column up is about twice rho0 g depth.

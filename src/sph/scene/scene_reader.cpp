@@ -482,7 +482,9 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
     read_output(c, desc);
   });
 
-  root.object("Fluid", {"density0", "stiffness", "viscosity", "negativePressure", "pressureForce", "particleMass"},
+  root.object("Fluid",
+              {"density0", "stiffness", "viscosity", "negativePressure", "pressureForce", "gradientCorrection",
+               "particleMass"},
               [&](ObjectReader& f) {
     sim.fluid.rest_density = f.positive("density0", "a positive rest density in kg/m^" + std::to_string(D), 1000.0);
     sim.fluid.stiffness = f.positive("stiffness", "a positive EOS stiffness k in m^2/s^2 (p = k (rho - rho0))");
@@ -493,6 +495,9 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
     sim.fluid.pressure_force = f.choice("pressureForce", {"paper", "symmetric"}, "paper") == "symmetric"
                                    ? PressureForce::Symmetric
                                    : PressureForce::Paper;
+    sim.fluid.gradient_correction = f.choice("gradientCorrection", {"none", "renormalize"}, "none") == "renormalize"
+                                        ? GradientCorrection::Renormalize
+                                        : GradientCorrection::None;
     if (f.find("particleMass")) {
       sim.particle_mass = f.positive("particleMass", "a positive particle mass in kg");
     } else {

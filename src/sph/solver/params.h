@@ -34,6 +34,17 @@ enum class PressureForce {
   Symmetric,
 };
 
+/// Whether the pressure force corrects the kernel gradient.
+enum class GradientCorrection {
+  None,  ///< the plain spiky gradient (the paper's method; default)
+  /// Each particle's gradient renormalized by L_i = A_i^-1, A_i = sum_j V_j grad W_ij (x_j - x_i)^T,
+  /// so that a linear pressure field has its exact gradient; pairs use (L_i + L_j) / 2, which
+  /// keeps every pair's forces equal and opposite (momentum is conserved). At h = 2 spacings the
+  /// plain gradient makes a resting tank's pressure 15-17 % high (docs/validation.md). Where
+  /// A_i is nearly singular (det below 1/2: a particle at the surface or alone), L_i = I.
+  Renormalize,
+};
+
 /// Weakly compressible fluid: EOS p = k (rho - rho0).
 struct FluidParams {
   double rest_density = 1000;  ///< rho0, kg/m^D
@@ -41,6 +52,7 @@ struct FluidParams {
   double viscosity = 0;        ///< dynamic viscosity mu of Eq. 6, Pa s (2D: kg/s)
   NegativePressure negative_pressure = NegativePressure::Clamp;
   PressureForce pressure_force = PressureForce::Paper;
+  GradientCorrection gradient_correction = GradientCorrection::None;
 };
 
 /// Damped penalty springs at the container walls and obstacle faces. They act on particles

@@ -102,6 +102,9 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
   const P hv = P::set1(h), h2v = P::set1(h * h), zero = P::set1(R(0)), one = P::set1(R(1)), minus_one = P::set1(R(-1)),
           half = P::set1(R(0.5));
   const P grad_c = P::set1(R(-3) * SpikyKernel<D, R>(h).norm());
+  // With a gradient correction the pressure term is added by corrected_pressure_pass instead
+  // (times 1 leaves every other result bitwise as it was).
+  const P pressure_on = P::set1(fluid.gradient_correction == GradientCorrection::None ? R(1) : R(0));
   const R lap_c = ViscosityKernel<D, R>(h).laplacian_norm();
   const R mu = static_cast<R>(fluid.viscosity);
   const R* pos = flat(ps.position);
@@ -144,7 +147,8 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
         pij = pi_sym + pj * inv_rhoj * inv_rhoj;
       // -m_j P_ij times the spiky gradient -3 C (h - r)^2 rij / r (Eq. 5), and the viscosity
       // term mu m_j (v_j - v_i) C_lap (h - r) / (rho_i rho_j) (Eq. 6).
-      const P fp = select(apart, (grad_c * dh * dh / select(apart, r, one)) * (minus_one * mj * pij), zero);
+      const P fp =
+          select(apart, (grad_c * dh * dh / select(apart, r, one)) * (minus_one * mj * pij), zero) * pressure_on;
       const P fv = select(near, visc_i * mj * inv_rhoj * dh, zero);
       P q2 = zero;  // Eq. 7: squared pair distance after the step, predicted with today's velocities
       for (int d = 0; d < D; ++d) {
@@ -167,6 +171,83 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
     for (int d = 0; d < D; ++d) a[d] += simd::sum_lanes(acc[d]);
     if (walls != nullptr) a += (*walls)(ps.position[i], ps.velocity[i]);
     ps.acceleration[i] = a;
+  });
+}
+
+/// The spiky gradient grad_i W(x_i - x_j) for rij = x_i - x_j, zero outside (0, h).
+template <int D, std::floating_point R>
+Vec<D, R> spiky_gradient(const Vec<D, R>& rij, R h, R grad_c) {
+  const R r2 = norm2(rij);
+  if (!(r2 < h * h) || !(r2 > R(0))) return Vec<D, R>{};
+  const R r = std::sqrt(r2);
+  return rij * (grad_c * (h - r) * (h - r) / r);
+}
+
+/// L_i = A_i^-1 with A_i = sum_j V_j grad_i W_ij (x_j - x_i)^T (row-major D x D per particle),
+/// or the identity where det A_i < 1/2 (see GradientCorrection::Renormalize).
+template <int D, std::floating_point R>
+std::vector<R> gradient_corrections(const ParticleSet<D, R>& ps, const NeighborLists& lists, R h) {
+  const R grad_c = R(-3) * SpikyKernel<D, R>(h).norm();
+  std::vector<R> L(ps.size() * D * D);
+  parallel_for(ps.size(), [&](std::size_t i) {
+    R a[D][D] = {};
+    for (const std::uint32_t j : lists.of(i)) {
+      const Vec<D, R> rij = ps.position[i] - ps.position[j];
+      const Vec<D, R> g = spiky_gradient<D, R>(rij, h, grad_c);
+      const R v = ps.mass[j] / ps.density[j];
+      for (int r = 0; r < D; ++r)
+        for (int c = 0; c < D; ++c) a[r][c] -= v * g[r] * rij[c];  // x_j - x_i = -rij
+    }
+    R* out = &L[i * D * D];
+    R det;
+    if constexpr (D == 2)
+      det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+    else
+      det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+            a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    if (!(det >= R(0.5))) {  // also NaN
+      for (int r = 0; r < D; ++r)
+        for (int c = 0; c < D; ++c) out[r * D + c] = r == c ? R(1) : R(0);
+      return;
+    }
+    if constexpr (D == 2) {
+      out[0] = a[1][1] / det, out[1] = -a[0][1] / det, out[2] = -a[1][0] / det, out[3] = a[0][0] / det;
+    } else {
+      // The adjugate's transpose over the determinant.
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) {
+          const int r1 = (c + 1) % 3, r2 = (c + 2) % 3, c1 = (r + 1) % 3, c2 = (r + 2) % 3;
+          out[r * 3 + c] = (a[r1][c1] * a[r2][c2] - a[r1][c2] * a[r2][c1]) / det;
+        }
+    }
+  });
+  return L;
+}
+
+/// Adds the pressure accelerations with corrected gradients: each pair's term of the plain
+/// force (Paper or Symmetric form) with grad W_ij replaced by (L_i + L_j) / 2 grad W_ij.
+template <int D, std::floating_point R>
+void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid) {
+  const std::vector<R> L = gradient_corrections(ps, lists, h);
+  const R grad_c = R(-3) * SpikyKernel<D, R>(h).norm();
+  const bool paper = fluid.pressure_force == PressureForce::Paper;
+  parallel_for(ps.size(), [&](std::size_t i) {
+    const R* li = &L[i * D * D];
+    const R inv_rhoi = R(1) / ps.density[i];
+    Vec<D, R> acc{};
+    for (const std::uint32_t j : lists.of(i)) {
+      const Vec<D, R> g = spiky_gradient<D, R>(ps.position[i] - ps.position[j], h, grad_c);
+      const R inv_rhoj = R(1) / ps.density[j];
+      const R pij = paper ? (R(0.5) * ps.pressure[i] + R(0.5) * ps.pressure[j]) * inv_rhoi * inv_rhoj
+                          : ps.pressure[i] * inv_rhoi * inv_rhoi + ps.pressure[j] * inv_rhoj * inv_rhoj;
+      const R* lj = &L[std::size_t{j} * D * D];
+      for (int r = 0; r < D; ++r) {
+        R gc = 0;
+        for (int c = 0; c < D; ++c) gc += R(0.5) * (li[r * D + c] + lj[r * D + c]) * g[c];
+        acc[r] -= ps.mass[j] * pij * gc;
+      }
+    }
+    ps.acceleration[i] += acc;
   });
 }
 
@@ -206,6 +287,7 @@ template <int D, std::floating_point R>
 void compute_fluid_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                                  const Vec<D, R>& gravity, std::span<std::uint8_t> exit_flags, R dt) {
   dispatch_force_pass<D, R>(ps, lists, h, fluid, gravity, nullptr, exit_flags, dt);
+  if (fluid.gradient_correction == GradientCorrection::Renormalize) corrected_pressure_pass(ps, lists, h, fluid);
 }
 
 template <int D, std::floating_point R>
@@ -220,6 +302,7 @@ void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
                            const Vec<D, R>& gravity, const WallContact<D, R>& walls, std::span<std::uint8_t> exit_flags,
                            R dt) {
   dispatch_force_pass(ps, lists, h, fluid, gravity, &walls, exit_flags, dt);
+  if (fluid.gradient_correction == GradientCorrection::Renormalize) corrected_pressure_pass(ps, lists, h, fluid);
 }
 
 template <int D, std::floating_point R>

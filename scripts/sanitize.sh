@@ -2,12 +2,14 @@
 # Runs the tests under sanitizers and fuzzes the scene reader, each in its own build directory
 # (the normal build/ is not touched), with clang and Debian's compiler-rt and libomp:
 #   asan  build-asan: every ctest test (gtest programs, the sph binary they run, the Python
-#         readback test, bench.smoke) under AddressSanitizer + UndefinedBehaviorSanitizer, leak
+#         readback tests; not the browser test and the repeats of the small benchmark) under
+#         AddressSanitizer + UndefinedBehaviorSanitizer, leak
 #         detection on, any undefined behaviour fatal.
 #   tsan  build-tsan: the tests of the parallel code (core, neighbors, solver: determinism tests
-#         included) and bench.smoke under ThreadSanitizer, OpenMP made visible to it by LLVM's
-#         Archer tool; first a self-check that a race planted in a parallel_for body is reported
-#         and a race-free one is not.
+#         included), bench.smoke, and sph render (parallel frames, the ffmpeg feeder thread) and
+#         view on a short run under ThreadSanitizer, OpenMP made visible to it by LLVM's Archer
+#         tool; first a self-check that a race planted in a parallel_for body is reported and a
+#         race-free one is not.
 #   fuzz  build-fuzz: the libFuzzer target of the scene reader (tests/fuzz) under ASan + UBSan:
 #         the saved crashers are replayed, then it fuzzes for SPH_FUZZ_SECONDS (default 60).
 # Usage: bash scripts/sanitize.sh [asan] [tsan] [fuzz]     (no argument: all three)
@@ -74,9 +76,14 @@ configure_and_build() {  # dir, then cmake cache settings, then -- and the targe
 # Every ctest test of a build directory. The SmallSuites tests share one run of the benchmark's
 # small suite (SetUpTestSuite) that ctest would repeat in each test's own process, seven times
 # over: under a sanitizer they run here as one gtest process instead, the same checks.
+# Left out as well, to keep CI short: bench.smoke and BenchCli.SmallNeighborsRunWritesItsFiles
+# (the same small benchmark code as SmallSuites, run a third and fourth time) and the browser test
+# (its subject is the page's JavaScript; the page builder runs under the sanitizers in
+# test_render's Viewer tests).
 run_suite() {  # dir
   local dir=$1 status=0
-  ctest --test-dir "$dir" --output-on-failure --no-tests=error -j "$jobs" -E '^SmallSuites\.' || status=1
+  ctest --test-dir "$dir" --output-on-failure --no-tests=error -j "$jobs" \
+    -E '^(SmallSuites\.|bench\.smoke$|BenchCli\.SmallNeighborsRunWritesItsFiles$|py\.view_browser_test$)' || status=1
   local log=$dir/small_suites.log
   if ! (cd "$dir/tests" && ./test_bench --gtest_filter='SmallSuites.*') >"$log" 2>&1 ||
     ! grep -q '^\[  PASSED  \] [1-9]' "$log"; then
@@ -143,6 +150,21 @@ EOF
   echo "tsan self-check: Archer active; a planted race is reported, the race-free loop is clean"
 }
 
+# A short run, rendered to PNGs and an MP4 on 2 threads, and its page, all under TSan.
+tsan_render_check() {
+  local out=build-tsan/render_check
+  rm -rf "$out"
+  if ./build-tsan/sph run scenes/paper/dam_break_2d.json --steps 200 --every 25 --threads 2 --no-progress \
+       -o "$out" >"$out.log" 2>&1 &&
+     ./build-tsan/sph render "$out" --mp4 --size 320x240 --threads 2 --no-progress >>"$out.log" 2>&1 &&
+     ./build-tsan/sph view "$out" >>"$out.log" 2>&1 &&
+     [ -s "$out/render/movie.mp4" ] && [ -s "$out/render/frame_000008.png" ] && [ -s "$out/view.html" ]; then
+    echo "tsan render check: sph run, render --mp4 and view on 2 threads, no race"
+  else
+    cat "$out.log"; echo "tsan render check failed (log: $out.log)"; return 1
+  fi
+}
+
 stage_tsan() {
   local t0=$SECONDS status=ok
   echo "== sanitize tsan: build-tsan (ThreadSanitizer + Archer), the core, neighbors and solver tests, bench.smoke"
@@ -163,6 +185,9 @@ stage_tsan() {
   ctest --test-dir build-tsan --output-on-failure --no-tests=error -j "$jobs" -L '^(core|neighbors|solver)$' ||
     status=FAIL
   ctest --test-dir build-tsan --output-on-failure --no-tests=error -R '^bench\.smoke$' || status=FAIL
+  # The other threads: sph render draws frames in a parallel_for and feeds ffmpeg from a thread
+  # of its own; sph compare and sph view read what the runs wrote.
+  tsan_render_check || status=FAIL
   unset OMP_TOOL_LIBRARIES TSAN_OPTIONS
   record tsan $status $((SECONDS - t0)) "build $((built - t0))s, self-check + tests $((SECONDS - built))s"
 }

@@ -18,6 +18,7 @@
 #include <sph/core/parallel.h>
 #include <sph/core/timer.h>
 #include <sph/io/atomic_file.h>
+#include <sph/io/frame_format.h>
 #include <sph/io/frames.h>
 #include <sph/render/frame_image.h>
 #include <sph/render/png.h>
@@ -95,9 +96,9 @@ std::vector<std::size_t> parse_frames(const std::string& s, std::size_t count) {
                   "--frames");
     const long long n = static_cast<long long>(count);
     if (k < -n || k >= n)
-      throw Error(fmt::format("frame {} does not exist: the run has frames 0 to {} (or -{} to -1 from the end)", k,
-                              n - 1, n),
-                  "--frames");
+      throw Error(
+          fmt::format("frame {} does not exist: the run has frames 0 to {} (or -{} to -1 from the end)", k, n - 1, n),
+          "--frames");
     out.push_back(static_cast<std::size_t>(k < 0 ? n + k : k));
   }
   std::sort(out.begin(), out.end());
@@ -128,12 +129,8 @@ int render(const RenderCliOptions& opt) {
     throw Error(fmt::format("unknown color map \"{}\"; expected viridis, coolwarm or turbo", opt.colormap),
                 "--colormap");
   std::optional<FrameFormat> format;
-  if (!opt.format.empty()) {
-    if (opt.format == "vtu") format = FrameFormat::Vtu;
-    else if (opt.format == "vtk") format = FrameFormat::Vtk;
-    else if (opt.format == "ply") format = FrameFormat::Ply;
-    else throw Error(fmt::format("unknown frame format \"{}\"; expected vtu, vtk or ply", opt.format), "--format");
-  }
+  if (!opt.format.empty() && !(format = parse_frame_format(opt.format)))
+    throw Error(fmt::format("unknown frame format \"{}\"; expected vtu, vtk or ply", opt.format), "--format");
   if (opt.no_png && !opt.mp4) throw Error("--no-png leaves nothing to write; give --mp4 with it", "--no-png");
   if (opt.threads > 0) set_num_threads(opt.threads);
 
@@ -171,13 +168,13 @@ int render(const RenderCliOptions& opt) {
   std::unique_ptr<VideoWriter> video;
   Stopwatch wall;
   fmt::print(stderr, "sph: render {} frame{} of {} ({}, colored by {}) -> {}\n", frames.size(),
-             frames.size() == 1 ? "" : "s", opt.dir, several ? fmt::format("{} runs side by side", runs.size())
-                                                           : fmt::format("{}D", runs[0].dimension),
+             frames.size() == 1 ? "" : "s", opt.dir,
+             several ? fmt::format("{} runs side by side", runs.size()) : fmt::format("{}D", runs[0].dimension),
              opt.color_by, out.string());
-  Progress progress(static_cast<std::int64_t>(frames.size()),
-                    opt.no_progress ? Progress::Mode::Off
-                                    : (::isatty(STDERR_FILENO) ? Progress::Mode::Bar : Progress::Mode::Lines),
-                    stderr, "frame");
+  Progress progress(
+      static_cast<std::int64_t>(frames.size()),
+      opt.no_progress ? Progress::Mode::Off : (::isatty(STDERR_FILENO) ? Progress::Mode::Bar : Progress::Mode::Lines),
+      stderr, "frame");
 
   // Frames are rendered in parallel, a batch at a time, and handed to the movie in order.
   const std::size_t batch = 2 * static_cast<std::size_t>(num_threads());
@@ -199,8 +196,8 @@ int render(const RenderCliOptions& opt) {
     for (std::size_t k = 0; k < n; ++k)
       if (!errors[k].empty()) throw Error(errors[k]);
     if (opt.mp4) {
-      if (!video) video = std::make_unique<VideoWriter>(out / "movie.mp4", images[0].width(), images[0].height(),
-                                                        opt.video_fps);
+      if (!video)
+        video = std::make_unique<VideoWriter>(out / "movie.mp4", images[0].width(), images[0].height(), opt.video_fps);
       for (std::size_t k = 0; k < n; ++k) video->add(images[k]);
     }
     progress.update(static_cast<std::int64_t>(first + n), 0);
@@ -213,8 +210,8 @@ int render(const RenderCliOptions& opt) {
   if (!opt.no_png)
     fmt::print(stderr, "  {}/frame_{:06d}.png{}\n", out.string(), frames.front(),
                frames.size() > 1 ? fmt::format(" ... frame_{:06d}.png", frames.back()) : "");
-  if (video) fmt::print(stderr, "  {}/movie.mp4 ({} frames at {} per second)\n", out.string(), video->frames(),
-                        opt.video_fps);
+  if (video)
+    fmt::print(stderr, "  {}/movie.mp4 ({} frames at {} per second)\n", out.string(), video->frames(), opt.video_fps);
   return kOk;
 }
 

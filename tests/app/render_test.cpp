@@ -42,8 +42,8 @@ class Render : public testing::Test {
   }
   /// A short run into tmp/NAME: frames every 50 of 200 steps (5 frames).
   void run(const std::string& scene, const std::string& name, const std::vector<std::string>& extra = {}) {
-    std::vector<std::string> args{"run",      scene, "--steps", "200", "--set", "Configuration.outputEveryNSteps=50",
-                                  "--no-progress", "-o", name};
+    std::vector<std::string> args{
+        "run", scene, "--steps", "200", "--set", "Configuration.outputEveryNSteps=50", "--no-progress", "-o", name};
     args.insert(args.end(), extra.begin(), extra.end());
     const CommandResult r = sph(args);
     ASSERT_EQ(r.code, 0) << r.err;
@@ -71,7 +71,7 @@ TEST_F(Render, EveryFrameBecomesAnImageWithOneColorScaleForTheRun) {
   ASSERT_EQ(first.width, last.width);
   ASSERT_GT(first.height, 720);  // the panel under a caption row with the time
   ASSERT_LT(first.height, 800);
-  EXPECT_GT(first.width, 1280);  // the color bar beside the 1280-pixel panel
+  EXPECT_GT(first.width, 1280);    // the color bar beside the 1280-pixel panel
   EXPECT_NE(first.rgb, last.rgb);  // the fluid moved
   // The color bar (the strip right of the panel) is the same in every frame: one scale.
   auto strip = [](const sph::test::DecodedPng& d) {
@@ -90,12 +90,12 @@ TEST_F(Render, EveryFrameBecomesAnImageWithOneColorScaleForTheRun) {
 TEST_F(Render, TheChosenFieldCameraAndSizeAreUsed) {
   run(kBlock, "block");
   ASSERT_EQ(sph({"render", "block", "--frames", "-1", "--size", "320x240", "-o", "a", "--no-progress"}).code, 0);
-  ASSERT_EQ(sph({"render", "block", "--frames", "-1", "--size", "320x240", "--azimuth", "-60", "-o", "b",
+  ASSERT_EQ(
+      sph({"render", "block", "--frames", "-1", "--size", "320x240", "--azimuth", "-60", "-o", "b", "--no-progress"})
+          .code,
+      0);
+  ASSERT_EQ(sph({"render", "block", "--frames", "-1", "--size", "320x240", "--color-by", "initial_position", "-o", "c",
                  "--no-progress"})
-                .code,
-            0);
-  ASSERT_EQ(sph({"render", "block", "--frames", "-1", "--size", "320x240", "--color-by", "initial_position", "-o",
-                 "c", "--no-progress"})
                 .code,
             0);
   const auto a = load_png(tmp_.path() / "a" / "frame_000004.png");
@@ -104,8 +104,8 @@ TEST_F(Render, TheChosenFieldCameraAndSizeAreUsed) {
   EXPECT_GT(a.height, 240);
   EXPECT_LT(a.height, 300);
   EXPECT_EQ(a.width, b.width);
-  EXPECT_NE(a.rgb, b.rgb);    // another camera
-  EXPECT_EQ(c.width, 320);    // initial position: a key, no color bar
+  EXPECT_NE(a.rgb, b.rgb);  // another camera
+  EXPECT_EQ(c.width, 320);  // initial position: a key, no color bar
 }
 
 TEST_F(Render, AMovieHasOneFramePerImage) {
@@ -123,9 +123,9 @@ TEST_F(Render, AMovieHasOneFramePerImage) {
 }
 
 TEST_F(Render, ACompareDirectoryShowsTheModesSideBySide) {
-  const CommandResult c = sph({"compare", kDamBreak, "--steps", "100", "--modes", "standard,adaptive", "--set",
-                               "Configuration.outputEveryNSteps=50", "--perturbation", "0", "--no-audit",
-                               "--no-progress", "-o", "cmp"});
+  const CommandResult c =
+      sph({"compare", kDamBreak, "--steps", "100", "--modes", "standard,adaptive", "--set",
+           "Configuration.outputEveryNSteps=50", "--perturbation", "0", "--no-audit", "--no-progress", "-o", "cmp"});
   ASSERT_EQ(c.code, 0) << c.err;
   // Each mode's run directory, in run order, with its own mode in scene.json; not the chaos run.
   EXPECT_EQ(sph::test::slurp(tmp_.path() / "cmp" / "runs.txt"), "standard\nadaptive\n");

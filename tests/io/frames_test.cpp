@@ -21,6 +21,7 @@
 #include <sph/scene/builders.h>
 #include <sph/scene/scene_reader.h>
 
+#include "support/test_particles.h"
 #include "support/temp_dir.h"
 
 namespace sph {
@@ -34,28 +35,6 @@ using test::TempDir;
 const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
 constexpr FrameFormat kFormats[] = {FrameFormat::Vtu, FrameFormat::Vtk, FrameFormat::Ply};
 
-template <int D, class R>
-ParticleSet<D, R> make_particles(std::size_t n) {
-  ParticleSet<D, R> ps;
-  for (std::size_t i = 0; i < n; ++i) {
-    Vec<D, R> x, vel;
-    for (int d = 0; d < D; ++d) {
-      x[d] = static_cast<R>(0.1 * static_cast<double>(i) + 0.01 * d + 1.0 / 3.0);  // not exact in float
-      vel[d] = static_cast<R>(-1.0 * static_cast<double>(i) + 0.5 * d - 0.1);
-    }
-    ps.add(x, vel, R(0.5));
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    ps.density[i] = static_cast<R>(1000.1 + static_cast<double>(i));
-    ps.pressure[i] = static_cast<R>(-10.3 * static_cast<double>(i));
-    ps.position[i][0] += R(1);  // moved: position != initial_position
-  }
-  // Permuted, so that ids differ from indices.
-  std::vector<std::uint32_t> perm(n);
-  for (std::size_t k = 0; k < n; ++k) perm[k] = static_cast<std::uint32_t>((k * 3 + 1) % n);
-  if (n % 3 != 0) ps.permute(perm);
-  return ps;
-}
 
 template <int D, class R>
 void write_frame(FrameFormat f, const fs::path& path, const ParticleSet<D, R>& ps, double time, FrameFieldMask mask) {
@@ -87,7 +66,7 @@ void check_round_trip(FrameFormat f, std::size_t n, FrameFieldMask mask) {
   SCOPED_TRACE(::testing::Message() << frame_format_name(f) << ", " << D << "D, "
                                     << (sizeof(R) == 4 ? "float" : "double") << ", N = " << n << ", fields " << mask);
   TempDir dir;
-  const ParticleSet<D, R> ps = make_particles<D, R>(n);
+  const ParticleSet<D, R> ps = test::make_test_particles<D, R>(n);
   const double time = 0.1 + 0.025;  // 0.125 with a rounding error: the time must survive exactly
   write_frame(f, frame_path(dir, f), ps, time, mask);
   const FrameData fr = read_frame(frame_path(dir, f));
@@ -154,16 +133,16 @@ INSTANTIATE_TEST_SUITE_P(Formats, FrameRoundTrip, testing::ValuesIn(kFormats),
 
 TEST(FrameFiles, PrecisionOfTheRunIsKept) {
   TempDir dir;
-  write_vtu(dir / "f.vtu", make_particles<3, float>(3), 0.5);
-  write_vtu(dir / "d.vtu", make_particles<3, double>(3), 0.5);
+  write_vtu(dir / "f.vtu", test::make_test_particles<3, float>(3), 0.5);
+  write_vtu(dir / "d.vtu", test::make_test_particles<3, double>(3), 0.5);
   EXPECT_NE(slurp(dir / "f.vtu").find("type=\"Float32\" Name=\"position\""), std::string::npos);
   EXPECT_NE(slurp(dir / "d.vtu").find("type=\"Float64\" Name=\"position\""), std::string::npos);
-  write_legacy_vtk(dir / "f.vtk", make_particles<3, float>(3), 0.5);
-  write_legacy_vtk(dir / "d.vtk", make_particles<3, double>(3), 0.5);
+  write_legacy_vtk(dir / "f.vtk", test::make_test_particles<3, float>(3), 0.5);
+  write_legacy_vtk(dir / "d.vtk", test::make_test_particles<3, double>(3), 0.5);
   EXPECT_NE(slurp(dir / "f.vtk").find("POINTS 3 float\n"), std::string::npos);
   EXPECT_NE(slurp(dir / "d.vtk").find("POINTS 3 double\n"), std::string::npos);
   // The PLY header: the time as a comment, Blender/Houdini property names.
-  write_ply(dir / "p.ply", make_particles<2, double>(3), 0.125, kFieldVelocity | kFieldId);
+  write_ply(dir / "p.ply", test::make_test_particles<2, double>(3), 0.125, kFieldVelocity | kFieldId);
   const std::string ply = slurp(dir / "p.ply");
   EXPECT_EQ(ply.substr(0, ply.find("end_header\n") + 11),
             "ply\nformat binary_little_endian 1.0\ncomment sph frame\ncomment time 0.125\nelement vertex 3\n"
@@ -188,7 +167,7 @@ void expect_refused(const fs::path& path, const std::string& what) {
 TEST_P(FrameRoundTrip, EveryTruncationIsRefusedOrAWholeShorterFile) {
   const FrameFormat f = GetParam();
   TempDir dir;
-  const auto ps = make_particles<3, double>(5);
+  const auto ps = test::make_test_particles<3, double>(5);
   const fs::path path = frame_path(dir, f);
   write_frame(f, path, ps, 0.25, kAllFrameFields);
   const std::string good = slurp(path);
@@ -227,7 +206,7 @@ TEST_P(FrameRoundTrip, CorruptBytesNeverCrash) {
   const FrameFormat f = GetParam();
   TempDir dir;
   const fs::path path = frame_path(dir, f);
-  write_frame(f, path, make_particles<3, float>(4), 1.5, kAllFrameFields);
+  write_frame(f, path, test::make_test_particles<3, float>(4), 1.5, kAllFrameFields);
   const std::string good = slurp(path);
   std::size_t refused = 0;
   for (std::size_t at = 0; at < good.size(); ++at)
@@ -281,13 +260,13 @@ TEST(FrameFiles, ForeignAndMissingFilesAreRefused) {
   spit(dir / "other.vtu", "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\"></VTKFile>\n");
   expect_refused(dir / "other.vtu", "not a VTK XML unstructured grid");
   // A .vtu another program wrote, compressed: refused, not misread.
-  write_vtu(dir / "c.vtu", make_particles<3, double>(2), 0);
+  write_vtu(dir / "c.vtu", test::make_test_particles<3, double>(2), 0);
   std::string c = slurp(dir / "c.vtu");
   c.replace(c.find("header_type"), 0, "compressor=\"vtkZLibDataCompressor\" ");
   spit(dir / "c.vtu", c);
   expect_refused(dir / "c.vtu", "compressed");
   // An unknown point field.
-  write_vtu(dir / "u.vtu", make_particles<3, double>(2), 0);
+  write_vtu(dir / "u.vtu", test::make_test_particles<3, double>(2), 0);
   std::string u = slurp(dir / "u.vtu");
   u.replace(u.find("Name=\"pressure\""), 15, "Name=\"temperat\"");
   spit(dir / "u.vtu", u);
@@ -297,7 +276,7 @@ TEST(FrameFiles, ForeignAndMissingFilesAreRefused) {
 TEST(FrameFiles, VtuWithoutTimeReadsAsTimeZero) {
   // Frames written before frames carried their time.
   TempDir dir;
-  write_vtu(dir / "a.vtu", make_particles<2, double>(3), 7.5);
+  write_vtu(dir / "a.vtu", test::make_test_particles<2, double>(3), 7.5);
   std::string s = slurp(dir / "a.vtu");
   const std::size_t b = s.find("    <FieldData>"), e = s.find("</FieldData>\n") + 13;
   s.erase(b, e - b);

@@ -16,6 +16,7 @@
 #include <sph/core/error.h>
 #include <sph/io/vtk.h>
 
+#include "support/test_particles.h"
 #include "support/temp_dir.h"
 
 namespace sph {
@@ -136,34 +137,12 @@ Vtu parse_vtu(const fs::path& path, std::size_t n_expected) {
   return v;
 }
 
-template <int D, class R>
-ParticleSet<D, R> make_particles(std::size_t n) {
-  ParticleSet<D, R> ps;
-  for (std::size_t i = 0; i < n; ++i) {
-    Vec<D, R> x, vel;
-    for (int d = 0; d < D; ++d) {
-      x[d] = static_cast<R>(0.1 * static_cast<double>(i) + 0.01 * d);
-      vel[d] = static_cast<R>(-1.0 * static_cast<double>(i) + 0.5 * d);
-    }
-    ps.add(x, vel, R(0.5));
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    ps.density[i] = static_cast<R>(1000 + i);
-    ps.pressure[i] = static_cast<R>(10.0 * static_cast<double>(i));
-    ps.position[i][0] += R(1);  // moved: position != initial_position
-  }
-  // Shuffle so that ids are not in index order.
-  std::vector<std::uint32_t> perm(n);
-  for (std::size_t k = 0; k < n; ++k) perm[k] = static_cast<std::uint32_t>((k * 3 + 1) % n);
-  if (n % 3 != 0) ps.permute(perm);
-  return ps;
-}
 
 template <int D, class R>
 void check_round_trip(std::size_t n) {
   SCOPED_TRACE(::testing::Message() << D << "D, " << (sizeof(R) == 4 ? "float" : "double") << ", N = " << n);
   TempDir dir;
-  const ParticleSet<D, R> ps = make_particles<D, R>(n);
+  const ParticleSet<D, R> ps = test::make_test_particles<D, R>(n);
   const fs::path path = dir / "frame_000000.vtu";
   write_vtu(path, ps);
   EXPECT_EQ(entries(dir.path()), std::vector<std::string>{"frame_000000.vtu"}) << "no temporaries left";
@@ -227,15 +206,15 @@ TEST(VtkWriter, VtuEmpty) {
 TEST(VtkWriter, VtuOverwritesAnOlderFrame) {
   TempDir dir;
   const fs::path path = dir / "f.vtu";
-  write_vtu(path, make_particles<3, double>(50));
-  write_vtu(path, make_particles<3, double>(3));
+  write_vtu(path, test::make_test_particles<3, double>(50));
+  write_vtu(path, test::make_test_particles<3, double>(3));
   parse_vtu(path, 3);
   EXPECT_EQ(entries(dir.path()), std::vector<std::string>{"f.vtu"});
 }
 
 TEST(VtkWriter, MissingDirectoryThrowsSphError) {
   TempDir dir;
-  EXPECT_THROW(write_vtu(dir / "no/frame_000000.vtu", make_particles<3, double>(2)), Error);
+  EXPECT_THROW(write_vtu(dir / "no/frame_000000.vtu", test::make_test_particles<3, double>(2)), Error);
   EXPECT_THROW(write_pvd(dir / "no/frames.pvd", {{0.0, "a.vtu"}}), Error);
   EXPECT_TRUE(entries(dir.path()).empty());
 }

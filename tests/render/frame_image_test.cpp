@@ -81,8 +81,8 @@ TEST(FrameImage, InitialPositionHasAKeyInsteadOfAColorBar) {
   const std::vector<RunDirectory> runs{run2d("a")};
   const std::vector<FrameData> frames{one_particle(1.0, 0.5, 0.0, 0.0)};
   const Image img = render_frame(runs, frames, style(400, 200, ColorBy::InitialPosition));
-  EXPECT_EQ(img.width(), 400);  // no color bar
-  EXPECT_GT(count_color(img, Rgb{255, 255, 40}), 100);  // x and y at their high ends, z flat
+  EXPECT_EQ(img.width(), 400);                                              // no color bar
+  EXPECT_GT(count_color(img, Rgb{255, 255, 40}), 100);                      // x and y at their high ends, z flat
   EXPECT_GT(count_dark(img, 0, img.height() - 20, 400, img.height()), 20);  // the key along the bottom
 }
 

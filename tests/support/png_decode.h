@@ -12,7 +12,7 @@ namespace sph::test {
 
 struct DecodedPng {
   int width = 0, height = 0;
-  bool rgb8 = false;  ///< the file itself is 8-bit RGB without alpha
+  bool rgb8 = false;              ///< the file itself is 8-bit RGB without alpha
   std::vector<std::uint8_t> rgb;  ///< 3 bytes per pixel, rows top to bottom
 };
 

@@ -99,8 +99,12 @@ std::vector<double> color_values(const FrameData& frame, ColorBy by, const RunDi
         break;
       }
       case ColorBy::Density:
-      case ColorBy::Pressure: out[i] = v[i]; break;
-      case ColorBy::InitialPosition: out[i] = v[3 * i + 1]; break;
+      case ColorBy::Pressure:
+        out[i] = v[i];
+        break;
+      case ColorBy::InitialPosition:
+        out[i] = v[3 * i + 1];
+        break;
     }
   }
   return out;

@@ -23,8 +23,8 @@ enum class ColorBy {
 };
 
 /// Every quantity, in the order above.
-inline constexpr ColorBy kColorByAll[] = {ColorBy::Speed, ColorBy::KineticEnergy, ColorBy::Density,
-                                          ColorBy::Pressure, ColorBy::InitialPosition};
+inline constexpr ColorBy kColorByAll[] = {ColorBy::Speed, ColorBy::KineticEnergy, ColorBy::Density, ColorBy::Pressure,
+                                          ColorBy::InitialPosition};
 
 /// The quantity's name on the command line: "speed", "kinetic_energy", "density", "pressure",
 /// "initial_position".

@@ -17,9 +17,9 @@ constexpr Rgb kInk{40, 40, 40};
 /// `t = 0.125 s` with enough digits to tell frames apart at usual frame rates.
 std::string time_label(double t) { return fmt::format("t = {:.3f} s", t); }
 
-/// The positions of `frame` as `dim` coordinates per particle, as render_particles takes them.
-std::vector<double> coordinates(const FrameData& frame, int dim) {
-  if (dim == 3) return frame.position;
+/// The x, y of each particle of a 2D frame, as render_particles takes them (a 3D frame's
+/// positions are passed as they are).
+std::vector<double> xy_of(const FrameData& frame) {
   std::vector<double> xy(2 * frame.size);
   for (std::size_t i = 0; i < frame.size; ++i) {
     xy[2 * i] = frame.position[3 * i];
@@ -57,7 +57,8 @@ Image render_frame(std::span<const RunDirectory> runs, std::span<const FrameData
     const FrameData& frame = frames[k];
     SPH_CHECK(frame.position.size() == 3 * frame.size, "3 coordinates per particle");
     const std::vector<Rgb> colors = particle_colors(frame, style.color, run);
-    const std::vector<double> xyz = coordinates(frame, run.dimension);
+    const std::vector<double> xy = run.dimension == 2 ? xy_of(frame) : std::vector<double>();
+    const std::span<const double> xyz = run.dimension == 2 ? std::span<const double>(xy) : frame.position;
     panels.push_back(
         render_particles(xyz, run.dimension, colors, run.particle_radius, run.box_lo, run.box_hi, style.view));
     // The time in a caption row above the panel, where it never covers particles or the box.

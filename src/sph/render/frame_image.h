@@ -27,8 +27,8 @@ std::pair<double, double> run_color_range(std::span<const RunDirectory> runs, Co
                                           std::size_t max_values = 50000);
 
 /// One panel per run, side by side, each under a caption with its frame's simulated time (and
-/// its run's label when there are several); `frames[k]` is a frame of `runs[k]`. Throws sph::Error as particle_colors and ParticleCamera do. Precondition:
-/// runs.size() == frames.size() >= 1.
+/// its run's label when there are several); `frames[k]` is a frame of `runs[k]`. Throws sph::Error as particle_colors
+/// and ParticleCamera do. Precondition: runs.size() == frames.size() >= 1.
 Image render_frame(std::span<const RunDirectory> runs, std::span<const FrameData> frames, const FrameStyle& style);
 
 }  // namespace sph

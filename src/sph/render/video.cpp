@@ -96,15 +96,42 @@ VideoWriter::VideoWriter(fs::path path, int width, int height, double fps)
     throw Error(
         "making an MP4 needs ffmpeg with its H.264 encoder (libx264), which was not found on PATH; install it "
         "with `apt-get install ffmpeg` (bash scripts/setup.sh does), or leave out --mp4");
-  { std::ofstream probe(log_); if (!probe) throw Error("cannot create a file in this directory (is it writable?)", log_.parent_path().string()); }
+  {
+    std::ofstream probe(log_);
+    if (!probe) throw Error("cannot create a file in this directory (is it writable?)", log_.parent_path().string());
+  }
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) throw Error(std::string("cannot create a pipe to ffmpeg: ") + std::strerror(errno));
   // The child gets the read end as stdin via dup2, which clears O_CLOEXEC on the copy.
-  const std::vector<std::string> args = {
-      "ffmpeg", "-hide_banner", "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s",
-      fmt::format("{}x{}", even_width_, even_height_), "-framerate", fmt::format("{}", fps), "-i", "pipe:0", "-an",
-      "-c:v", "libx264", "-preset", "superfast", "-crf", "20", "-pix_fmt", "yuv420p", "-movflags", "+faststart",
-      "-f", "mp4", tmp_.string()};
+  const std::vector<std::string> args = {"ffmpeg",
+                                         "-hide_banner",
+                                         "-loglevel",
+                                         "error",
+                                         "-y",
+                                         "-f",
+                                         "rawvideo",
+                                         "-pix_fmt",
+                                         "rgb24",
+                                         "-s",
+                                         fmt::format("{}x{}", even_width_, even_height_),
+                                         "-framerate",
+                                         fmt::format("{}", fps),
+                                         "-i",
+                                         "pipe:0",
+                                         "-an",
+                                         "-c:v",
+                                         "libx264",
+                                         "-preset",
+                                         "superfast",
+                                         "-crf",
+                                         "20",
+                                         "-pix_fmt",
+                                         "yuv420p",
+                                         "-movflags",
+                                         "+faststart",
+                                         "-f",
+                                         "mp4",
+                                         tmp_.string()};
   pid_ = spawn(args, fds[0], log_);
   ::close(fds[0]);
   if (pid_ < 0) {
@@ -227,8 +254,7 @@ void VideoWriter::finish() {
     const std::string why = last_line(log_);
     fs::remove(tmp_, ec);
     fs::remove(log_, ec);
-    throw Error(fmt::format("ffmpeg failed (exit status {}){}", status, why.empty() ? "" : ": " + why),
-                path_.string());
+    throw Error(fmt::format("ffmpeg failed (exit status {}){}", status, why.empty() ? "" : ": " + why), path_.string());
   }
   fs::remove(log_, ec);
   fs::rename(tmp_, path_, ec);

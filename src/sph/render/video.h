@@ -58,8 +58,8 @@ class VideoWriter {
   std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<std::vector<std::uint8_t>> queue_;  ///< padded RGB frames not yet written
-  bool closing_ = false;   ///< no more frames will come
-  bool broken_ = false;    ///< a write to ffmpeg failed
+  bool closing_ = false;                         ///< no more frames will come
+  bool broken_ = false;                          ///< a write to ffmpeg failed
   std::thread feeder_;
 };
 

@@ -13,6 +13,10 @@ void set_num_threads(int n);
 /// The number of worker threads parallel loops use.
 int num_threads();
 
+/// The calling thread's index in [0, num_threads()) inside a parallel loop (0 outside one).
+/// Only for per-thread scratch: results must never depend on which thread ran what.
+int thread_index();
+
 /// Calls f(i) for i in [0, n), in parallel. f must only write data owned by index i.
 template <class F>
 void parallel_for(std::size_t n, F&& f) {

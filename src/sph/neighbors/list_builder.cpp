@@ -144,11 +144,6 @@ void ensure_room(std::vector<std::uint32_t>& buf, std::size_t need) {
 // may load NeighborLists::kPadding entries past a list's end.
 constexpr std::size_t kRoom = 16;
 
-/// Per-thread scratch: grows to twice what is needed, so that after a few steps it covers the
-/// largest chunk any thread meets and stops allocating (which thread merges which chunk varies).
-void ensure_scratch(std::vector<std::uint32_t>& buf, std::size_t need) {
-  if (buf.size() < need) buf.resize(2 * need);
-}
 static_assert(kRoom >= NeighborLists::kPadding);
 
 }  // namespace
@@ -199,6 +194,15 @@ void ListBuilder<D, R>::rebuild_some(const UniformGrid<D, R>& grid, std::span<co
   lists.end_.resize(n);
   chunk_entries_.resize(chunks);
 
+  // Each thread copies a chunk's old lists aside before merging. The copy buffers are grown
+  // here, before the loop, to the largest old chunk: their size depends only on the lists, not
+  // on which thread meets which chunk, so a steady state allocates nothing for any schedule.
+  std::size_t largest_old = 0;
+  for (std::size_t c = 0; c * kChunkSize < old_n; ++c)
+    largest_old = std::max<std::size_t>(largest_old, lists.end_[std::min(old_n, (c + 1) * kChunkSize) - 1]);
+  old_copy_.resize(static_cast<std::size_t>(num_threads()));
+  for (auto& copy : old_copy_) ensure_room(copy, largest_old);
+
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     const auto marked = [&](std::size_t i) { return rebuild[i] != 0 || i >= old_n; };
     std::size_t kept = 0;
@@ -213,44 +217,30 @@ void ListBuilder<D, R>::rebuild_some(const UniformGrid<D, R>& grid, std::span<co
       chunk_entries_[c] = kept;
       return;
     }
-    // New lists of the marked particles first; then the chunk's old lists are copied aside and
-    // merged with the new ones back into the chunk's own buffer (which keeps its room: no
-    // allocation unless the lists grew).
-    thread_local std::vector<std::uint32_t> fresh, old_copy;
-    thread_local std::vector<std::uint32_t> fresh_count;
-    fresh_count.resize(kChunkSize);
-    Stencil<D, R> st;
-    std::size_t used = 0;
-    for (std::size_t i = b; i < e; ++i) {
-      if (!marked(i)) continue;
-      st.update(grid, grid.cell_of(i));
-      ensure_scratch(fresh, used + st.candidates + kRoom);
-      fresh_count[i - b] =
-          gather(vector_, grid, st, positions[i], static_cast<std::uint32_t>(i), r2, fresh.data() + used);
-      used += fresh_count[i - b];
-    }
+    // The chunk's old lists are copied aside, then the chunk's buffer is rewritten in order:
+    // kept lists from the copy, marked ones gathered in place. The buffer belongs to the chunk
+    // and keeps its room, so it grows only when the chunk's lists do.
     std::vector<std::uint32_t>& buf = lists.chunks_[c];
     const std::size_t last_old = std::min(e, old_n);  // particles [b, last_old) had lists
     const std::size_t old_size = last_old > b ? lists.end_[last_old - 1] : 0;
-    ensure_scratch(old_copy, old_size);
+    std::vector<std::uint32_t>& old_copy = old_copy_[static_cast<std::size_t>(thread_index())];
     std::copy_n(buf.data(), old_size, old_copy.data());
-    ensure_room(buf, kept + used + kRoom);
-    const std::uint32_t* next_fresh = fresh.data();
+    Stencil<D, R> st;
     std::size_t at = 0;
     std::uint32_t old_end = 0;  // end of list i - 1 before this merge
     for (std::size_t i = b; i < e; ++i) {
       const std::uint32_t old_begin = old_end;
       old_end = i < old_n ? lists.end_[i] : old_end;
-      std::uint32_t len;
       if (marked(i)) {
-        len = fresh_count[i - b];
-        std::copy_n(next_fresh, len, buf.data() + at);
-        next_fresh += len;
+        st.update(grid, grid.cell_of(i));
+        ensure_room(buf, at + st.candidates + kRoom);
+        at += gather(vector_, grid, st, positions[i], static_cast<std::uint32_t>(i), r2, buf.data() + at);
       } else {
-        len = old_end - old_begin;
+        const std::uint32_t len = old_end - old_begin;
+        ensure_room(buf, at + len + kRoom);
         std::copy_n(old_copy.data() + old_begin, len, buf.data() + at);
+        at += len;
       }
-      at += len;
       lists.end_[i] = static_cast<std::uint32_t>(at);
     }
     std::fill_n(buf.data() + at, kRoom, 0u);  // readable padding, valid indices

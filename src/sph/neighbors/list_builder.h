@@ -40,6 +40,7 @@ class ListBuilder {
  private:
   bool vector_ = true;
   std::vector<std::size_t> chunk_entries_;
+  std::vector<std::vector<std::uint32_t>> old_copy_;  // rebuild_some: one per thread
 };
 
 extern template class ListBuilder<2, float>;

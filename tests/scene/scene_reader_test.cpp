@@ -269,6 +269,22 @@ TEST(SceneReader, NegativePressureBadValue) {
   EXPECT_CONTAINS(error_of(j), "got boolean true");
 }
 
+TEST(SceneReader, PressureForceTakesEachFormAndRefusesOthers) {
+  json j = valid_scene();
+  EXPECT_EQ(parse(j).body<2>().sim.fluid.pressure_force, sph::PressureForce::Paper);
+  const std::pair<const char*, sph::PressureForce> forms[] = {{"paper", sph::PressureForce::Paper},
+                                                              {"symmetric", sph::PressureForce::Symmetric},
+                                                              {"variational", sph::PressureForce::Variational}};
+  for (const auto& [name, form] : forms) {
+    j["Fluid"]["pressureForce"] = name;
+    EXPECT_EQ(parse(j).body<2>().sim.fluid.pressure_force, form) << name;
+  }
+  j["Fluid"]["pressureForce"] = "spiky";
+  const std::string m = error_of(j);
+  EXPECT_CONTAINS(m, "Fluid.pressureForce");
+  EXPECT_CONTAINS(m, "\"paper\", \"symmetric\", \"variational\"");
+}
+
 TEST(SceneReader, NumberOfStepsMustBeAPositiveInteger) {
   for (json v : {json(10.5), json(10.0), json(0), json(-3), json("10"), json(1e13)}) {
     json j = valid_scene();
@@ -586,8 +602,7 @@ TEST(SceneReaderOutput, Defaults) {
   EXPECT_EQ(d.output.every_steps, 1) << "max(1, steps / 100)";
   EXPECT_EQ(d.output.fps, 0.0);
   EXPECT_EQ(d.output.formats, std::vector<sph::FrameFormat>{sph::FrameFormat::Vtu});
-  EXPECT_EQ(d.output.fields,
-            (std::vector<std::string>{"velocity", "density", "pressure", "id", "initial_position"}));
+  EXPECT_EQ(d.output.fields, (std::vector<std::string>{"velocity", "density", "pressure", "id", "initial_position"}));
   json j = valid_scene();
   j["Configuration"]["numberOfSteps"] = 1000;
   EXPECT_EQ(parse(j).output.every_steps, 10);

@@ -244,29 +244,31 @@ double settling_time(std::span<const double> times, std::span<const double> valu
   return times[last_above + 1];
 }
 
-double lattice_gradient_consistency(int dimension, double spacing, double h) {
+double lattice_gradient_consistency(int dimension, double spacing, double h, bool poly6_gradient) {
   if (dimension != 2 && dimension != 3) throw Error("expected 2 or 3", "dimension");
   const int n = static_cast<int>(std::ceil(h / spacing)) + 1;
   double sum = 0;
-  const auto add = [&](auto kernel, double y, double r, double volume) {
-    // x_ij = x_i - x_j with x_i at the origin: y_ij = -y; dW/dy_i = -3 C (h - r)^2 y_ij / r.
+  // x_ij = x_i - x_j with x_i at the origin: y_ij = -y. dW/dy_i is -3 C (h - r)^2 y_ij / r for
+  // the spiky kernel and -6 C (h^2 - r^2)^2 y_ij for poly6.
+  const auto add = [&](double norm, double y, double r, double volume) {
     if (r <= 0 || r >= h) return;
     const double yij = -y;
-    const double dwdy = -3.0 * kernel.norm() * (h - r) * (h - r) * yij / r;
+    const double dwdy = poly6_gradient ? -6.0 * norm * (h * h - r * r) * (h * h - r * r) * yij
+                                       : -3.0 * norm * (h - r) * (h - r) * yij / r;
     sum -= volume * yij * dwdy;
   };
   if (dimension == 2) {
     const double volume = lattice_mass<2>(1.0, spacing, h);  // m / rho0 with rho0 = 1
-    const SpikyKernel<2, double> spiky(h);
+    const double norm = poly6_gradient ? Poly6Kernel<2, double>(h).norm() : SpikyKernel<2, double>(h).norm();
     for (int a = -n; a <= n; ++a)
-      for (int b = -n; b <= n; ++b) add(spiky, b * spacing, spacing * std::sqrt(double(a * a + b * b)), volume);
+      for (int b = -n; b <= n; ++b) add(norm, b * spacing, spacing * std::sqrt(double(a * a + b * b)), volume);
   } else {
     const double volume = lattice_mass<3>(1.0, spacing, h);
-    const SpikyKernel<3, double> spiky(h);
+    const double norm = poly6_gradient ? Poly6Kernel<3, double>(h).norm() : SpikyKernel<3, double>(h).norm();
     for (int a = -n; a <= n; ++a)
       for (int b = -n; b <= n; ++b)
         for (int c = -n; c <= n; ++c)
-          add(spiky, b * spacing, spacing * std::sqrt(double(a * a + b * b + c * c)), volume);
+          add(norm, b * spacing, spacing * std::sqrt(double(a * a + b * b + c * c)), volume);
   }
   return sum;
 }
@@ -478,7 +480,8 @@ HydrostaticRun run_hydrostatic(const std::filesystem::path& dir, int dimension, 
     run.gravity = -p.gravity[1];
     run.steps = desc.steps;
     run.particles = sim.particles().size();
-    run.predicted_ratio = 1.0 / lattice_gradient_consistency(D, run.spacing, run.h);
+    run.predicted_ratio =
+        1.0 / lattice_gradient_consistency(D, run.spacing, run.h, p.fluid.pressure_force == PressureForce::Variational);
     const std::int64_t every = std::max<std::int64_t>(1, desc.steps / 500);
     const EnergyModel model = energy_model(p);
     const auto sample = [&]() {

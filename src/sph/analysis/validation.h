@@ -155,11 +155,12 @@ HydrostaticProfile hydrostatic_profile(const FluidState& state, const Hydrostati
 /// first sample if it always does; NaN if the last sample is still above).
 double settling_time(std::span<const double> times, std::span<const double> values, double fraction);
 
-/// M_yy = -sum_j V_j (y_i - y_j) dW_spiky/dy_i on a perfect lattice of the given spacing (square
-/// in 2D, cubic in 3D), with V_j = m / rho0 and m the lattice mass: the factor by which the
-/// discrete pressure gradient of a linear pressure field differs from the exact one (1 for a
-/// consistent gradient). A resting tank settles at p / (rho0 g d) of about 1 / M_yy.
-double lattice_gradient_consistency(int dimension, double spacing, double h);
+/// M_yy = -sum_j V_j (y_i - y_j) dW/dy_i on a perfect lattice of the given spacing (square in
+/// 2D, cubic in 3D), with V_j = m / rho0 and m the lattice mass, for the spiky kernel's gradient
+/// or (poly6_gradient, the variational pressure force) poly6's: the factor by which the discrete
+/// pressure gradient of a linear pressure field differs from the exact one (1 for a consistent
+/// gradient). A resting tank settles at p / (rho0 g d) of about 1 / M_yy.
+double lattice_gradient_consistency(int dimension, double spacing, double h, bool poly6_gradient = false);
 
 // ---- Running the cases ----------------------------------------------------------------------
 

@@ -492,9 +492,10 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
     sim.fluid.negative_pressure =
         f.choice("negativePressure", {"clamp", "allow"}, "clamp") == "allow" ? NegativePressure::Allow
                                                                              : NegativePressure::Clamp;
-    sim.fluid.pressure_force = f.choice("pressureForce", {"paper", "symmetric"}, "paper") == "symmetric"
-                                   ? PressureForce::Symmetric
-                                   : PressureForce::Paper;
+    const std::string form = f.choice("pressureForce", {"paper", "symmetric", "variational"}, "paper");
+    sim.fluid.pressure_force = form == "symmetric"     ? PressureForce::Symmetric
+                               : form == "variational" ? PressureForce::Variational
+                                                       : PressureForce::Paper;
     sim.fluid.gradient_correction = f.choice("gradientCorrection", {"none", "renormalize"}, "none") == "renormalize"
                                         ? GradientCorrection::Renormalize
                                         : GradientCorrection::None;

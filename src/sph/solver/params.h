@@ -32,6 +32,11 @@ enum class PressureForce {
   /// Monaghan's symmetric form: -sum_j m_j (p_i / rho_i^2 + p_j / rho_j^2) grad W_ij, which
   /// approximates -grad(p) / rho: a tank settles at rho0 g depth.
   Symmetric,
+  /// The symmetric form with the density kernel's gradient (poly6) instead of the spiky one:
+  /// the force is then minus the gradient of the EOS's internal energy of the summed densities
+  /// (variational SPH), so that inviscid motion conserves energy, and on the lattice at h = 2
+  /// spacings a resting tank settles at rho0 g depth (docs/physics.md).
+  Variational,
 };
 
 /// Whether the pressure force corrects the kernel gradient.

@@ -94,7 +94,7 @@ std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
   return total;
 }
 
-template <bool kPaper, bool kExitTest, int D, std::floating_point R>
+template <PressureForce kForm, bool kExitTest, int D, std::floating_point R>
 void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                 const Vec<D, R>& gravity, const WallContact<D, R>* walls, std::span<std::uint8_t> flags, R dt) {
   using P = simd::Pack<R>;
@@ -102,6 +102,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
   const P hv = P::set1(h), h2v = P::set1(h * h), zero = P::set1(R(0)), one = P::set1(R(1)), minus_one = P::set1(R(-1)),
           half = P::set1(R(0.5));
   const P grad_c = P::set1(R(-3) * SpikyKernel<D, R>(h).norm());
+  const P grad6_c = P::set1(R(-6) * Poly6Kernel<D, R>(h).norm());
   // With a gradient correction the pressure term is added by corrected_pressure_pass instead
   // (times 1 leaves every other result bitwise as it was).
   const P pressure_on = P::set1(fluid.gradient_correction == GradientCorrection::None ? R(1) : R(0));
@@ -141,14 +142,20 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
       const P pj = P::template gather<1>(prs, idx + k0, 0);
       const P mj = P::template gather<1>(mass, idx + k0, 0);
       P pij;
-      if constexpr (kPaper)
+      if constexpr (kForm == PressureForce::Paper)
         pij = (pi_half + half * pj * inv_rhoi_v) * inv_rhoj;
       else
         pij = pi_sym + pj * inv_rhoj * inv_rhoj;
       // -m_j P_ij times the spiky gradient -3 C (h - r)^2 rij / r (Eq. 5), and the viscosity
       // term mu m_j (v_j - v_i) C_lap (h - r) / (rho_i rho_j) (Eq. 6).
-      const P fp =
-          select(apart, (grad_c * dh * dh / select(apart, r, one)) * (minus_one * mj * pij), zero) * pressure_on;
+      // Variational: the density kernel's gradient -6 C6 (h^2 - r^2)^2 rij instead.
+      P fp;
+      if constexpr (kForm == PressureForce::Variational) {
+        const P d2 = h2v - r2;
+        fp = select(near, grad6_c * d2 * d2 * (minus_one * mj * pij), zero) * pressure_on;
+      } else {
+        fp = select(apart, (grad_c * dh * dh / select(apart, r, one)) * (minus_one * mj * pij), zero) * pressure_on;
+      }
       const P fv = select(near, visc_i * mj * inv_rhoj * dh, zero);
       P q2 = zero;  // Eq. 7: squared pair distance after the step, predicted with today's velocities
       for (int d = 0; d < D; ++d) {
@@ -174,26 +181,40 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
   });
 }
 
-/// The spiky gradient grad_i W(x_i - x_j) for rij = x_i - x_j, zero outside (0, h).
+/// The kernel gradient grad_i W(x_i - x_j) the pressure force uses, for rij = x_i - x_j: the
+/// spiky kernel's, or poly6's for PressureForce::Variational; zero outside (0, h).
 template <int D, std::floating_point R>
-Vec<D, R> spiky_gradient(const Vec<D, R>& rij, R h, R grad_c) {
-  const R r2 = norm2(rij);
-  if (!(r2 < h * h) || !(r2 > R(0))) return Vec<D, R>{};
-  const R r = std::sqrt(r2);
-  return rij * (grad_c * (h - r) * (h - r) / r);
-}
+class PressureGradient {
+ public:
+  PressureGradient(R h, PressureForce form)
+      : h_(h),
+        poly6_(form == PressureForce::Variational),
+        c_(poly6_ ? R(-6) * Poly6Kernel<D, R>(h).norm() : R(-3) * SpikyKernel<D, R>(h).norm()) {}
+  Vec<D, R> operator()(const Vec<D, R>& rij) const {
+    const R r2 = norm2(rij);
+    if (!(r2 < h_ * h_) || !(r2 > R(0))) return Vec<D, R>{};
+    if (poly6_) return rij * (c_ * (h_ * h_ - r2) * (h_ * h_ - r2));
+    const R r = std::sqrt(r2);
+    return rij * (c_ * (h_ - r) * (h_ - r) / r);
+  }
+
+ private:
+  R h_;
+  bool poly6_;
+  R c_;
+};
 
 /// L_i = A_i^-1 with A_i = sum_j V_j grad_i W_ij (x_j - x_i)^T (row-major D x D per particle),
 /// or the identity where det A_i < 1/2 (see GradientCorrection::Renormalize).
 template <int D, std::floating_point R>
-std::vector<R> gradient_corrections(const ParticleSet<D, R>& ps, const NeighborLists& lists, R h) {
-  const R grad_c = R(-3) * SpikyKernel<D, R>(h).norm();
+std::vector<R> gradient_corrections(const ParticleSet<D, R>& ps, const NeighborLists& lists,
+                                    const PressureGradient<D, R>& gradient) {
   std::vector<R> L(ps.size() * D * D);
   parallel_for(ps.size(), [&](std::size_t i) {
     R a[D][D] = {};
     for (const std::uint32_t j : lists.of(i)) {
       const Vec<D, R> rij = ps.position[i] - ps.position[j];
-      const Vec<D, R> g = spiky_gradient<D, R>(rij, h, grad_c);
+      const Vec<D, R> g = gradient(rij);
       const R v = ps.mass[j] / ps.density[j];
       for (int r = 0; r < D; ++r)
         for (int c = 0; c < D; ++c) a[r][c] -= v * g[r] * rij[c];  // x_j - x_i = -rij
@@ -225,18 +246,18 @@ std::vector<R> gradient_corrections(const ParticleSet<D, R>& ps, const NeighborL
 }
 
 /// Adds the pressure accelerations with corrected gradients: each pair's term of the plain
-/// force (Paper or Symmetric form) with grad W_ij replaced by (L_i + L_j) / 2 grad W_ij.
+/// force (in its form) with grad W_ij replaced by (L_i + L_j) / 2 grad W_ij.
 template <int D, std::floating_point R>
 void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid) {
-  const std::vector<R> L = gradient_corrections(ps, lists, h);
-  const R grad_c = R(-3) * SpikyKernel<D, R>(h).norm();
+  const PressureGradient<D, R> gradient(h, fluid.pressure_force);
+  const std::vector<R> L = gradient_corrections(ps, lists, gradient);
   const bool paper = fluid.pressure_force == PressureForce::Paper;
   parallel_for(ps.size(), [&](std::size_t i) {
     const R* li = &L[i * D * D];
     const R inv_rhoi = R(1) / ps.density[i];
     Vec<D, R> acc{};
     for (const std::uint32_t j : lists.of(i)) {
-      const Vec<D, R> g = spiky_gradient<D, R>(ps.position[i] - ps.position[j], h, grad_c);
+      const Vec<D, R> g = gradient(ps.position[i] - ps.position[j]);
       const R inv_rhoj = R(1) / ps.density[j];
       const R pij = paper ? (R(0.5) * ps.pressure[i] + R(0.5) * ps.pressure[j]) * inv_rhoi * inv_rhoj
                           : ps.pressure[i] * inv_rhoi * inv_rhoi + ps.pressure[j] * inv_rhoj * inv_rhoj;
@@ -268,17 +289,22 @@ void dispatch_force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h,
                          R dt) {
   SPH_CHECK(exit_flags.empty() || exit_flags.size() == ps.size(), "one exit flag per particle");
   check_pass_inputs(ps, lists);
-  const bool paper = fluid.pressure_force == PressureForce::Paper;
-  if (exit_flags.empty()) {
-    if (paper)
-      force_pass<true, false>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
+  const auto run = [&]<PressureForce kForm>() {
+    if (exit_flags.empty())
+      force_pass<kForm, false>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
     else
-      force_pass<false, false>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
-  } else {
-    if (paper)
-      force_pass<true, true>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
-    else
-      force_pass<false, true>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
+      force_pass<kForm, true>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
+  };
+  switch (fluid.pressure_force) {
+    case PressureForce::Paper:
+      run.template operator()<PressureForce::Paper>();
+      break;
+    case PressureForce::Symmetric:
+      run.template operator()<PressureForce::Symmetric>();
+      break;
+    case PressureForce::Variational:
+      run.template operator()<PressureForce::Variational>();
+      break;
   }
 }
 }  // namespace

@@ -24,7 +24,8 @@ std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborList
 /// viscosity-kernel Laplacian) and gravity:
 ///   a_i = g + sum_j m_j [ -P_ij grad W_spiky(x_i - x_j) + mu (v_j - v_i) / (rho_i rho_j) lap W_visc ]
 /// with P_ij = (p_i + p_j) / (2 rho_i rho_j) (PressureForce::Paper: Eq. 5's force density
-/// divided by rho_i) or p_i / rho_i^2 + p_j / rho_j^2 (PressureForce::Symmetric).
+/// divided by rho_i) or p_i / rho_i^2 + p_j / rho_j^2 (PressureForce::Symmetric; and
+/// PressureForce::Variational, which takes poly6's gradient in place of the spiky one).
 /// Every pair term is antisymmetric (m_i a_i = -m_j a_j), so total momentum is conserved when
 /// lists are symmetric.
 ///

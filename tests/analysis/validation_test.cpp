@@ -112,6 +112,28 @@ TEST(FrontError, IncompleteWhenTheRunStoppedEarly) {
   EXPECT_NEAR(e.max, 0.0, 1e-12);
 }
 
+TEST(FrontChange, ComparesTwoFrontsAtTheExperimentsTimes) {
+  // The fine front is the coarse one plus 0.1 T: at the compared times 0.5, 1.5 and 2.5 the
+  // changes are 0.05, 0.15 and 0.25.
+  const std::vector<double> Tc{0, 1, 2, 3}, Zc{1, 2, 3, 4};
+  const std::vector<double> Tf{0, 3}, Zf{1, 4.3};
+  const std::vector<FrontPoint> exp{{0.5, 9}, {1.5, 9}, {2.5, 9}};
+  const FrontError at = front_error(Tf, Zf, exp, 3.0);
+  const FrontError c = front_change(Tf, Zf, Tc, Zc, at);
+  EXPECT_EQ(c.points, 3);
+  EXPECT_TRUE(c.complete);
+  EXPECT_NEAR(c.max, 0.25, 1e-12);
+  EXPECT_NEAR(c.worst_T, 2.5, 1e-12);
+  EXPECT_NEAR(c.mean, 0.15, 1e-12);
+  EXPECT_NEAR(c.rms, std::sqrt((0.05 * 0.05 + 0.15 * 0.15 + 0.25 * 0.25) / 3), 1e-12);
+  // A coarse run that stopped at T = 2 has no value at 2.5: that point is left out.
+  const std::vector<double> Ts{0, 1, 2}, Zs{1, 2, 3};
+  const FrontError s = front_change(Tf, Zf, Ts, Zs, at);
+  EXPECT_FALSE(s.complete);
+  EXPECT_EQ(s.points, 2);
+  EXPECT_NEAR(s.max, 0.15, 1e-12);
+}
+
 TEST(EosInternalEnergy, FormulaAndDerivativeIsPOverRhoSquared) {
   const double rho0 = 1000, k = 400;
   EXPECT_EQ(eos_internal_energy(rho0, rho0, k), 0.0);

@@ -125,6 +125,22 @@ FrontError front_error(std::span<const double> T, std::span<const double> Z, std
   return e;
 }
 
+FrontError front_change(std::span<const double> fine_T, std::span<const double> fine_Z,
+                        std::span<const double> coarse_T, std::span<const double> coarse_Z, const FrontError& at) {
+  std::vector<FrontPoint> coarse;
+  bool complete = true;
+  for (const FrontPoint& p : at.experiment) {
+    const double z = interpolate(coarse_T, coarse_Z, p.T);
+    if (std::isfinite(z))
+      coarse.push_back({p.T, z});
+    else
+      complete = false;
+  }
+  FrontError e = front_error(fine_T, fine_Z, coarse, std::numeric_limits<double>::infinity());
+  e.complete = e.complete && complete;
+  return e;
+}
+
 double eos_internal_energy(double rho, double rho0, double stiffness) {
   if (!(rho > rho0)) return 0.0;
   return stiffness * (std::log(rho / rho0) + rho0 / rho - 1.0);
@@ -620,6 +636,23 @@ ValidationResult run_validation(const ValidationOptions& opt, const ValidationPr
           fine.failure.empty() && coarse.failure.empty() && fine.error.complete && fine.error.max <= coarse.error.max,
           q);
     }
+    // Self-convergence: how far each refinement moves the front, at the experiment's times. A
+    // converging method moves it less at each refinement, however far its limit is from the
+    // experiment.
+    for (std::size_t k = 1; k < levels.size(); ++k) {
+      const FrontRun& coarse = res.front_runs[done.at({levels[k - 1], "standard"})];
+      FrontRun& fine = res.front_runs[done.at({levels[k], "standard"})];
+      fine.change = front_change(fine.T, fine.Z, coarse.T, coarse.Z, fine.error);
+      if (k < 2) continue;
+      const FrontRun& previous = coarse;
+      add_check(res, "resolution",
+                fmt::format("max |Z(a/{}) - Z(a/{})| (a/{} to a/{}: {:.3f})", levels[k], levels[k - 1], levels[k - 2],
+                            levels[k - 1], previous.change.max),
+                fine.change.max, fmt::format("<= {:.3f} (shrinks)", previous.change.max),
+                fine.failure.empty() && previous.change.complete && fine.change.complete &&
+                    fine.change.max <= previous.change.max,
+                q);
+    }
   }
   if (wants("hydrostatic")) {
     for (int d : {2, 3}) {
@@ -801,15 +834,18 @@ std::string report_md(const ValidationResult& res, const std::vector<std::string
     md += "## Resolution study\n\n";
     md +=
         "The same dam break at several spacings (standard mode). h, dt scale with the spacing; the wall\n"
-        "stiffness with 1 / spacing^2; viscosity and stiffness are fixed.\n\n";
+        "stiffness with 1 / spacing^2; viscosity and stiffness are fixed. The change from the coarser is\n"
+        "Z at this spacing minus Z at the next coarser one, at the experiment's times: it shrinks when the\n"
+        "method converges, whatever the distance of its limit from the experiment.\n\n";
     md += "![resolution](resolution.png)\n\n![resolution error](resolution_error.png)\n\n";
     md +=
-        "| spacing | particles | steps | wall s | max dZ | RMS dZ | mean dZ |\n| --- | ---: | ---: | ---: | ---: | "
-        "---: | ---: |\n";
+        "| spacing | particles | steps | wall s | max dZ | RMS dZ | mean dZ | max change from the coarser | RMS change "
+        "|\n| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     for (int n : resolutions(res))
       if (const FrontRun* r = find_run(res, n, "standard"))
-        md += fmt::format("| a/{} | {} | {} | {:.1f} | {} | {} | {:+.3f} |\n", n, r->particles, r->steps, r->seconds,
-                          g(r->error.max), g(r->error.rms), r->error.mean);
+        md += fmt::format("| a/{} | {} | {} | {:.1f} | {} | {} | {:+.3f} | {} | {} |\n", n, r->particles, r->steps,
+                          r->seconds, g(r->error.max), g(r->error.rms), r->error.mean, g(r->change.max),
+                          g(r->change.rms));
     md += "\n" + checks_table(res, "resolution");
   }
   if (has(res, "hydrostatic")) {
@@ -900,14 +936,14 @@ void write_validation(const std::filesystem::path& dir, const ValidationResult& 
     write_file_atomic(dir / "front.csv", out);
     out =
         "run,resolution,mode,particles,spacing,dt,steps,seconds,points,complete,max_dZ,rms_dZ,mean_dZ,worst_T,"
-        "failure\n";
+        "max_change_from_coarser,rms_change_from_coarser,failure\n";
     for (const FrontRun& r : res.front_runs) {
       std::string failure = r.failure;
       std::replace(failure.begin(), failure.end(), '"', '\'');
-      out += fmt::format("{},{},{},{},{:.9g},{:.9g},{},{:.3f},{},{},{:.6f},{:.6f},{:.6f},{:.2f},\"{}\"\n", r.label,
-                         r.resolution, r.mode, r.particles, r.spacing, r.dt, r.steps, r.seconds, r.error.points,
-                         r.error.complete ? "yes" : "no", r.error.max, r.error.rms, r.error.mean, r.error.worst_T,
-                         failure);
+      out += fmt::format("{},{},{},{},{:.9g},{:.9g},{},{:.3f},{},{},{:.6f},{:.6f},{:.6f},{:.2f},{:.6f},{:.6f},\"{}\"\n",
+                         r.label, r.resolution, r.mode, r.particles, r.spacing, r.dt, r.steps, r.seconds,
+                         r.error.points, r.error.complete ? "yes" : "no", r.error.max, r.error.rms, r.error.mean,
+                         r.error.worst_T, r.change.max, r.change.rms, failure);
     }
     write_file_atomic(dir / "front_errors.csv", out);
     out = "T,Z_experiment";
@@ -938,11 +974,13 @@ void write_validation(const std::filesystem::path& dir, const ValidationResult& 
     spec.y_label = "|dZ| over T <= 3.33";
     Series mx{.name = "max |dZ|", .x = {}, .y = {}, .color = series_color(0), .dashed = false};
     Series rms{.name = "RMS dZ", .x = {}, .y = {}, .color = series_color(1), .dashed = true};
+    Series change{.name = "max change from the coarser", .x = {}, .y = {}, .color = series_color(2), .dashed = false};
     for (const FrontRun* r : runs) {
       mx.x.push_back(r->resolution), mx.y.push_back(r->error.max);
       rms.x.push_back(r->resolution), rms.y.push_back(r->error.rms);
+      if (std::isfinite(r->change.max)) change.x.push_back(r->resolution), change.y.push_back(r->change.max);
     }
-    spec.series = {mx, rms};
+    spec.series = {mx, rms, change};
     write_png(dir / "resolution_error.png", render_plot(spec));
   }
   if (has(res, "hydrostatic")) {

@@ -196,7 +196,17 @@ struct FrontRun {
   std::vector<double> time, T, Z;
   std::vector<EnergyParts> energy;
   FrontError error;
+  /// Resolution study: this front against the next coarser one's, at the experiment's times
+  /// (max and RMS of Z_this - Z_coarser); empty for the coarsest.
+  FrontError change;
 };
+
+/// The front `fine` compared with the front `coarse` (both T increasing) at the times of
+/// `at.experiment` (the experimental points a front_error compared), as front_error does with
+/// the experiment: how much a refinement moved the front. Points where `coarse` has no value
+/// are left out and make the result incomplete.
+FrontError front_change(std::span<const double> fine_T, std::span<const double> fine_Z,
+                        std::span<const double> coarse_T, std::span<const double> coarse_Z, const FrontError& at);
 
 /// A hydrostatic tank run.
 struct HydrostaticRun {

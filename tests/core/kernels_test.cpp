@@ -28,9 +28,12 @@ double radial_integral(F&& w, double h, int n = 200000) {
 
 template <int D>
 void check_normalization(double h) {
-  EXPECT_NEAR(radial_integral<D>([&](double r) { return Poly6Kernel<D, double>(h).w(r); }, h), 1.0, 1e-6) << D << "D poly6";
-  EXPECT_NEAR(radial_integral<D>([&](double r) { return SpikyKernel<D, double>(h).w(r); }, h), 1.0, 1e-6) << D << "D spiky";
-  EXPECT_NEAR(radial_integral<D>([&](double r) { return ViscosityKernel<D, double>(h).w(r); }, h), 1.0, 1e-4) << D << "D viscosity";
+  EXPECT_NEAR(radial_integral<D>([&](double r) { return Poly6Kernel<D, double>(h).w(r); }, h), 1.0, 1e-6)
+      << D << "D poly6";
+  EXPECT_NEAR(radial_integral<D>([&](double r) { return SpikyKernel<D, double>(h).w(r); }, h), 1.0, 1e-6)
+      << D << "D spiky";
+  EXPECT_NEAR(radial_integral<D>([&](double r) { return ViscosityKernel<D, double>(h).w(r); }, h), 1.0, 1e-4)
+      << D << "D viscosity";
 }
 
 TEST(Kernels, IntegrateToOne2D) {
@@ -76,6 +79,29 @@ void check_spiky_gradient(double h) {
 TEST(Kernels, SpikyGradientIsDerivativeOfW) {
   check_spiky_gradient<2>(0.02);
   check_spiky_gradient<3>(0.04);
+}
+
+template <int D>
+void check_poly6_gradient(double h) {
+  const Poly6Kernel<D, double> k(h);
+  for (double q : {0.1, 0.35, 0.6, 0.9}) {
+    Vec<D, double> rij{};
+    rij[0] = q * h * 0.6;
+    rij[1] = q * h * 0.8;
+    const double r = norm(rij);
+    const double e = 1e-7 * h;
+    const double dwdr = (k.w(r + e) - k.w(r - e)) / (2 * e);
+    const Vec<D, double> g = k.gradient(rij, r * r);
+    for (int d = 0; d < D; ++d) EXPECT_NEAR(g[d], dwdr * rij[d] / r, 1e-6 * std::abs(dwdr) + 1e-12) << D << "D q=" << q;
+  }
+  Vec<D, double> at_h{};
+  at_h[0] = h;
+  EXPECT_EQ(norm(k.gradient(at_h, h * h)), 0.0);
+  EXPECT_EQ(norm(k.gradient(Vec<D, double>{}, 0.0)), 0.0);  // flat at the center
+}
+TEST(Kernels, Poly6GradientIsDerivativeOfW) {
+  check_poly6_gradient<2>(0.02);
+  check_poly6_gradient<3>(0.04);
 }
 
 template <int D>

@@ -260,33 +260,35 @@ double settling_time(std::span<const double> times, std::span<const double> valu
   return times[last_above + 1];
 }
 
-double lattice_gradient_consistency(int dimension, double spacing, double h, bool poly6_gradient) {
-  if (dimension != 2 && dimension != 3) throw Error("expected 2 or 3", "dimension");
+namespace {
+/// M_yy of lattice_gradient_consistency in D dimensions.
+template <int D>
+double lattice_m_yy(double spacing, double h, bool poly6_gradient) {
+  const double volume = lattice_mass<D>(1.0, spacing, h);  // m / rho0 with rho0 = 1
+  const Poly6Kernel<D, double> poly6(h);
+  const SpikyKernel<D, double> spiky(h);
   const int n = static_cast<int>(std::ceil(h / spacing)) + 1;
   double sum = 0;
-  // x_ij = x_i - x_j with x_i at the origin: y_ij = -y. dW/dy_i is -3 C (h - r)^2 y_ij / r for
-  // the spiky kernel and -6 C (h^2 - r^2)^2 y_ij for poly6.
-  const auto add = [&](double norm, double y, double r, double volume) {
-    if (r <= 0 || r >= h) return;
-    const double yij = -y;
-    const double dwdy = poly6_gradient ? -6.0 * norm * (h * h - r * r) * (h * h - r * r) * yij
-                                       : -3.0 * norm * (h - r) * (h - r) * yij / r;
-    sum -= volume * yij * dwdy;
-  };
-  if (dimension == 2) {
-    const double volume = lattice_mass<2>(1.0, spacing, h);  // m / rho0 with rho0 = 1
-    const double norm = poly6_gradient ? Poly6Kernel<2, double>(h).norm() : SpikyKernel<2, double>(h).norm();
-    for (int a = -n; a <= n; ++a)
-      for (int b = -n; b <= n; ++b) add(norm, b * spacing, spacing * std::sqrt(double(a * a + b * b)), volume);
-  } else {
-    const double volume = lattice_mass<3>(1.0, spacing, h);
-    const double norm = poly6_gradient ? Poly6Kernel<3, double>(h).norm() : SpikyKernel<3, double>(h).norm();
-    for (int a = -n; a <= n; ++a)
-      for (int b = -n; b <= n; ++b)
-        for (int c = -n; c <= n; ++c)
-          add(norm, b * spacing, spacing * std::sqrt(double(a * a + b * b + c * c)), volume);
-  }
+  for (int a = -n; a <= n; ++a)
+    for (int b = -n; b <= n; ++b)
+      for (int c = (D == 3 ? -n : 0); c <= (D == 3 ? n : 0); ++c) {
+        // x_i at the origin and x_j on the lattice: rij = x_i - x_j; the term is -V_j y_ij dW/dy_i.
+        Vec<D, double> rij{};
+        rij[0] = -a * spacing;
+        rij[1] = -b * spacing;
+        if constexpr (D == 3) rij[2] = -c * spacing;
+        const double r2 = norm2(rij);
+        if (!(r2 > 0)) continue;
+        const Vec<D, double> g = poly6_gradient ? poly6.gradient(rij, r2) : spiky.gradient(rij, std::sqrt(r2));
+        sum -= volume * rij[1] * g[1];
+      }
   return sum;
+}
+}  // namespace
+
+double lattice_gradient_consistency(int dimension, double spacing, double h, bool poly6_gradient) {
+  if (dimension != 2 && dimension != 3) throw Error("expected 2 or 3", "dimension");
+  return dimension == 2 ? lattice_m_yy<2>(spacing, h, poly6_gradient) : lattice_m_yy<3>(spacing, h, poly6_gradient);
 }
 
 // ---- Running --------------------------------------------------------------------------------
@@ -643,14 +645,13 @@ ValidationResult run_validation(const ValidationOptions& opt, const ValidationPr
       const FrontRun& coarse = res.front_runs[done.at({levels[k - 1], "standard"})];
       FrontRun& fine = res.front_runs[done.at({levels[k], "standard"})];
       fine.change = front_change(fine.T, fine.Z, coarse.T, coarse.Z, fine.error);
-      if (k < 2) continue;
-      const FrontRun& previous = coarse;
+      if (k < 2) continue;  // the coarser pair's change is coarse.change
       add_check(res, "resolution",
                 fmt::format("max |Z(a/{}) - Z(a/{})| (a/{} to a/{}: {:.3f})", levels[k], levels[k - 1], levels[k - 2],
-                            levels[k - 1], previous.change.max),
-                fine.change.max, fmt::format("<= {:.3f} (shrinks)", previous.change.max),
-                fine.failure.empty() && previous.change.complete && fine.change.complete &&
-                    fine.change.max <= previous.change.max,
+                            levels[k - 1], coarse.change.max),
+                fine.change.max, fmt::format("<= {:.3f} (shrinks)", coarse.change.max),
+                fine.failure.empty() && coarse.change.complete && fine.change.complete &&
+                    fine.change.max <= coarse.change.max,
                 q);
     }
   }

@@ -19,7 +19,8 @@
 
 namespace sph {
 
-/// Poly6 kernel: used for density (paper Eq. 4).
+/// Poly6 kernel: used for density (paper Eq. 4), and its gradient for the variational pressure
+/// force.
 template <int D, std::floating_point R>
 class Poly6Kernel {
  public:
@@ -40,6 +41,13 @@ class Poly6Kernel {
   R w(R r) const { return w_r2(r * r); }
   /// W(0): the particle's own contribution to its density.
   R w_zero() const { return norm_ * h2_ * h2_ * h2_; }
+  /// Gradient of W with respect to x_i, for rij = x_i - x_j at squared distance r2 = |rij|^2:
+  /// -6 C (h^2 - r^2)^2 rij (the variational pressure force's). Zero for r2 >= h^2.
+  Vec<D, R> gradient(const Vec<D, R>& rij, R r2) const {
+    if (r2 >= h2_) return Vec<D, R>{};
+    const R d = h2_ - r2;
+    return rij * (R(-6) * norm_ * d * d);
+  }
 
  private:
   R h_, h2_, norm_;
@@ -95,8 +103,7 @@ class ViscosityKernel {
     const double pi = std::numbers::pi;
     if constexpr (D == 3) {
       const double q = rd / hd;
-      return static_cast<R>(15.0 / (2.0 * pi * hd * hd * hd) *
-                            (-q * q * q / 2.0 + q * q + 1.0 / (2.0 * q) - 1.0));
+      return static_cast<R>(15.0 / (2.0 * pi * hd * hd * hd) * (-q * q * q / 2.0 + q * q + 1.0 / (2.0 * q) - 1.0));
     } else {
       const double c = 40.0 / (pi * std::pow(hd, 5));
       return static_cast<R>(c * (hd * rd * rd / 4.0 - rd * rd * rd / 9.0 - 5.0 * hd * hd * hd / 36.0 -

@@ -186,22 +186,17 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
 template <int D, std::floating_point R>
 class PressureGradient {
  public:
-  PressureGradient(R h, PressureForce form)
-      : h_(h),
-        poly6_(form == PressureForce::Variational),
-        c_(poly6_ ? R(-6) * Poly6Kernel<D, R>(h).norm() : R(-3) * SpikyKernel<D, R>(h).norm()) {}
+  PressureGradient(R h, PressureForce form) : poly6_(h), spiky_(h), variational_(form == PressureForce::Variational) {}
   Vec<D, R> operator()(const Vec<D, R>& rij) const {
     const R r2 = norm2(rij);
-    if (!(r2 < h_ * h_) || !(r2 > R(0))) return Vec<D, R>{};
-    if (poly6_) return rij * (c_ * (h_ * h_ - r2) * (h_ * h_ - r2));
-    const R r = std::sqrt(r2);
-    return rij * (c_ * (h_ - r) * (h_ - r) / r);
+    if (variational_) return poly6_.gradient(rij, r2);
+    return spiky_.gradient(rij, std::sqrt(r2));
   }
 
  private:
-  R h_;
-  bool poly6_;
-  R c_;
+  Poly6Kernel<D, R> poly6_;
+  SpikyKernel<D, R> spiky_;
+  bool variational_;
 };
 
 /// L_i = A_i^-1 with A_i = sum_j V_j grad_i W_ij (x_j - x_i)^T (row-major D x D per particle),

@@ -2,6 +2,10 @@
 
 #include <sph/core/particle_set.h>
 
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
 namespace sph {
 namespace {
 
@@ -27,6 +31,53 @@ TEST(ParticleSet, PermutationOfWrongSizeIsABug) {
   ps.add({}, {}, 1.0);
   const std::vector<std::uint32_t> perm{0, 1};
   EXPECT_THROW(ps.permute(perm), std::logic_error);
+}
+
+}  // namespace
+}  // namespace sph
+
+namespace sph {
+namespace {
+
+// for_each_field visits every field of the table once, in table order, each with a column of the
+// element type its descriptor's kind says.
+template <int D, class R>
+void check_field_visit() {
+  ParticleSet<D, R> ps;
+  ps.add({}, {}, R(1));
+  std::size_t k = 0;
+  ps.for_each_field([&](const FieldDesc& f, const auto& column) {
+    using T = typename std::decay_t<decltype(column)>::value_type;
+    ASSERT_LT(k, std::size(kParticleFields));
+    EXPECT_EQ(f.name, kParticleFields[k].name);
+    const FieldKind kind = std::is_same_v<T, Vec<D, R>> ? FieldKind::Vector
+                           : std::is_same_v<T, R>       ? FieldKind::Real
+                                                        : FieldKind::Id;
+    EXPECT_EQ(f.kind, kind) << f.name;
+    EXPECT_EQ(column.size(), 1u) << f.name;
+    ++k;
+  });
+  EXPECT_EQ(k, std::size(kParticleFields));
+}
+
+TEST(ParticleFields, EveryFieldIsVisitedWithItsKind) {
+  check_field_visit<2, float>();
+  check_field_visit<3, double>();
+}
+
+TEST(ParticleFields, FrameFieldNamesAreTheTablesFrameFields) {
+  std::vector<std::string_view> names;
+  for (const FieldDesc& f : kParticleFields)
+    if (f.in_frames) names.push_back(f.name);
+  EXPECT_EQ(std::vector<std::string_view>(kFrameFieldNames.begin(), kFrameFieldNames.end()), names);
+  EXPECT_EQ(frame_field_list(" or "), "velocity, density, pressure, id or initial_position");
+  for (const FieldDesc& f : kParticleFields) {
+    EXPECT_EQ(find_particle_field(f.name), &f);
+    EXPECT_TRUE(valid_field_name(f.name)) << f.name;
+    for (int c = 0; f.in_frames && c < f.components(); ++c)
+      EXPECT_FALSE(f.ply[static_cast<std::size_t>(c)].empty()) << f.name;
+  }
+  EXPECT_EQ(find_particle_field("nope"), nullptr);
 }
 
 }  // namespace

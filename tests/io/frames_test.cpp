@@ -36,19 +36,21 @@ const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
 constexpr FrameFormat kFormats[] = {FrameFormat::Vtu, FrameFormat::Vtk, FrameFormat::Ply};
 
 
+/// Which of kFrameFieldNames a test frame holds: bit k for kFrameFieldNames[k].
+using FieldMask = unsigned;
+constexpr FieldMask kFieldVelocity = 1u << 0, kFieldDensity = 1u << 1, kFieldPressure = 1u << 2, kFieldId = 1u << 3,
+                    kFieldInitialPosition = 1u << 4, kAllFrameFields = 0x1Fu;
+
+FrameFields fields_of(FieldMask mask) {
+  std::vector<std::string> names;
+  for (std::size_t k = 0; k < kFrameFieldNames.size(); ++k)
+    if (mask & (1u << k)) names.emplace_back(kFrameFieldNames[k]);
+  return FrameFields::only(names);
+}
+
 template <int D, class R>
-void write_frame(FrameFormat f, const fs::path& path, const ParticleSet<D, R>& ps, double time, FrameFieldMask mask) {
-  switch (f) {
-    case FrameFormat::Vtu:
-      write_vtu(path, ps, time, mask);
-      break;
-    case FrameFormat::Vtk:
-      write_legacy_vtk(path, ps, time, mask);
-      break;
-    case FrameFormat::Ply:
-      write_ply(path, ps, time, mask);
-      break;
-  }
+void write_frame(FrameFormat f, const fs::path& path, const ParticleSet<D, R>& ps, double time, FieldMask mask) {
+  sph::write_frame(f, path, ps, time, fields_of(mask));
 }
 
 fs::path frame_path(const TempDir& dir, FrameFormat f) {
@@ -62,7 +64,7 @@ double stored(FrameFormat f, R x) {
 }
 
 template <int D, class R>
-void check_round_trip(FrameFormat f, std::size_t n, FrameFieldMask mask) {
+void check_round_trip(FrameFormat f, std::size_t n, FieldMask mask) {
   SCOPED_TRACE(::testing::Message() << frame_format_name(f) << ", " << D << "D, "
                                     << (sizeof(R) == 4 ? "float" : "double") << ", N = " << n << ", fields " << mask);
   TempDir dir;
@@ -75,7 +77,7 @@ void check_round_trip(FrameFormat f, std::size_t n, FrameFieldMask mask) {
   ASSERT_EQ(fr.position.size(), 3 * n);
   std::vector<std::string> expected_fields;
   for (int k = 0; k < 5; ++k)
-    if (mask & (1u << k)) expected_fields.push_back(kFrameFieldNames[k]);
+    if (mask & (1u << k)) expected_fields.emplace_back(kFrameFieldNames[k]);
   std::vector<std::string> got;
   for (const FrameField& ff : fr.fields) got.push_back(ff.name);
   EXPECT_EQ(got, expected_fields) << "exactly the chosen fields, in kFrameFieldNames order";
@@ -142,7 +144,7 @@ TEST(FrameFiles, PrecisionOfTheRunIsKept) {
   EXPECT_NE(slurp(dir / "f.vtk").find("POINTS 3 float\n"), std::string::npos);
   EXPECT_NE(slurp(dir / "d.vtk").find("POINTS 3 double\n"), std::string::npos);
   // The PLY header: the time as a comment, Blender/Houdini property names.
-  write_ply(dir / "p.ply", test::make_test_particles<2, double>(3), 0.125, kFieldVelocity | kFieldId);
+  write_ply(dir / "p.ply", test::make_test_particles<2, double>(3), 0.125, fields_of(kFieldVelocity | kFieldId));
   const std::string ply = slurp(dir / "p.ply");
   EXPECT_EQ(ply.substr(0, ply.find("end_header\n") + 11),
             "ply\nformat binary_little_endian 1.0\ncomment sph frame\ncomment time 0.125\nelement vertex 3\n"

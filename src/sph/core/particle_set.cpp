@@ -1,33 +1,80 @@
-#include <sph/core/error.h>
 #include <sph/core/particle_set.h>
+
 #include <algorithm>
 
+#include <sph/core/error.h>
 #include <sph/core/state_stream.h>
 
 namespace sph {
 
 template <int D, std::floating_point R>
+std::size_t ParticleSet<D, R>::add_field(FieldSpec spec) {
+  if (!valid_field_name(spec.name))
+    throw Error("\"" + spec.name +
+                    "\" is not a valid particle field name; expected 1 to 64 of a-z, 0-9 and _, starting with a letter",
+                "particle field");
+  if (find_particle_field(spec.name) || added_field_index(spec.name) >= 0)
+    throw Error("a particle field named \"" + spec.name + "\" exists already", "particle field");
+  if (spec.kind == FieldKind::Id) throw Error("added particle fields hold reals or vectors, not ids", spec.name);
+  AddedField a;
+  if (spec.kind == FieldKind::Vector)
+    a.ply = {spec.name + "_x", spec.name + "_y", spec.name + "_z"};
+  else
+    a.ply = {spec.name, "", ""};
+  a.spec = std::move(spec);
+  if (a.spec.kind == FieldKind::Vector)
+    a.vectors.assign(size(), V{});
+  else
+    a.reals.assign(size(), R(0));
+  if (a.spec.kind == FieldKind::Vector)
+    a.vectors.reserve(position.capacity());
+  else
+    a.reals.reserve(position.capacity());
+  added_.push_back(std::move(a));
+  return added_.size() - 1;
+}
+
+template <int D, std::floating_point R>
+std::ptrdiff_t ParticleSet<D, R>::added_field_index(std::string_view name) const {
+  for (std::size_t k = 0; k < added_.size(); ++k)
+    if (added_[k].spec.name == name) return static_cast<std::ptrdiff_t>(k);
+  return -1;
+}
+
+template <int D, std::floating_point R>
+std::vector<R>& ParticleSet<D, R>::real_field(std::size_t k) {
+  SPH_CHECK(k < added_.size() && added_[k].spec.kind == FieldKind::Real, "real_field: no such real field");
+  return added_[k].reals;
+}
+template <int D, std::floating_point R>
+const std::vector<R>& ParticleSet<D, R>::real_field(std::size_t k) const {
+  SPH_CHECK(k < added_.size() && added_[k].spec.kind == FieldKind::Real, "real_field: no such real field");
+  return added_[k].reals;
+}
+template <int D, std::floating_point R>
+std::vector<Vec<D, R>>& ParticleSet<D, R>::vector_field(std::size_t k) {
+  SPH_CHECK(k < added_.size() && added_[k].spec.kind == FieldKind::Vector, "vector_field: no such vector field");
+  return added_[k].vectors;
+}
+template <int D, std::floating_point R>
+const std::vector<Vec<D, R>>& ParticleSet<D, R>::vector_field(std::size_t k) const {
+  SPH_CHECK(k < added_.size() && added_[k].spec.kind == FieldKind::Vector, "vector_field: no such vector field");
+  return added_[k].vectors;
+}
+
+template <int D, std::floating_point R>
 void ParticleSet<D, R>::reserve(std::size_t n) {
-  position.reserve(n);
-  velocity.reserve(n);
-  acceleration.reserve(n);
-  initial_position.reserve(n);
-  density.reserve(n);
-  pressure.reserve(n);
-  mass.reserve(n);
-  id.reserve(n);
+  for_each_field([n](const FieldDesc&, auto& column) { column.reserve(n); });
 }
 
 template <int D, std::floating_point R>
 std::uint64_t ParticleSet<D, R>::add(const V& x, const V& v, R m) {
-  position.push_back(x);
-  velocity.push_back(v);
-  acceleration.push_back(V{});
-  initial_position.push_back(x);
-  density.push_back(R(0));
-  pressure.push_back(R(0));
-  mass.push_back(m);
-  id.push_back(next_id_);
+  for_each_field([](const FieldDesc&, auto& column) { column.emplace_back(); });  // zeros
+  position.back() = x;
+  velocity.back() = v;
+  initial_position.back() = x;
+  mass.back() = m;
+  id.back() = next_id_;
   return next_id_++;
 }
 
@@ -41,65 +88,57 @@ void ParticleSet<D, R>::permute(std::span<const std::uint32_t> perm) {
     SPH_CHECK(p < n && !((placed_[p / 64] >> (p % 64)) & 1u), "not a permutation");
     placed_[p / 64] |= std::uint64_t{1} << (p % 64);
   }
-  std::fill(placed_.begin(), placed_.end(), 0);
-  const auto placed = [&](std::size_t k) { return (placed_[k / 64] >> (k % 64)) & 1u; };
-  const auto move_to = [&](std::size_t dst, std::size_t src) {
-    position[dst] = position[src];
-    velocity[dst] = velocity[src];
-    acceleration[dst] = acceleration[src];
-    initial_position[dst] = initial_position[src];
-    density[dst] = density[src];
-    pressure[dst] = pressure[src];
-    mass[dst] = mass[src];
-    id[dst] = id[src];
-  };
-  // Each cycle k -> perm[k] -> perm[perm[k]] ... is rotated through one saved particle.
-  for (std::size_t start = 0; start < n; ++start) {
-    if (placed(start) || perm[start] == start) continue;
-    const V x = position[start], v = velocity[start], a = acceleration[start], x0 = initial_position[start];
-    const R rho = density[start], p = pressure[start], m = mass[start];
-    const std::uint64_t ident = id[start];
-    std::size_t k = start;
-    for (;;) {
-      placed_[k / 64] |= std::uint64_t{1} << (k % 64);
-      const std::size_t src = perm[k];
-      if (src == start) break;
-      move_to(k, src);
-      k = src;
+  // Each field in turn: each cycle k -> perm[k] -> perm[perm[k]] ... is rotated through one
+  // saved value.
+  for_each_field([&](const FieldDesc&, auto& column) {
+    std::fill(placed_.begin(), placed_.end(), 0);
+    const auto placed = [&](std::size_t k) { return (placed_[k / 64] >> (k % 64)) & 1u; };
+    for (std::size_t start = 0; start < n; ++start) {
+      if (placed(start) || perm[start] == start) continue;
+      const auto saved = column[start];
+      std::size_t k = start;
+      for (;;) {
+        placed_[k / 64] |= std::uint64_t{1} << (k % 64);
+        const std::size_t src = perm[k];
+        if (src == start) break;
+        column[k] = column[src];
+        k = src;
+      }
+      column[k] = saved;
     }
-    position[k] = x, velocity[k] = v, acceleration[k] = a, initial_position[k] = x0;
-    density[k] = rho, pressure[k] = p, mass[k] = m, id[k] = ident;
-  }
+  });
 }
 
 template <int D, std::floating_point R>
 void ParticleSet<D, R>::save(StateWriter& out) const {
   out.put(next_id_);
-  out.put(position);
-  out.put(velocity);
-  out.put(acceleration);
-  out.put(initial_position);
-  out.put(density);
-  out.put(pressure);
-  out.put(mass);
-  out.put(id);
+  out.put(static_cast<std::uint64_t>(std::size(kParticleFields) + added_.size()));
+  for_each_field([&](const FieldDesc& f, const auto& column) {
+    out.put(std::string(f.name));
+    out.put(static_cast<std::uint8_t>(f.kind));
+    out.put(column);
+  });
 }
 
 template <int D, std::floating_point R>
 void ParticleSet<D, R>::load(StateReader& in) {
   in.get(next_id_);
-  in.get(position);
-  in.get(velocity);
-  in.get(acceleration);
-  in.get(initial_position);
-  in.get(density);
-  in.get(pressure);
-  in.get(mass);
-  in.get(id);
-  const std::size_t n = position.size();
-  in.expect(velocity.size() == n && acceleration.size() == n && initial_position.size() == n && density.size() == n &&
-                pressure.size() == n && mass.size() == n && id.size() == n,
-            "particle fields of different lengths");
+  const auto fields = in.get<std::uint64_t>();
+  in.expect(fields == std::size(kParticleFields) + added_.size(),
+            "it holds " + std::to_string(fields) + " particle fields; this run has " +
+                std::to_string(std::size(kParticleFields) + added_.size()));
+  std::size_t n = 0;
+  bool first = true;
+  for_each_field([&](const FieldDesc& f, auto& column) {
+    std::string name;
+    in.get(name);
+    const auto kind = in.get<std::uint8_t>();
+    in.expect(name == f.name && kind == static_cast<std::uint8_t>(f.kind),
+              "it holds the particle field \"" + name + "\" where this run has \"" + std::string(f.name) + "\"");
+    in.get(column);
+    if (first) n = column.size(), first = false;
+    in.expect(column.size() == n, "particle fields of different lengths");
+  });
   for (std::uint64_t i : id) in.expect(i < next_id_, "a particle id at or above the next id");
 }
 

@@ -23,10 +23,11 @@
 
 namespace sph {
 
-/// The format version this build writes and reads. Version 2 (frame formats and the fps
-/// schedule) keeps the frames' times and the schedule's next tick instead of version 1's .vtu
+/// The format version this build writes and reads. Version 3 stores the particle fields by
+/// name and kind, in kParticleFields order, then the fields a run added (ParticleSet::save);
+/// version 2 kept the frames' times and the schedule's next tick instead of version 1's .vtu
 /// file list.
-inline constexpr std::uint32_t kCheckpointVersion = 2;
+inline constexpr std::uint32_t kCheckpointVersion = 3;
 /// The checkpoint's file name in a run's output directory.
 inline constexpr const char* kCheckpointFile = "checkpoint.sphc";
 

@@ -1,27 +1,54 @@
 #pragma once
-/// \file Names of the frame formats and fields (scene keys, --format, --fields, file extensions)
-/// and the field selection the frame writers take.
+/// \file The field selection the frame writers take, and the one dispatch from a frame format to
+/// its writer. Format names are in scene/frame_formats.h, field names in core/particle_fields.h.
 
-#include <optional>
+#include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include <sph/scene/scene_desc.h>
+#include <sph/core/particle_set.h>
+#include <sph/scene/frame_formats.h>
 
 namespace sph {
 
-/// "vtu", "vtk" or "ply": the scene's name of the format, which is also its file extension.
-const char* frame_format_name(FrameFormat f);
-/// The format named `name` ("vtu", "vtk", "ply"), or nullopt.
-std::optional<FrameFormat> parse_frame_format(std::string_view name);
+/// Which point fields a frame holds besides the positions: every field that frames may hold
+/// (the default), or those named.
+class FrameFields {
+ public:
+  /// Every field whose descriptor is `in_frames`, built-in or added (ParticleSet::add_field).
+  FrameFields() = default;
+  /// Exactly the fields named (none for an empty list); written in the set's field order.
+  static FrameFields only(std::vector<std::string> names) {
+    FrameFields f;
+    f.all_ = false;
+    f.names_ = std::move(names);
+    return f;
+  }
+  bool has(std::string_view name) const {
+    if (all_) return true;
+    for (const std::string& n : names_)
+      if (n == name) return true;
+    return false;
+  }
 
-/// Which of kFrameFieldNames a frame holds: bit i for kFrameFieldNames[i].
-using FrameFieldMask = unsigned;
-inline constexpr FrameFieldMask kFieldVelocity = 1u << 0, kFieldDensity = 1u << 1, kFieldPressure = 1u << 2,
-                                kFieldId = 1u << 3, kFieldInitialPosition = 1u << 4;
-inline constexpr FrameFieldMask kAllFrameFields = 0x1Fu;
-/// The mask of `names` (each one of kFrameFieldNames; SPH_CHECK: the scene reader checked them).
-FrameFieldMask frame_field_mask(const std::vector<std::string>& names);
+ private:
+  bool all_ = true;
+  std::vector<std::string> names_;
+};
+
+/// Calls f(desc, column) for each field of `ps` that a frame with `fields` holds, in the set's
+/// field order (ParticleSet::for_each_field).
+template <int D, std::floating_point R, class F>
+void for_each_frame_field(const ParticleSet<D, R>& ps, const FrameFields& fields, F&& f) {
+  ps.for_each_field([&](const FieldDesc& desc, const auto& column) {
+    if (desc.in_frames && fields.has(desc.name)) f(desc, column);
+  });
+}
+
+/// Writes one frame file of `format` (write_vtu, write_legacy_vtk or write_ply), atomically.
+template <int D, std::floating_point R>
+void write_frame(FrameFormat format, const std::filesystem::path& path, const ParticleSet<D, R>& particles,
+                 double time, const FrameFields& fields = {});
 
 }  // namespace sph

@@ -24,6 +24,19 @@ std::string frame_name(std::size_t index, FrameFormat f) {
 
 }  // namespace
 
+template <int D, std::floating_point R>
+void write_frame(FrameFormat format, const fs::path& path, const ParticleSet<D, R>& particles, double time,
+                 const FrameFields& fields) {
+  switch (format) {
+    case FrameFormat::Vtu:
+      return write_vtu(path, particles, time, fields);
+    case FrameFormat::Vtk:
+      return write_legacy_vtk(path, particles, time, fields);
+    case FrameFormat::Ply:
+      return write_ply(path, particles, time, fields);
+  }
+}
+
 bool FrameSchedule::due(std::int64_t step, double time, bool last) const {
   if (every_ > 0) return step % every_ == 0 || last;
   if (fps_ > 0) return last || time * fps_ >= static_cast<double>(next_tick_) * (1 - kTickTolerance);
@@ -41,7 +54,7 @@ void FrameSchedule::written(double time) {
 
 template <int D, std::floating_point R>
 FrameWriter<D, R>::FrameWriter(fs::path dir, OutputDesc output)
-    : dir_(std::move(dir)), output_(std::move(output)), fields_(frame_field_mask(output_.fields)), schedule_(output_) {}
+    : dir_(std::move(dir)), output_(std::move(output)), fields_(FrameFields::only(output_.fields)), schedule_(output_) {}
 
 template <int D, std::floating_point R>
 bool FrameWriter<D, R>::write_due(const Simulation<D, R>& sim, bool last) {
@@ -55,20 +68,7 @@ bool FrameWriter<D, R>::write_due(const Simulation<D, R>& sim, bool last) {
 template <int D, std::floating_point R>
 void FrameWriter<D, R>::write(const Simulation<D, R>& sim) {
   const std::size_t index = times_.size();
-  for (FrameFormat f : output_.formats) {
-    const fs::path path = dir_ / frame_name(index, f);
-    switch (f) {
-      case FrameFormat::Vtu:
-        write_vtu(path, sim.particles(), sim.time(), fields_);
-        break;
-      case FrameFormat::Vtk:
-        write_legacy_vtk(path, sim.particles(), sim.time(), fields_);
-        break;
-      case FrameFormat::Ply:
-        write_ply(path, sim.particles(), sim.time(), fields_);
-        break;
-    }
-  }
+  for (FrameFormat f : output_.formats) write_frame(f, dir_ / frame_name(index, f), sim.particles(), sim.time(), fields_);
   times_.push_back(sim.time());
   schedule_.written(sim.time());
   last_off_schedule_ = false;
@@ -116,6 +116,14 @@ void FrameWriter<D, R>::load_state(StateReader& in) {
   }
   if (!times_.empty()) write_index();  // (a run without frames has no frames.pvd)
 }
+
+#define SPH_INSTANTIATE(D, R) \
+  template void write_frame<D, R>(FrameFormat, const fs::path&, const ParticleSet<D, R>&, double, const FrameFields&);
+SPH_INSTANTIATE(2, float)
+SPH_INSTANTIATE(2, double)
+SPH_INSTANTIATE(3, float)
+SPH_INSTANTIATE(3, double)
+#undef SPH_INSTANTIATE
 
 template class FrameWriter<2, float>;
 template class FrameWriter<2, double>;

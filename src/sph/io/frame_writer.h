@@ -79,7 +79,7 @@ class FrameWriter {
 
   std::filesystem::path dir_;
   OutputDesc output_;
-  FrameFieldMask fields_;
+  FrameFields fields_;
   FrameSchedule schedule_;
   std::vector<double> times_;
   bool last_off_schedule_ = false;  // the latest frame was written only because its step was the last

@@ -29,33 +29,41 @@ char* put_vec(char* p, const Vec<D, R>& v) {
   return p;
 }
 
+template <int D, std::floating_point R>
+char* put_value(char* p, const Vec<D, R>& v) {
+  return put_vec(p, v);
+}
+template <std::floating_point R>
+char* put_value(char* p, R v) {
+  return put_le(p, static_cast<float>(v));
+}
+char* put_value(char* p, std::uint64_t id) { return put_le(p, static_cast<std::uint32_t>(id)); }
+
 }  // namespace
 
 template <int D, std::floating_point R>
-void write_ply(const std::filesystem::path& path, const ParticleSet<D, R>& ps, double time, FrameFieldMask fields) {
+void write_ply(const std::filesystem::path& path, const ParticleSet<D, R>& ps, double time,
+               const FrameFields& fields) {
   const std::size_t n = ps.size();
   std::string header = fmt::format(
       "ply\nformat binary_little_endian 1.0\ncomment sph frame\ncomment time {}\nelement vertex {}\n"
       "property float x\nproperty float y\nproperty float z\n",
       time, n);
   std::size_t record = 12;
-  if (fields & kFieldVelocity) header += "property float vx\nproperty float vy\nproperty float vz\n", record += 12;
-  if (fields & kFieldDensity) header += "property float density\n", record += 4;
-  if (fields & kFieldPressure) header += "property float pressure\n", record += 4;
-  if (fields & kFieldId) header += "property uint id\n", record += 4;
-  if (fields & kFieldInitialPosition)
-    header += "property float x0\nproperty float y0\nproperty float z0\n", record += 12;
+  for_each_frame_field(ps, fields, [&](const FieldDesc& f, const auto&) {
+    const char* type = f.kind == FieldKind::Id ? "uint" : "float";  // ids stay below 2e9
+    for (int c = 0; c < f.components(); ++c) header += fmt::format("property {} {}\n", type, f.ply[c]);
+    record += 4 * static_cast<std::size_t>(f.components());
+  });
   header += "end_header\n";
+  // Field by field into the interleaved records: each field's values at its offset in a record.
   std::string data(n * record, '\0');
-  char* p = data.data();
-  for (std::size_t i = 0; i < n; ++i) {
-    p = put_vec(p, ps.position[i]);
-    if (fields & kFieldVelocity) p = put_vec(p, ps.velocity[i]);
-    if (fields & kFieldDensity) p = put_le(p, static_cast<float>(ps.density[i]));
-    if (fields & kFieldPressure) p = put_le(p, static_cast<float>(ps.pressure[i]));
-    if (fields & kFieldId) p = put_le(p, static_cast<std::uint32_t>(ps.id[i]));  // ids stay below 2e9
-    if (fields & kFieldInitialPosition) p = put_vec(p, ps.initial_position[i]);
-  }
+  for (std::size_t i = 0; i < n; ++i) put_vec(data.data() + i * record, ps.position[i]);
+  std::size_t offset = 12;
+  for_each_frame_field(ps, fields, [&](const FieldDesc& f, const auto& column) {
+    for (std::size_t i = 0; i < n; ++i) put_value(data.data() + i * record + offset, column[i]);
+    offset += 4 * static_cast<std::size_t>(f.components());
+  });
   AtomicFile f(path);
   f.write(header);
   f.write(data);
@@ -63,7 +71,7 @@ void write_ply(const std::filesystem::path& path, const ParticleSet<D, R>& ps, d
 }
 
 #define SPH_INSTANTIATE(D, R) \
-  template void write_ply<D, R>(const std::filesystem::path&, const ParticleSet<D, R>&, double, FrameFieldMask);
+  template void write_ply<D, R>(const std::filesystem::path&, const ParticleSet<D, R>&, double, const FrameFields&);
 SPH_INSTANTIATE(2, float)
 SPH_INSTANTIATE(2, double)
 SPH_INSTANTIATE(3, float)

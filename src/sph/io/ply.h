@@ -21,12 +21,14 @@ namespace sph {
 ///   property float pressure                             (if in `fields`)
 ///   property uint id                                    (if in `fields`)
 ///   property float x0 / y0 / z0     initial position    (if in `fields`)
+///   property float NAME             an added Real field (if in `fields`)
+///   property float NAME_x / _y / _z an added Vector field (if in `fields`)
 ///   end_header
 ///
 /// then one record per particle. Everything is single precision whatever the run's precision:
 /// that is what Blender's and Houdini's importers read as attributes.
 template <int D, std::floating_point R>
 void write_ply(const std::filesystem::path& path, const ParticleSet<D, R>& particles, double time,
-               FrameFieldMask fields = kAllFrameFields);
+               const FrameFields& fields = {});
 
 }  // namespace sph

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstring>
 #include <sstream>
+#include <type_traits>
 
 #include <fmt/format.h>
 
@@ -59,6 +60,28 @@ std::vector<R> as3(const std::vector<Vec<D, R>>& v) {
   return out;
 }
 
+/// A field's values as a frame stores them: vectors padded to 3 components, others as they are.
+template <int D, std::floating_point R>
+std::vector<R> frame_values(const std::vector<Vec<D, R>>& v) {
+  return as3(v);
+}
+template <class T>
+const std::vector<T>& frame_values(const std::vector<T>& v) {
+  return v;
+}
+
+/// PointData's Scalars= and Vectors= attributes: the fields ParaView shows first.
+template <int D, std::floating_point R>
+std::string active_arrays(const ParticleSet<D, R>& ps, const FrameFields& fields) {
+  std::string scalars, vectors;
+  for_each_frame_field(ps, fields, [&](const FieldDesc& f, const auto&) {
+    if (!f.vtk_active) return;
+    std::string& attr = f.kind == FieldKind::Vector ? vectors : scalars;
+    if (attr.empty()) attr = std::string(f.name);
+  });
+  return (scalars.empty() ? "" : " Scalars=\"" + scalars + "\"") + (vectors.empty() ? "" : " Vectors=\"" + vectors + "\"");
+}
+
 /// Appends `values` to `out` in big-endian byte order (the legacy VTK format's only one).
 template <class T>
 void append_big_endian(std::string& out, const std::vector<T>& values) {
@@ -78,7 +101,7 @@ void append_big_endian(std::string& out, const std::vector<T>& values) {
 }  // namespace
 
 template <int D, std::floating_point R>
-void write_vtu(const std::filesystem::path& path, const ParticleSet<D, R>& ps, double time, FrameFieldMask fields) {
+void write_vtu(const std::filesystem::path& path, const ParticleSet<D, R>& ps, double time, const FrameFields& fields) {
   const std::size_t n = ps.size();
   Appended app;
   std::ostringstream xml;
@@ -90,14 +113,10 @@ void write_vtu(const std::filesystem::path& path, const ParticleSet<D, R>& ps, d
       << "      " << app.array("TimeValue", 1, std::vector<double>{time}, " NumberOfTuples=\"1\"") << "\n"
       << "    </FieldData>\n"
       << "    <Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << n << "\">\n"
-      << "      <PointData" << ((fields & kFieldDensity) ? " Scalars=\"density\"" : "")
-      << ((fields & kFieldVelocity) ? " Vectors=\"velocity\"" : "") << ">\n";
-  if (fields & kFieldVelocity) xml << "        " << app.array("velocity", 3, as3(ps.velocity)) << "\n";
-  if (fields & kFieldDensity) xml << "        " << app.array("density", 1, ps.density) << "\n";
-  if (fields & kFieldPressure) xml << "        " << app.array("pressure", 1, ps.pressure) << "\n";
-  if (fields & kFieldId) xml << "        " << app.array("id", 1, ps.id) << "\n";
-  if (fields & kFieldInitialPosition)
-    xml << "        " << app.array("initial_position", 3, as3(ps.initial_position)) << "\n";
+      << "      <PointData" << active_arrays(ps, fields) << ">\n";
+  for_each_frame_field(ps, fields, [&](const FieldDesc& f, const auto& column) {
+    xml << "        " << app.array(std::string(f.name), f.components(), frame_values(column)) << "\n";
+  });
   xml << "      </PointData>\n      <Points>\n";
   xml << "        " << app.array("position", 3, as3(ps.position)) << "\n";
   xml << "      </Points>\n      <Cells>\n";
@@ -119,7 +138,7 @@ void write_vtu(const std::filesystem::path& path, const ParticleSet<D, R>& ps, d
 
 template <int D, std::floating_point R>
 void write_legacy_vtk(const std::filesystem::path& path, const ParticleSet<D, R>& ps, double time,
-                      FrameFieldMask fields) {
+                      const FrameFields& fields) {
   const std::size_t n = ps.size();
   // Cells hold 32-bit indices in this format.
   if (n > 0x7fffffffu) throw Error("too many particles for a legacy VTK file (at most 2^31 - 1)", path.string());
@@ -139,40 +158,24 @@ void write_legacy_vtk(const std::filesystem::path& path, const ParticleSet<D, R>
   append_big_endian(s, std::vector<std::int32_t>(n, 1));  // VTK_VERTEX
   // The point fields as one FIELD block: readers load every array of it, whereas of SCALARS
   // and VECTORS sections VTK's reader loads only the first of each unless asked for all.
-  const int arrays = std::popcount(fields & kAllFrameFields);
+  int arrays = 0;
+  for_each_frame_field(ps, fields, [&](const FieldDesc&, const auto&) { ++arrays; });
   s += fmt::format("\nPOINT_DATA {}\nFIELD FieldData {}\n", n, arrays);
-  const auto field = [&](const char* name, int components, const char* type) {
-    s += fmt::format("{} {} {} {}\n", name, components, n, type);
-  };
-  if (fields & kFieldVelocity) {
-    field("velocity", 3, real);
-    append_big_endian(s, as3(ps.velocity));
+  for_each_frame_field(ps, fields, [&](const FieldDesc& f, const auto& column) {
+    using T = typename std::decay_t<decltype(column)>::value_type;
+    if constexpr (std::is_same_v<T, std::uint64_t>) {
+      // 32 bits: ids stay below the 2e9 particles a scene may hold, and every reader knows
+      // unsigned_int (64-bit types are spelt differently by VTK versions).
+      std::vector<std::uint32_t> id(n);
+      for (std::size_t i = 0; i < n; ++i) id[i] = static_cast<std::uint32_t>(column[i]);
+      s += fmt::format("{} {} {} {}\n", f.name, 1, n, "unsigned_int");
+      append_big_endian(s, id);
+    } else {
+      s += fmt::format("{} {} {} {}\n", f.name, f.components(), n, real);
+      append_big_endian(s, frame_values(column));
+    }
     s += "\n";
-  }
-  if (fields & kFieldDensity) {
-    field("density", 1, real);
-    append_big_endian(s, ps.density);
-    s += "\n";
-  }
-  if (fields & kFieldPressure) {
-    field("pressure", 1, real);
-    append_big_endian(s, ps.pressure);
-    s += "\n";
-  }
-  if (fields & kFieldId) {
-    // 32 bits: ids stay below the 2e9 particles a scene may hold, and every reader knows
-    // unsigned_int (64-bit types are spelt differently by VTK versions).
-    std::vector<std::uint32_t> id(n);
-    for (std::size_t i = 0; i < n; ++i) id[i] = static_cast<std::uint32_t>(ps.id[i]);
-    field("id", 1, "unsigned_int");
-    append_big_endian(s, id);
-    s += "\n";
-  }
-  if (fields & kFieldInitialPosition) {
-    field("initial_position", 3, real);
-    append_big_endian(s, as3(ps.initial_position));
-    s += "\n";
-  }
+  });
   write_file_atomic(path, s);
 }
 
@@ -186,9 +189,10 @@ void write_pvd(const std::filesystem::path& path, const std::vector<PvdEntry>& e
   write_file_atomic(path, s);
 }
 
-#define SPH_INSTANTIATE(D, R)                                                                                    \
-  template void write_vtu<D, R>(const std::filesystem::path&, const ParticleSet<D, R>&, double, FrameFieldMask); \
-  template void write_legacy_vtk<D, R>(const std::filesystem::path&, const ParticleSet<D, R>&, double, FrameFieldMask);
+#define SPH_INSTANTIATE(D, R)                                                                                        \
+  template void write_vtu<D, R>(const std::filesystem::path&, const ParticleSet<D, R>&, double, const FrameFields&); \
+  template void write_legacy_vtk<D, R>(const std::filesystem::path&, const ParticleSet<D, R>&, double,               \
+                                       const FrameFields&);
 SPH_INSTANTIATE(2, float)
 SPH_INSTANTIATE(2, double)
 SPH_INSTANTIATE(3, float)

@@ -11,17 +11,21 @@ namespace sph {
 
 namespace {
 
+/// A quantity: its name, the particle field it is computed from, its legend label and, for a
+/// quantity that is not the field itself, its unit (otherwise the field's, from kParticleFields;
+/// none for colors).
 struct Info {
   ColorBy by;
-  std::string_view name, field, label, unit2, unit3;
+  std::string_view name, field, label, unit2 = {}, unit3 = {};
+  bool colors = false;  ///< colored by the field's components: no unit in the label
 };
 
 constexpr Info kInfo[] = {
-    {ColorBy::Speed, "speed", "velocity", "speed", "m/s", "m/s"},
+    {ColorBy::Speed, "speed", "velocity", "speed"},
     {ColorBy::KineticEnergy, "kinetic_energy", "velocity", "kinetic energy", "J/m", "J"},
-    {ColorBy::Density, "density", "density", "density", "kg/m^2", "kg/m^3"},
-    {ColorBy::Pressure, "pressure", "pressure", "pressure", "N/m", "Pa"},
-    {ColorBy::InitialPosition, "initial_position", "initial_position", "initial position", "", ""},
+    {ColorBy::Density, "density", "density", "density"},
+    {ColorBy::Pressure, "pressure", "pressure", "pressure"},
+    {ColorBy::InitialPosition, "initial_position", "initial_position", "initial position", {}, {}, true},
 };
 
 const Info& info(ColorBy by) {
@@ -49,7 +53,9 @@ const FrameField& require(const FrameData& frame, ColorBy by, const RunDirectory
                             name, color_by_name(by)),
                 run.dir.string());
   const std::size_t want = frame.size * static_cast<std::size_t>(f->components);
-  if (f->values.size() != want || (f->components != (name == "velocity" || name == "initial_position" ? 3 : 1)))
+  const FieldDesc* desc = find_particle_field(name);
+  SPH_CHECK(desc, "color-by needs a field of the table");
+  if (f->values.size() != want || f->components != desc->components())
     throw Error(fmt::format("the '{}' field of a frame has {} values with {} components for {} particles", name,
                             f->values.size(), f->components, frame.size),
                 run.dir.string());
@@ -74,8 +80,10 @@ std::string color_by_names() {
 
 std::string color_by_label(ColorBy by, int dimension) {
   const Info& i = info(by);
-  const std::string_view unit = dimension == 2 ? i.unit2 : i.unit3;
-  return unit.empty() ? std::string(i.label) : fmt::format("{} ({})", i.label, unit);
+  if (i.colors) return std::string(i.label);
+  std::string_view unit = dimension == 2 ? i.unit2 : i.unit3;
+  if (unit.empty()) unit = find_particle_field(i.field)->unit(dimension);
+  return fmt::format("{} ({})", i.label, unit);
 }
 
 std::string_view color_by_field(ColorBy by) { return info(by).field; }

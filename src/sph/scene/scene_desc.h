@@ -6,18 +6,13 @@
 #include <string>
 #include <vector>
 
+#include <sph/core/particle_fields.h>
+#include <sph/scene/frame_formats.h>
 #include <sph/solver/params.h>
 
 namespace sph {
 
 enum class Precision { Float, Double };
-
-/// File formats for particle frames: VTK XML (.vtu, ParaView), legacy VTK (.vtk, binary) and
-/// PLY (.ply, binary point clouds for Blender and Houdini).
-enum class FrameFormat { Vtu, Vtk, Ply };
-
-/// The point fields a frame may hold besides the positions (all by default).
-inline constexpr const char* kFrameFieldNames[] = {"velocity", "density", "pressure", "id", "initial_position"};
 
 /// What a run writes as frames and when (Configuration.outputEveryNSteps, outputFps,
 /// outputFormats, outputFields).

@@ -15,6 +15,7 @@
 #include <sph/core/timer.h>
 #include <sph/io/atomic_file.h>
 #include <sph/io/frames.h>
+#include <sph/run/memory.h>
 #include <sph/scene/scene_reader.h>
 
 #include "commands.h"

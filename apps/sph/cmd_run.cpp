@@ -221,7 +221,7 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesyste
                  "sph: interrupted by {} after step {} of {}: wrote a checkpoint. Continue the run with:\n"
                  "  sph run --resume {}\n",
                  result.stop_cause, result.steps_done, desc.steps, shell_word(dir.string()));
-      return 128 + (result.stop_cause == "SIGINT" ? SIGINT : SIGTERM);
+      return 128 + g_stop_signal;
     case RunStatus::Failed:
       fmt::print(stderr, "sph: error: {}\nsph: the frames written before the failure are kept in {}\n", result.error,
                  dir.string());

@@ -115,8 +115,7 @@ TEST_P(StopAndResume, GivesTheFilesOfARunNeverStopped) {
     expect_same_frames(tmp / "full", part);
     EXPECT_EQ(stats_rows(tmp / "full" / "stats.csv"), stats_rows(part / "stats.csv"));
     EXPECT_EQ(summary_facts(tmp / "full"), summary_facts(part));
-    EXPECT_EQ(nlohmann::json::parse(slurp(part / "summary.json")).at("resumed_at_steps"),
-              nlohmann::json::array({k}));
+    EXPECT_EQ(nlohmann::json::parse(slurp(part / "summary.json")).at("resumed_at_steps"), nlohmann::json::array({k}));
   }
 }
 
@@ -200,9 +199,9 @@ TEST(RunDriver, ARunWithoutADirectoryWritesNothingAndStillStops) {
 TEST(RunDriver, AFailedStepIsReturnedWithItsMessage) {
   TempDir tmp;
   // 30 km/s: far beyond the scene's blow-up limit, so the first step fails.
-  SceneDesc desc = read_scene_file(SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json",
-                                   {"Configuration.numberOfSteps=2000", "Configuration.outputEveryNSteps=0",
-                                    "FluidBlocks[0].velocity=[30000,0]"});
+  SceneDesc desc = read_scene_file(
+      SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json",
+      {"Configuration.numberOfSteps=2000", "Configuration.outputEveryNSteps=0", "FluidBlocks[0].velocity=[30000,0]"});
   RunDriver<2, double> run(desc, RunSettings{tmp / "o", 0});
   const RunResult r = run.run();
   ASSERT_EQ(r.status, RunStatus::Failed) << r.message;

@@ -119,7 +119,8 @@ RunRecord run_one(const SceneDesc& base, NeighborMode mode, bool perturbed, cons
       if (s % report_every == 0 || s == steps) progress(rec.label, index, count, s, steps);
     };
   const RunResult result = run.run(callbacks, [&](Simulation<D, R>& sim, const StepInfo& info) {
-    if (perturbed && info.emitted > 0) sim.perturb_positions(info.particles - info.emitted, amplitude, kPerturbationSeed);
+    if (perturbed && info.emitted > 0)
+      sim.perturb_positions(info.particles - info.emitted, amplitude, kPerturbationSeed);
     rec.steps.push_back(step_record(info, sim.kinetic_energy()));
     rec.totals += info.seconds;
     const std::int64_t s = sim.steps_done();

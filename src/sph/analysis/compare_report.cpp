@@ -334,20 +334,18 @@ std::string timing_csv(const CompareResult& res, const std::vector<std::vector<d
 
 /// neighbors.csv: each run's list counters per step.
 std::string neighbors_csv(const CompareResult& res) {
-  return per_step_csv(res,
-                      {"particles", "lists_rebuilt", "pairs_stored", "pairs_within_h", "missed_pairs",
-                       "max_missed_penetration"},
-                      [&res](const RunRecord& r, std::size_t s) {
-                        const StepRecord& x = r.steps[s];
-                        // Without the audit the missed-pair cells are empty, not 0.
-                        return std::vector<std::string>{
-                            std::to_string(x.particles),
-                            std::to_string(x.lists_rebuilt),
-                            std::to_string(x.pairs_stored),
-                            std::to_string(x.pairs_within_h),
-                            res.audited ? std::to_string(x.missed_pairs) : std::string(),
-                            res.audited ? fmt::format("{:.6g}", x.max_missed_penetration) : std::string()};
-                      });
+  return per_step_csv(
+      res, {"particles", "lists_rebuilt", "pairs_stored", "pairs_within_h", "missed_pairs", "max_missed_penetration"},
+      [&res](const RunRecord& r, std::size_t s) {
+        const StepRecord& x = r.steps[s];
+        // Without the audit the missed-pair cells are empty, not 0.
+        return std::vector<std::string>{std::to_string(x.particles),
+                                        std::to_string(x.lists_rebuilt),
+                                        std::to_string(x.pairs_stored),
+                                        std::to_string(x.pairs_within_h),
+                                        res.audited ? std::to_string(x.missed_pairs) : std::string(),
+                                        res.audited ? fmt::format("{:.6g}", x.max_missed_penetration) : std::string()};
+      });
 }
 
 /// phases.csv: one row per run with its phase totals and means.

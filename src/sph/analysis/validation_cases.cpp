@@ -362,10 +362,10 @@ void run_resolution(ValidationResult& res, FrontRuns& fronts) {
   for (std::size_t k = 1; k < levels.size(); ++k) {
     const FrontRun& coarse = fronts.standard(levels[k - 1]);
     const FrontRun& fine = fronts.standard(levels[k]);
-    add_check(res, "resolution", fmt::format("max |dZ| at a/{} (a/{}: {:.3f})", levels[k], levels[k - 1], coarse.error.max),
-              fine.error.max, fmt::format("<= {:.3f} (does not grow)", coarse.error.max),
-              fine.failure.empty() && coarse.failure.empty() && fine.error.complete && fine.error.max <= coarse.error.max,
-              q);
+    add_check(
+        res, "resolution", fmt::format("max |dZ| at a/{} (a/{}: {:.3f})", levels[k], levels[k - 1], coarse.error.max),
+        fine.error.max, fmt::format("<= {:.3f} (does not grow)", coarse.error.max),
+        fine.failure.empty() && coarse.failure.empty() && fine.error.complete && fine.error.max <= coarse.error.max, q);
   }
   // Self-convergence: how far each refinement moves the front, at the experiment's times. A
   // converging method moves it less at each refinement, however far its limit is from the
@@ -375,13 +375,13 @@ void run_resolution(ValidationResult& res, FrontRuns& fronts) {
     FrontRun& fine = fronts.standard(levels[k]);
     fine.change = front_change(fine.T, fine.Z, coarse.T, coarse.Z, fine.error);
     if (k < 2) continue;  // the coarser pair's change is coarse.change
-    add_check(res, "resolution",
-              fmt::format("max |Z(a/{}) - Z(a/{})| (a/{} to a/{}: {:.3f})", levels[k], levels[k - 1], levels[k - 2],
-                          levels[k - 1], coarse.change.max),
-              fine.change.max, fmt::format("<= {:.3f} (shrinks)", coarse.change.max),
-              fine.failure.empty() && coarse.change.complete && fine.change.complete &&
-                  fine.change.max <= coarse.change.max,
-              q);
+    add_check(
+        res, "resolution",
+        fmt::format("max |Z(a/{}) - Z(a/{})| (a/{} to a/{}: {:.3f})", levels[k], levels[k - 1], levels[k - 2],
+                    levels[k - 1], coarse.change.max),
+        fine.change.max, fmt::format("<= {:.3f} (shrinks)", coarse.change.max),
+        fine.failure.empty() && coarse.change.complete && fine.change.complete && fine.change.max <= coarse.change.max,
+        q);
   }
 }
 
@@ -391,8 +391,8 @@ void check_hydrostatic(ValidationResult& res, const HydrostaticRun& h) {
   const bool ok = h.failure.empty();
   const std::string c = "hydrostatic";
   if (q) {
-    add_check(res, c, fmt::format("{}: mean p / (rho0 g d), interior", h.label), h.profile.mean_ratio,
-              "in [1.0, 1.25]", ok && h.profile.mean_ratio >= 1.0 && h.profile.mean_ratio <= 1.25, true);
+    add_check(res, c, fmt::format("{}: mean p / (rho0 g d), interior", h.label), h.profile.mean_ratio, "in [1.0, 1.25]",
+              ok && h.profile.mean_ratio >= 1.0 && h.profile.mean_ratio <= 1.25, true);
   } else {
     add_check(res, c, fmt::format("{}: max |p / (rho0 g d) - 1| over depth bins below 2 layers", h.label),
               h.profile.max_bin_error, "<= 0.05", ok && h.profile.max_bin_error <= 0.05, false);

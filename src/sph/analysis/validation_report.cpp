@@ -130,9 +130,9 @@ std::string report_resolution(const ValidationResult& res) {
       "|\n| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
   for (int n : resolutions(res))
     if (const FrontRun* r = find_run(res, n, "standard"))
-      md += fmt::format("| a/{} | {} | {} | {:.1f} | {} | {} | {:+.3f} | {} | {} |\n", n, r->particles, r->steps,
-                        r->seconds, g(r->error.max), g(r->error.rms), r->error.mean, g(r->change.max),
-                        g(r->change.rms));
+      md +=
+          fmt::format("| a/{} | {} | {} | {:.1f} | {} | {} | {:+.3f} | {} | {} |\n", n, r->particles, r->steps,
+                      r->seconds, g(r->error.max), g(r->error.rms), r->error.mean, g(r->change.max), g(r->change.rms));
   md += "\n" + checks_table(res, "resolution");
   return md;
 }
@@ -186,8 +186,8 @@ std::string report_conservation(const ValidationResult& res) {
     std::vector<double> total;
     double peak = 0;
     for (const EnergyParts& e : r->energy) total.push_back(e.total()), peak = std::max(peak, e.kinetic);
-    md += fmt::format("| {} | {:.6g} | {:.6g} | {:.1f} % | {:.6g} | {:.3g} |\n", r->label, total.front(),
-                      total.back(), 100 * (total.front() - total.back()) / total.front(), peak, largest_rise(total));
+    md += fmt::format("| {} | {:.6g} | {:.6g} | {:.1f} % | {:.6g} | {:.3g} |\n", r->label, total.front(), total.back(),
+                      100 * (total.front() - total.back()) / total.front(), peak, largest_rise(total));
   }
   md += "\nEnergies in J/m (2D).\n\n" + checks_table(res, "conservation");
   return md;
@@ -261,9 +261,9 @@ void write_front_csvs(const std::filesystem::path& dir, const ValidationResult& 
     std::string failure = r.failure;
     std::replace(failure.begin(), failure.end(), '"', '\'');
     out += fmt::format("{},{},{},{},{:.9g},{:.9g},{},{:.3f},{},{},{:.6f},{:.6f},{:.6f},{:.2f},{:.6f},{:.6f},\"{}\"\n",
-                       r.label, r.resolution, r.mode, r.particles, r.spacing, r.dt, r.steps, r.seconds,
-                       r.error.points, r.error.complete ? "yes" : "no", r.error.max, r.error.rms, r.error.mean,
-                       r.error.worst_T, r.change.max, r.change.rms, failure);
+                       r.label, r.resolution, r.mode, r.particles, r.spacing, r.dt, r.steps, r.seconds, r.error.points,
+                       r.error.complete ? "yes" : "no", r.error.max, r.error.rms, r.error.mean, r.error.worst_T,
+                       r.change.max, r.change.rms, failure);
   }
   write_file_atomic(dir / "front_errors.csv", out);
   out = "T,Z_experiment";

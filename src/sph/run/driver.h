@@ -60,8 +60,8 @@ struct RunResult {
   /// The status as summary.json records it: "completed", "interrupted by CAUSE after step K of
   /// N", "failed: ERROR".
   std::string message;
-  std::string error;        ///< Failed: the error's text
-  std::string stop_cause;   ///< Interrupted: what stop_requested returned
+  std::string error;            ///< Failed: the error's text
+  std::string stop_cause;       ///< Interrupted: what stop_requested returned
   std::int64_t first_step = 0;  ///< steps done when this session started (0 unless resumed)
   std::int64_t steps_done = 0;  ///< steps done at the end
   double wall_seconds = 0;      ///< this session's wall seconds, from the driver's construction
@@ -114,7 +114,6 @@ class RunDriver {
   RunResult run(const RunCallbacks& callbacks = {}, const StepObserver& on_step = {});
 
  private:
-
   SceneDesc desc_;
   RunSettings settings_;
   Simulation<D, R> sim_;

@@ -13,8 +13,7 @@
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 #include <sph/core/timer.h>
-#include <sph/io/atomic_file.h>
-#include <sph/io/frames.h>
+#include <sph/run/memory.h>
 #include <sph/scene/scene_reader.h>
 
 #include "commands.h"
@@ -57,19 +56,6 @@ std::vector<NeighborMode> parse_modes(const std::string& list) {
   return modes;
 }
 
-/// Creates `dir`, checks it is writable and removes what an earlier comparison left there.
-void prepare_compare_directory(const fs::path& dir) {
-  make_writable_directory(dir, "the comparison's output");
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    const std::string f = entry.path().filename().string();
-    // Files whose set depends on the options: images of other steps, the audit's plot.
-    const bool frame = f.rfind("frame_", 0) == 0 && entry.path().extension() == ".png";
-    // runs.txt too: with --no-run-frames an earlier comparison's run directories must not be shown.
-    if (frame || f == "missed_pairs.png" || f == kRunListFile) fs::remove(entry.path(), ec);
-  }
-}
-
 int compare(const CompareCliOptions& opt) {
   CompareOptions co;
   co.modes = parse_modes(opt.modes);
@@ -85,7 +71,7 @@ int compare(const CompareCliOptions& opt) {
   check_fits_in_memory(desc);  // each mode's run holds one simulation at a time
   for (const auto& w : desc.warnings) fmt::print(stderr, "sph: warning: {}\n", w);
   const fs::path dir = opt.output.empty() ? fs::path("out") / (desc.name + "_compare") : fs::path(opt.output);
-  prepare_compare_directory(dir);
+  prepare_comparison_directory(dir);
   if (!opt.no_run_frames) co.runs_dir = dir;
 
   fmt::print(stderr, "sph: compare {} ({}D, {} steps, {} thread{}) -> {}\n", desc.name, desc.dimension, desc.steps,

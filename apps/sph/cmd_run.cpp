@@ -12,31 +12,19 @@
 
 #include <fmt/format.h>
 
-#include <sph/bench/machine.h>
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
-#include <sph/core/timer.h>
-#include <sph/core/version.h>
 #include <sph/io/checkpoint.h>
 #include <sph/io/run_output.h>
-#include <sph/scene/builders.h>
+#include <sph/run/driver.h>
+#include <sph/run/resume.h>
+#include <sph/scene/dispatch.h>
 #include <sph/scene/scene_reader.h>
 
 #include "commands.h"
 #include "progress.h"
 
 namespace sph::app {
-
-void check_fits_in_memory(const SceneDesc& desc) {
-  const double need = estimated_run_bytes(desc);
-  const std::int64_t have = machine_info().memory_bytes;
-  if (have > 0 && need > static_cast<double>(have))
-    throw Error(fmt::format("the scene holds up to {} particles, which need about {:.3g} GB (particle fields, "
-                            "neighbor lists, grid), more than this machine's {:.3g} GB of memory; use fewer "
-                            "particles (a larger Configuration.particleRadius, smaller blocks or emitter budgets)",
-                            max_particles(desc), need / 1e9, static_cast<double>(have) / 1e9),
-                desc.source);
-}
 
 namespace {
 
@@ -163,89 +151,85 @@ std::string frames_hint(const OutputDesc& output, const std::filesystem::path& d
   return s;
 }
 
-/// Runs `desc` into `dir`: a new run, or (with `checkpoint`) the continuation of the run that
-/// wrote it.
+/// The closing lines of a completed run.
 template <int D, std::floating_point R>
-int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesystem::path& dir,
-              CheckpointReader* checkpoint) {
-  // Everything that can be refused is checked before the output directory is touched.
-  check_fits_in_memory(desc);
-  Simulation<D, R> sim = make_simulation<D, R>(desc);
-  if (checkpoint)
-    prepare_resume_directory(dir);
-  else
-    prepare_output_directory(dir);
-
-  RunInfo info{std::string(to_string(sim.params().neighbors)), num_threads()};
-  RunOutput<D, R> out(dir, desc, info);
-  Stopwatch wall;
-  if (checkpoint) {
-    const std::string warning = checkpoint->restore(sim, out);
-    if (!warning.empty()) fmt::print(stderr, "sph: warning: {}\n", warning);
-  }
-  const std::int64_t first = sim.steps_done();
-  fmt::print(stderr, "sph: {} ({}D, {}, {} neighbors, {} thread{}): {} particles{}, {} steps of {:.4g} s{} -> {}\n",
-             desc.name, D, std::is_same_v<R, float> ? "float" : "double", info.mode, info.threads,
-             info.threads == 1 ? "" : "s", sim.particles().size(),
-             sim.params().emitters.empty() ? "" : " (emitters add more)", desc.steps, sim.params().time_step,
-             checkpoint ? fmt::format(", resumed at step {}", first) : std::string(), dir.string());
-  if (!checkpoint) out.begin(sim);
-  Progress progress(
-      desc.steps - first,
-      opt.no_progress ? Progress::Mode::Off : (::isatty(STDERR_FILENO) ? Progress::Mode::Bar : Progress::Mode::Lines),
-      stderr);
-  const StopSignals signals;
-  try {
-    for (std::int64_t s = first; s < desc.steps; ++s) {
-      const StepInfo& step = sim.step();
-      const bool last = s + 1 == desc.steps;
-      out.after_step(sim, step, last);
-      progress.update(s + 1 - first, step.particles);
-      if (const int sig = g_stop_signal; sig != 0 && !last) {  // (a signal in the last step lets it complete)
-        write_checkpoint(dir, desc, sim, out, wall.elapsed(), opt.checkpoint_every);
-        progress.finish();
-        const char* name = sig == SIGINT ? "SIGINT" : "SIGTERM";
-        out.finish(sim, fmt::format("interrupted by {} after step {} of {}", name, sim.steps_done(), desc.steps),
-                   wall.elapsed());
-        fmt::print(stderr,
-                   "sph: interrupted by {} after step {} of {}: wrote a checkpoint. Continue the run with:\n"
-                   "  sph run --resume {}\n",
-                   name, sim.steps_done(), desc.steps, shell_word(dir.string()));
-        return 128 + sig;
-      }
-      if (opt.checkpoint_every > 0 && (sim.steps_done() % opt.checkpoint_every == 0 || last))
-        write_checkpoint(dir, desc, sim, out, wall.elapsed(), opt.checkpoint_every);
-    }
-  } catch (const Error& e) {
-    progress.finish();
-    out.finish(sim, std::string("failed: ") + e.what(), wall.elapsed());
-    fmt::print(stderr, "sph: error: {}\nsph: the frames written before the failure are kept in {}\n", e.what(),
-               dir.string());
-    return kRunFailed;
-  }
-  progress.finish();
-  const double seconds = wall.elapsed();
-  out.finish(sim, "completed", seconds);
-  const std::int64_t ran = desc.steps - first;
+void print_done(const RunDriver<D, R>& run, const RunResult& result, bool audit) {
+  const RunOutput<D, R>& out = *run.output();
+  const std::filesystem::path& dir = run.settings().dir;
+  const std::int64_t ran = result.steps_done - result.first_step;
   fmt::print(stderr,
              "sph: done: {} steps, {} particles, {:.2f} s ({:.3f} ms/step). {} {} frames.\n"
              "{}"
              "  {}/stats.csv    per-step energy, neighbors and phase timings\n"
              "  {}/summary.json totals\n"
              "{}",
-             ran, sim.particles().size(), seconds, 1e3 * seconds / static_cast<double>(std::max<std::int64_t>(ran, 1)),
-             checkpoint ? "The run now has" : "Wrote", out.frames_written(), frames_hint(desc.output, dir),
-             dir.string(), dir.string(),
+             ran, run.simulation().particles().size(), result.wall_seconds,
+             1e3 * result.wall_seconds / static_cast<double>(std::max<std::int64_t>(ran, 1)),
+             result.first_step > 0 ? "The run now has" : "Wrote", out.frames_written(),
+             frames_hint(run.scene().output, dir), dir.string(), dir.string(),
              out.frames_written() > 0
                  ? fmt::format("  look at it: sph render {0} --mp4 (PNG frames, a movie); sph view {0} (a web page)\n",
                                shell_word(dir.string()))
                  : std::string());
-  if (opt.audit)
+  if (audit)
     fmt::print(stderr,
                "sph: audit: {} pairs within h were missing from the lists, in {} of {} steps; the deepest miss "
                "was (h - r) / h = {:.3g}\n",
-               out.audit_totals().missed_pairs, out.audit_steps_with_misses(), sim.steps_done(),
+               out.audit_totals().missed_pairs, out.audit_steps_with_misses(), result.steps_done,
                out.audit_totals().max_penetration);
+}
+
+/// Runs `desc` into `dir`: a new run, or (with `checkpoint`) the continuation of the run that
+/// wrote it. Returns the exit code.
+template <int D, std::floating_point R>
+int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesystem::path& dir,
+              CheckpointReader* checkpoint) {
+  const RunSettings settings{dir, opt.checkpoint_every};
+  std::optional<RunDriver<D, R>> run;
+  if (checkpoint)
+    run.emplace(desc, *checkpoint, settings);
+  else
+    run.emplace(desc, settings);
+  if (!run->resume_warning().empty()) fmt::print(stderr, "sph: warning: {}\n", run->resume_warning());
+  const Simulation<D, R>& sim = run->simulation();
+  const RunInfo& info = run->info();
+  const std::int64_t first = run->first_step();
+  fmt::print(stderr, "sph: {} ({}D, {}, {} neighbors, {} thread{}): {} particles{}, {} steps of {:.4g} s{} -> {}\n",
+             desc.name, D, std::is_same_v<R, float> ? "float" : "double", info.mode, info.threads,
+             info.threads == 1 ? "" : "s", sim.particles().size(),
+             sim.params().emitters.empty() ? "" : " (emitters add more)", desc.steps, sim.params().time_step,
+             checkpoint ? fmt::format(", resumed at step {}", first) : std::string(), dir.string());
+  Progress progress(
+      desc.steps - first,
+      opt.no_progress ? Progress::Mode::Off : (::isatty(STDERR_FILENO) ? Progress::Mode::Bar : Progress::Mode::Lines),
+      stderr);
+  RunCallbacks callbacks;
+  callbacks.progress = [&](std::int64_t done, std::size_t particles) { progress.update(done - first, particles); };
+  callbacks.stop_requested = [](std::int64_t) -> std::string {
+    const int sig = g_stop_signal;
+    return sig == 0 ? "" : sig == SIGINT ? "SIGINT" : "SIGTERM";
+  };
+  RunResult result;
+  {
+    const StopSignals signals;
+    result = run->run(callbacks);
+  }
+  progress.finish();
+  switch (result.status) {
+    case RunStatus::Interrupted:
+      fmt::print(stderr,
+                 "sph: interrupted by {} after step {} of {}: wrote a checkpoint. Continue the run with:\n"
+                 "  sph run --resume {}\n",
+                 result.stop_cause, result.steps_done, desc.steps, shell_word(dir.string()));
+      return 128 + g_stop_signal;
+    case RunStatus::Failed:
+      fmt::print(stderr, "sph: error: {}\nsph: the frames written before the failure are kept in {}\n", result.error,
+                 dir.string());
+      return kRunFailed;
+    case RunStatus::Completed:
+      break;
+  }
+  print_done(*run, result, opt.audit);
   return kOk;
 }
 
@@ -266,35 +250,13 @@ int resume(RunOptions opt) {
         fmt::format("--resume continues a run with the scene and settings it started with; {} cannot be "
                     "given with it (allowed: --steps, --threads, --checkpoint-every, --no-progress)",
                     conflict));
-  const std::filesystem::path dir(opt.resume);
-  std::error_code ec;
-  if (!std::filesystem::is_directory(dir, ec))
-    throw Error("no such directory; expected the output directory of an earlier run (sph run -o DIR)", dir.string());
-  CheckpointReader checkpoint(dir / kCheckpointFile);
-  const CheckpointHeader& h = checkpoint.header();
-  if (h.sph_version != kVersion)
-    fmt::print(stderr, "sph: warning: the checkpoint was written by sph {}, this is sph {}\n", h.sph_version, kVersion);
-  std::vector<std::string> sets;
-  if (opt.steps > 0) sets.push_back("Configuration.numberOfSteps=" + std::to_string(opt.steps));
   if (opt.threads > 0) set_num_threads(opt.threads);
-  SceneDesc desc = parse_scene(h.scene_json, h.scene_source, sets);
-  if (opt.checkpoint_every == 0) opt.checkpoint_every = h.checkpoint_every;  // go on as the run did
-  desc.body2.sim.audit = desc.body3.sim.audit = h.audit;
-  if (desc.steps <= h.step)
-    throw Error(opt.steps > 0
-                    ? fmt::format("--steps {} is not beyond the checkpoint, which is at step {}; give a larger total",
-                                  opt.steps, h.step)
-                    : fmt::format("the run already did all its {} steps (its checkpoint is at step {}); give --steps "
-                                  "N with N > {} to continue it further",
-                                  desc.steps, h.step, h.step),
-                dir.string());
-  const bool f = desc.precision == Precision::Float;
-  if (desc.dimension != h.dimension || f != (h.precision == Precision::Float))
-    throw Error("the checkpoint's dimension or precision differs from its scene's: the file is corrupt",
-                (dir / kCheckpointFile).string());
-  if (desc.dimension == 2)
-    return f ? run_scene<2, float>(desc, opt, dir, &checkpoint) : run_scene<2, double>(desc, opt, dir, &checkpoint);
-  return f ? run_scene<3, float>(desc, opt, dir, &checkpoint) : run_scene<3, double>(desc, opt, dir, &checkpoint);
+  RunToResume resumed = open_run_to_resume(opt.resume, opt.steps);
+  for (const auto& w : resumed.warnings) fmt::print(stderr, "sph: warning: {}\n", w);
+  if (opt.checkpoint_every == 0) opt.checkpoint_every = resumed.checkpoint_every;  // go on as the run did
+  return dispatch(resumed.desc, [&]<int D, class R>() {
+    return run_scene<D, R>(resumed.desc, opt, resumed.dir, resumed.checkpoint.get());
+  });
 }
 
 int run(const RunOptions& opt) {
@@ -313,10 +275,7 @@ int run(const RunOptions& opt) {
   for (const auto& w : desc.warnings) fmt::print(stderr, "sph: warning: {}\n", w);
   const std::filesystem::path dir =
       opt.output.empty() ? std::filesystem::path("out") / desc.name : std::filesystem::path(opt.output);
-  const bool f = desc.precision == Precision::Float;
-  if (desc.dimension == 2)
-    return f ? run_scene<2, float>(desc, opt, dir, nullptr) : run_scene<2, double>(desc, opt, dir, nullptr);
-  return f ? run_scene<3, float>(desc, opt, dir, nullptr) : run_scene<3, double>(desc, opt, dir, nullptr);
+  return dispatch(desc, [&]<int D, class R>() { return run_scene<D, R>(desc, opt, dir, nullptr); });
 }
 
 }  // namespace

@@ -13,7 +13,6 @@
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 #include <sph/core/timer.h>
-#include <sph/io/atomic_file.h>
 
 #include "commands.h"
 
@@ -54,19 +53,6 @@ std::vector<std::string> parse_cases(const std::string& list) {
   }
   if (cases.empty()) throw Error("no case given; expected e.g. martin_moyce,hydrostatic or all", "--cases");
   return cases;
-}
-
-/// Creates `dir`, checks it is writable and removes the files an earlier validation left there
-/// (their set depends on the cases run), so the directory holds only this run's results.
-void prepare_validation_directory(const fs::path& dir) {
-  make_writable_directory(dir, "the validation's output");
-  std::error_code ec;
-  ValidationResult every;
-  every.cases.assign(kValidationCases.begin(), kValidationCases.end());
-  every.front_runs.resize(1);
-  every.hydrostatic.resize(2);
-  every.hydrostatic[1].dimension = 3;
-  for (const std::string& f : validation_files(every)) fs::remove(dir / f, ec);
 }
 
 int validate(const ValidateCliOptions& opt) {

@@ -13,11 +13,6 @@ namespace sph::app {
 /// 2 bad input (scene, flags, paths), 70 internal error (a bug).
 enum ExitCode { kOk = 0, kRunFailed = 1, kBadInput = 2, kInternal = 70 };
 
-/// Refuses (sph::Error), before anything is allocated, a scene whose particles cannot fit in
-/// this machine's memory (the operating system would otherwise kill the run, or let it swap for
-/// hours).
-void check_fits_in_memory(const SceneDesc& desc);
-
 /// Adds `sph run` to the app; the returned function runs it after parsing.
 std::function<int()> add_run_command(CLI::App& app);
 /// Adds `sph compare`.

@@ -107,6 +107,11 @@ using CompareProgress = std::function<void(const std::string&, int, int, std::in
 CompareResult run_comparison(const SceneDesc& desc, const CompareOptions& options,
                              const CompareProgress& progress = {});
 
+/// Creates `dir` (the comparison's output), checks that files can be created in it and removes
+/// what an earlier comparison left there whose set depends on the options (images of other
+/// steps, the audit's plot, runs.txt). Throws sph::Error naming the path.
+void prepare_comparison_directory(const std::filesystem::path& dir);
+
 /// Files written by write_comparison (relative to the output directory).
 std::vector<std::string> comparison_files(const CompareResult& result);
 

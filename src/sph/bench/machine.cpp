@@ -17,6 +17,7 @@
 
 #include <sph/core/parallel.h>
 #include <sph/core/version.h>
+#include <sph/run/memory.h>
 
 #ifndef SPH_BENCH_COMPILER_ID
 #define SPH_BENCH_COMPILER_ID "unknown"
@@ -72,7 +73,7 @@ MachineInfo machine_info() {
   if (m.cpu_model.empty()) m.cpu_model = "unknown";
   m.logical_cores = static_cast<int>(std::thread::hardware_concurrency());
   m.default_threads = num_threads();
-  m.memory_bytes = std::max<std::int64_t>(0, proc_kib("/proc/meminfo", "MemTotal"));
+  m.memory_bytes = physical_memory_bytes();
   utsname u{};
   if (::uname(&u) == 0) m.os = fmt::format("{} {} {}", u.sysname, u.release, u.machine);
   m.compiler = fmt::format("{} {}", SPH_BENCH_COMPILER_ID, __VERSION__);

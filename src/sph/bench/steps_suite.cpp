@@ -11,6 +11,7 @@
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 #include <sph/core/timer.h>
+#include <sph/run/driver.h>
 #include <sph/scene/builders.h>
 #include <sph/scene/scene_reader.h>
 
@@ -37,19 +38,22 @@ StepsRow run_workload(const SceneDesc& desc, int side, NeighborMode mode, int th
   row.baseline_rss_bytes = current_rss_bytes();
   const std::int64_t heap_before = heap_bytes_in_use();
   {
-    Simulation<3, R> sim = make_simulation<3, R>(desc);
+    // No output directory: the driver adds nothing to the timed steps but the observer's sums.
+    RunDriver<3, R> run(desc, RunSettings{});
+    const Simulation<3, R>& sim = run.simulation();
     SPH_CHECK(sim.particles().size() == row.particles, "the dam break block does not hold side^3 particles");
+    SPH_CHECK(desc.steps == warmup + timed, "the workload's scene runs the warm-up and the timed steps");
     PhaseTimes sum;
     std::uint64_t rebuilt = 0;
     double wall = 0;
-    for (std::int64_t s = 0; s < warmup; ++s) sim.step();
+    run.advance(warmup);
     Stopwatch watch;
-    for (std::int64_t s = 0; s < timed; ++s) {
-      const StepInfo& info = sim.step();
+    const RunResult result = run.run({}, [&](Simulation<3, R>&, const StepInfo& info) {
       sum += info.seconds;
       rebuilt += info.neighbors.lists_rebuilt;
-    }
+    });
     wall = watch.elapsed();
+    if (result.status == RunStatus::Failed) throw Error(result.error);
     const double k = 1e3 / static_cast<double>(timed);
     row.ms_per_step = PhaseTimes{sum.grid * k, sum.lists * k, sum.density * k, sum.forces * k, sum.integrate * k};
     row.wall_ms_per_step = wall * k;

@@ -13,6 +13,8 @@
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 #include <sph/core/timer.h>
+#include <sph/run/driver.h>
+#include <sph/scene/dispatch.h>
 #include <sph/scene/builders.h>
 #include <sph/scene/scene_reader.h>
 
@@ -29,16 +31,26 @@ struct TankRunResult {
   std::size_t particles_end = 0;
 };
 
+/// `steps` steps of `desc` in precision R, timed from the first step to the last. No output
+/// directory: the driver adds nothing to the timed steps. Throws the failed step's sph::Error.
 template <std::floating_point R>
-TankRunResult run_tank(const SceneDesc& desc, std::int64_t steps) {
-  Simulation<3, R> sim = make_simulation<3, R>(desc);
+TankRunResult run_tank(SceneDesc desc, std::int64_t steps) {
+  desc.steps = steps;
+  RunDriver<3, R> run(std::move(desc), RunSettings{});
   Stopwatch watch;
-  for (std::int64_t s = 0; s < steps; ++s) sim.step();
-  return {watch.elapsed(), sim.particles().size()};
+  const RunResult result = run.run();
+  const double seconds = watch.elapsed();
+  if (result.status == RunStatus::Failed) throw Error(result.error);
+  return {seconds, run.simulation().particles().size()};
 }
 
-TankRunResult run_tank(const SceneDesc& desc, Precision p, std::int64_t steps) {
-  return p == Precision::Float ? run_tank<float>(desc, steps) : run_tank<double>(desc, steps);
+TankRunResult run_tank(const SceneDesc& desc, std::int64_t steps) {
+  return dispatch(desc, [&]<int D, class R>() -> TankRunResult {
+    if constexpr (D != 3)
+      throw Error("expected a 3D scene for the tank suite", desc.source);
+    else
+      return run_tank<R>(desc, steps);
+  });
 }
 
 }  // namespace
@@ -80,7 +92,7 @@ void run_tank_suite(const BenchOptions& options, BenchResult& result, const Benc
         SceneDesc d = base;
         d.precision = p;
         d.steps = steps;
-        d.body3.sim.neighbors = m;
+        d.body<3>().sim.neighbors = m;
         descs.push_back(std::move(d));
       }
       // Warm-up, not recorded: caches, page faults and thread start-up would otherwise be
@@ -88,7 +100,7 @@ void run_tank_suite(const BenchOptions& options, BenchResult& result, const Benc
       if (out.progress)
         out.progress(fmt::format("tank: {} {} thread{}: warm-up", precision_name(p), t, t == 1 ? "" : "s"));
       try {
-        run_tank(descs[0], p, std::min(steps, kWarmupSteps));
+        run_tank(descs[0], std::min(steps, kWarmupSteps));
       } catch (const Error&) {
         // The recorded standard run meets the same failure and reports it.
       }
@@ -101,7 +113,7 @@ void run_tank_suite(const BenchOptions& options, BenchResult& result, const Benc
                                      t == 1 ? "" : "s", rep + 1, options.repeats));
           TankRunResult r;
           try {
-            r = run_tank(descs[m], p, steps);
+            r = run_tank(descs[m], steps);
           } catch (const Error& e) {
             throw BenchFailure(fmt::format("the tank run {} {} with {} thread{} failed: {}", to_string(modes[m]),
                                            precision_name(p), t, t == 1 ? "" : "s", e.what()));

@@ -1,0 +1,120 @@
+#include <sph/run/driver.h>
+
+#include <fmt/format.h>
+
+#include <sph/core/error.h>
+#include <sph/core/parallel.h>
+#include <sph/run/memory.h>
+#include <sph/scene/builders.h>
+
+namespace sph {
+
+std::string_view to_string(RunStatus status) {
+  switch (status) {
+    case RunStatus::Completed:
+      return "completed";
+    case RunStatus::Interrupted:
+      return "interrupted";
+    case RunStatus::Failed:
+      return "failed";
+  }
+  return "unknown";
+}
+
+namespace {
+
+/// The simulation of `desc`, once the scene is known to fit in memory.
+template <int D, std::floating_point R>
+Simulation<D, R> build_simulation(const SceneDesc& desc) {
+  check_fits_in_memory(desc);
+  return make_simulation<D, R>(desc);
+}
+
+}  // namespace
+
+template <int D, std::floating_point R>
+RunDriver<D, R>::RunDriver(SceneDesc desc, RunSettings settings)
+    : desc_(std::move(desc)),
+      settings_(std::move(settings)),
+      sim_(build_simulation<D, R>(desc_)),
+      info_{std::string(to_string(sim_.params().neighbors)), num_threads()} {
+  SPH_CHECK(settings_.checkpoint_every == 0 || !settings_.dir.empty(), "RunDriver: checkpoints need a directory");
+  if (!settings_.dir.empty()) {
+    prepare_output_directory(settings_.dir);
+    output_ = std::make_unique<RunOutput<D, R>>(settings_.dir, desc_, info_);
+  }
+  wall_ = Stopwatch();
+}
+
+template <int D, std::floating_point R>
+RunDriver<D, R>::RunDriver(SceneDesc desc, CheckpointReader& checkpoint, RunSettings settings)
+    : desc_(std::move(desc)),
+      settings_(std::move(settings)),
+      sim_(build_simulation<D, R>(desc_)),
+      info_{std::string(to_string(sim_.params().neighbors)), num_threads()},
+      resumed_(true) {
+  SPH_CHECK(!settings_.dir.empty(), "RunDriver: a resumed run needs its directory");
+  prepare_resume_directory(settings_.dir);
+  output_ = std::make_unique<RunOutput<D, R>>(settings_.dir, desc_, info_);
+  wall_ = Stopwatch();
+  resume_warning_ = checkpoint.restore(sim_, *output_);
+  first_step_ = sim_.steps_done();
+}
+
+template <int D, std::floating_point R>
+RunDriver<D, R>::~RunDriver() = default;
+
+template <int D, std::floating_point R>
+void RunDriver<D, R>::advance(std::int64_t n) {
+  SPH_CHECK(!output_ && !ran_, "RunDriver::advance: only before run() of a run that writes nothing");
+  for (std::int64_t k = 0; k < n && sim_.steps_done() < desc_.steps; ++k) sim_.step();
+}
+
+template <int D, std::floating_point R>
+RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver& on_step) {
+  SPH_CHECK(!ran_, "RunDriver::run: a driver runs once");
+  ran_ = true;
+  RunResult result;
+  result.first_step = first_step_;
+  const auto end = [&](RunStatus status, std::string message) {
+    result.status = status;
+    result.message = std::move(message);
+    result.steps_done = sim_.steps_done();
+    result.wall_seconds = wall_.elapsed();
+    if (output_) output_->finish(sim_, result.message, result.wall_seconds);
+    return result;
+  };
+  const std::int64_t steps = desc_.steps;
+  if (output_ && !resumed_) output_->begin(sim_);  // (a failure here is thrown: nothing has run)
+  try {
+    for (std::int64_t s = sim_.steps_done(); s < steps; ++s) {
+      const StepInfo& step = sim_.step();
+      const bool last = s + 1 == steps;
+      if (on_step) on_step(sim_, step);
+      if (output_) output_->after_step(sim_, step, last);
+      if (callbacks.progress) callbacks.progress(sim_.steps_done(), step.particles);
+      if (callbacks.stop_requested && !last) {
+        if (std::string cause = callbacks.stop_requested(sim_.steps_done()); !cause.empty()) {
+          if (output_)
+            write_checkpoint(settings_.dir, desc_, sim_, *output_, wall_.elapsed(), settings_.checkpoint_every);
+          result.stop_cause = cause;
+          return end(RunStatus::Interrupted,
+                     fmt::format("interrupted by {} after step {} of {}", cause, sim_.steps_done(), steps));
+        }
+      }
+      if (settings_.checkpoint_every > 0 && (sim_.steps_done() % settings_.checkpoint_every == 0 || last))
+        write_checkpoint(settings_.dir, desc_, sim_, *output_, wall_.elapsed(), settings_.checkpoint_every);
+    }
+  } catch (const Error& e) {
+    result.error = e.what();
+    return end(RunStatus::Failed, std::string("failed: ") + e.what());
+  }
+  return end(RunStatus::Completed, "completed");
+}
+
+template class RunDriver<2, float>;
+template class RunDriver<2, double>;
+template class RunDriver<3, float>;
+template class RunDriver<3, double>;
+
+}  // namespace sph

@@ -1,0 +1,133 @@
+#pragma once
+/// \file RunDriver: one run of a scene, start to end, as `sph run`, `sph compare`, `sph validate`
+/// and the benchmarks run it. It builds the simulation, creates and prepares (or, resuming,
+/// checks) the output directory, runs the step loop with the output of each step (frames,
+/// stats.csv: RunOutput), writes checkpoints on their cadence and on a stop request, and returns
+/// how the run ended. It prints nothing: the caller reports through the callbacks and the result.
+///
+/// A run with no output directory writes nothing and checkpoints nothing: the step loop then
+/// adds no work to the steps but the callbacks the caller gives (benchmarks time it).
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include <sph/core/timer.h>
+#include <sph/io/checkpoint.h>
+#include <sph/io/run_output.h>
+#include <sph/scene/scene_desc.h>
+#include <sph/solver/simulation.h>
+
+namespace sph {
+
+/// How a run ended.
+enum class RunStatus {
+  Completed,    ///< every step of the scene was done
+  Interrupted,  ///< a stop request ended it after a step (with a checkpoint if it writes output)
+  Failed,       ///< a step or the output threw sph::Error (a blow-up, a full disk)
+};
+
+/// "completed", "interrupted", "failed".
+std::string_view to_string(RunStatus status);
+
+/// Where a run writes and how often it saves itself.
+struct RunSettings {
+  /// The run's output directory (frames, stats.csv, summary.json, scene.json, checkpoints);
+  /// empty: the run writes nothing.
+  std::filesystem::path dir;
+  /// A checkpoint every N steps and at the last step (0: only on a stop request). Recorded in
+  /// the checkpoint, so that a resumed run goes on as often. Needs `dir`.
+  std::int64_t checkpoint_every = 0;
+};
+
+/// What the caller hears during the run. Both are called between steps; either may be empty.
+struct RunCallbacks {
+  /// Polled after each step but the scene's last (a request during the last step lets the run
+  /// complete), with the steps done: a non-empty return (the cause, e.g. "SIGINT") stops the run
+  /// there, after a checkpoint if the run writes output.
+  std::function<std::string(std::int64_t steps_done)> stop_requested;
+  /// After each step's output: the steps done (counted from the start of the run, not of this
+  /// session) and the particles.
+  std::function<void(std::int64_t steps_done, std::size_t particles)> progress;
+};
+
+/// How a run ended, for the caller to report.
+struct RunResult {
+  RunStatus status = RunStatus::Completed;
+  /// The status as summary.json records it: "completed", "interrupted by CAUSE after step K of
+  /// N", "failed: ERROR".
+  std::string message;
+  std::string error;            ///< Failed: the error's text
+  std::string stop_cause;       ///< Interrupted: what stop_requested returned
+  std::int64_t first_step = 0;  ///< steps done when this session started (0 unless resumed)
+  std::int64_t steps_done = 0;  ///< steps done at the end
+  double wall_seconds = 0;      ///< this session's wall seconds, from the driver's construction
+};
+
+/// One run of one scene in dimension D and precision R. Not copyable or movable (its output
+/// refers to its scene).
+template <int D, std::floating_point R>
+class RunDriver {
+ public:
+  /// Called after each step, before its output, with the simulation (which it may change, e.g.
+  /// perturb) and what the step did.
+  using StepObserver = std::function<void(Simulation<D, R>&, const StepInfo&)>;
+
+  /// A new run of `desc`. Everything that can be refused is checked before the directory is
+  /// touched (check_fits_in_memory, the simulation's construction); then, with a settings.dir,
+  /// prepare_output_directory removes what an earlier run left there. Throws sph::Error.
+  RunDriver(SceneDesc desc, RunSettings settings);
+  /// The continuation of the run whose checkpoint `checkpoint` holds (`desc` from its scene: see
+  /// open_run_to_resume), in settings.dir, which must be that run's directory: checks it
+  /// (prepare_resume_directory) and restores the simulation and the output from the checkpoint.
+  /// Throws sph::Error.
+  RunDriver(SceneDesc desc, CheckpointReader& checkpoint, RunSettings settings);
+  ~RunDriver();
+  RunDriver(const RunDriver&) = delete;
+  RunDriver& operator=(const RunDriver&) = delete;
+
+  const SceneDesc& scene() const { return desc_; }
+  const RunSettings& settings() const { return settings_; }
+  /// The neighbor mode's name and the thread count, as summary.json records them.
+  const RunInfo& info() const { return info_; }
+  Simulation<D, R>& simulation() { return sim_; }
+  const Simulation<D, R>& simulation() const { return sim_; }
+  /// The run's output; null without a directory.
+  const RunOutput<D, R>* output() const { return output_.get(); }
+  /// Steps done when this session started: 0, or the checkpoint's step.
+  std::int64_t first_step() const { return first_step_; }
+  /// A resumed run's warning about its restored output ("" if none), e.g. missing stats rows.
+  const std::string& resume_warning() const { return resume_warning_; }
+
+  /// Runs `n` steps (at most those left) and nothing else: no output, no callbacks; a warm-up
+  /// before a timed stretch. Only for a run without a directory (SPH_CHECK) that has not run
+  /// yet. Throws the step's sph::Error.
+  void advance(std::int64_t n);
+  /// Runs the steps left, until the scene's last, a stop request or a failure; a new run first
+  /// writes its initial output (frame 0, scene.json). Ends the output (summary.json with the
+  /// status) and returns how the run ended. A failure of a step, of its output or of a
+  /// checkpoint is returned (Failed), not thrown; a failure to write the initial output or the
+  /// final summary throws sph::Error. Once per driver (SPH_CHECK).
+  RunResult run(const RunCallbacks& callbacks = {}, const StepObserver& on_step = {});
+
+ private:
+  SceneDesc desc_;
+  RunSettings settings_;
+  Simulation<D, R> sim_;
+  RunInfo info_;
+  std::unique_ptr<RunOutput<D, R>> output_;
+  Stopwatch wall_;
+  std::int64_t first_step_ = 0;
+  std::string resume_warning_;
+  bool resumed_ = false, ran_ = false;
+};
+
+extern template class RunDriver<2, float>;
+extern template class RunDriver<2, double>;
+extern template class RunDriver<3, float>;
+extern template class RunDriver<3, double>;
+
+}  // namespace sph

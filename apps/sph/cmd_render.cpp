@@ -130,7 +130,8 @@ int render(const RenderCliOptions& opt) {
                 "--colormap");
   std::optional<FrameFormat> format;
   if (!opt.format.empty() && !(format = parse_frame_format(opt.format)))
-    throw Error(fmt::format("unknown frame format \"{}\"; expected vtu, vtk or ply", opt.format), "--format");
+    throw Error(fmt::format("unknown frame format \"{}\"; expected {}", opt.format, frame_format_list("", " or ")),
+                "--format");
   if (opt.no_png && !opt.mp4) throw Error("--no-png leaves nothing to write; give --mp4 with it", "--no-png");
   if (opt.threads > 0) set_num_threads(opt.threads);
 
@@ -244,7 +245,7 @@ std::function<int()> add_render_command(CLI::App& app) {
       ->check(CLI::Range(-90.0, 90.0))
       ->default_str("20");
   cmd->add_flag("--flat", opt->flat, "Flat discs instead of shaded spheres");
-  cmd->add_option("--format", opt->format, "Which frames to read when the run wrote several formats: vtu, vtk, ply");
+  cmd->add_option("--format", opt->format, "Which frames to read when the run wrote several formats: " + frame_format_list());
   cmd->add_flag("--mp4", opt->mp4, "Also encode the images as movie.mp4 in the output directory (needs ffmpeg)");
   cmd->add_option("--video-fps", opt->video_fps, "Frames per second of the movie")
       ->check(CLI::Range(1.0, 240.0))

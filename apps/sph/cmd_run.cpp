@@ -87,7 +87,7 @@ std::vector<std::string> output_overrides(const RunOptions& opt) {
     sets.push_back("Configuration.outputEveryNSteps=0"),
         sets.push_back(fmt::format("Configuration.outputFps={}", *opt.fps));
   if (opt.formats)
-    sets.push_back("Configuration.outputFormats=" + name_list_json(*opt.formats, {"vtu", "vtk", "ply"}, "--format"));
+    sets.push_back("Configuration.outputFormats=" + name_list_json(*opt.formats, frame_format_names(), "--format"));
   if (opt.fields)
     sets.push_back(
         "Configuration.outputFields=" +
@@ -139,14 +139,8 @@ class StopSignals {
 std::string frames_hint(const OutputDesc& output, const std::filesystem::path& dir) {
   std::string s;
   for (FrameFormat f : output.formats) {
-    if (f == FrameFormat::Vtu)
-      s +=
-          fmt::format("  {}/frames.pvd   open in ParaView (Filters > Point Gaussian to see particles)\n", dir.string());
-    if (f == FrameFormat::Vtk)
-      s += fmt::format("  {}/frames/*.vtk legacy VTK frames (ParaView, VisIt, meshio)\n", dir.string());
-    if (f == FrameFormat::Ply)
-      s += fmt::format("  {}/frames/*.ply point clouds (Blender: File > Import > Stanford PLY; Houdini: File node)\n",
-                       dir.string());
+    const FrameFormatDesc& d = frame_format_desc(f);
+    s += fmt::format("  {}/{} {}\n", dir.string(), d.look_at, d.hint);
   }
   return s;
 }
@@ -295,12 +289,12 @@ std::function<int()> add_run_command(CLI::App& app) {
                   "--set FluidBlocks[0].end=[0.5,1.0] (repeatable; VALUE is JSON or a plain string)")
       ->type_name("KEY=VALUE");
   cmd->add_option("--format", opt->formats,
-                  "Frame formats, a comma-separated list of vtu (ParaView), vtk (legacy VTK) and ply (Blender, "
-                  "Houdini), overriding Configuration.outputFormats (default: vtu)")
+                  "Frame formats, a comma-separated list of " + frame_format_list("", " and ", true) +
+                      ", overriding Configuration.outputFormats (default: vtu)")
       ->type_name("LIST");
   cmd->add_option("--fields", opt->fields,
-                  "Point fields of each frame besides the positions, a comma-separated list of velocity, density, "
-                  "pressure, id and initial_position, or none; overrides Configuration.outputFields (default: all)")
+                  "Point fields of each frame besides the positions, a comma-separated list of " +
+                      frame_field_list() + ", or none; overrides Configuration.outputFields (default: all)")
       ->type_name("LIST");
   cmd->add_option("--every", opt->every,
                   "A frame every N steps (0: no frames), overriding Configuration.outputEveryNSteps and outputFps")

@@ -279,7 +279,7 @@ int resume(RunOptions opt) {
   if (opt.threads > 0) set_num_threads(opt.threads);
   SceneDesc desc = parse_scene(h.scene_json, h.scene_source, sets);
   if (opt.checkpoint_every == 0) opt.checkpoint_every = h.checkpoint_every;  // go on as the run did
-  desc.body2.sim.audit = desc.body3.sim.audit = h.audit;
+  desc.set_audit(h.audit);
   if (desc.steps <= h.step)
     throw Error(opt.steps > 0
                     ? fmt::format("--steps {} is not beyond the checkpoint, which is at step {}; give a larger total",
@@ -309,7 +309,7 @@ int run(const RunOptions& opt) {
   if (opt.threads > 0) set_num_threads(opt.threads);
 
   SceneDesc desc = read_scene_file(opt.scene, sets);
-  desc.body2.sim.audit = desc.body3.sim.audit = opt.audit;
+  desc.set_audit(opt.audit);
   for (const auto& w : desc.warnings) fmt::print(stderr, "sph: warning: {}\n", w);
   const std::filesystem::path dir =
       opt.output.empty() ? std::filesystem::path("out") / desc.name : std::filesystem::path(opt.output);

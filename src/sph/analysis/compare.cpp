@@ -24,6 +24,7 @@
 #include <sph/render/plot.h>
 #include <sph/render/png.h>
 #include <sph/scene/builders.h>
+#include <sph/scene/scene_writer.h>
 
 namespace sph {
 
@@ -92,9 +93,7 @@ RunRecord run_one(const SceneDesc& base, NeighborMode mode, bool perturbed, cons
     const std::filesystem::path dir = opt.runs_dir / slug(rec.label);
     prepare_output_directory(dir);
     // The run's own scene: the comparison's with this run's mode, as `sph run --neighbors` writes it.
-    nlohmann::ordered_json scene = nlohmann::ordered_json::parse(desc.effective_json);
-    scene["Configuration"]["neighbors"] = std::string(to_string(mode));
-    write_file_atomic(dir / "scene.json", scene.dump(2) + "\n");
+    write_file_atomic(dir / "scene.json", scene_text(desc) + "\n");
     frames.emplace(dir, desc.output);
     frames->write_due(sim, false);
   }

@@ -80,7 +80,7 @@ void run_tank_suite(const BenchOptions& options, BenchResult& result, const Benc
         SceneDesc d = base;
         d.precision = p;
         d.steps = steps;
-        d.body3.sim.neighbors = m;
+        d.body<3>().sim.neighbors = m;
         descs.push_back(std::move(d));
       }
       // Warm-up, not recorded: caches, page faults and thread start-up would otherwise be

@@ -1,6 +1,11 @@
 #pragma once
 /// \file The scene format's vocabulary, shared by the reader and the writer: the keys each
 /// object may have (docs/scene-format.md) and the names of the enumerated values.
+///
+/// A new key: add it to its object's list here, read it in scene_reader.cpp, write it in
+/// scene_writer.cpp and document it in docs/scene-format.md. Reading or writing an undeclared key
+/// is an SPH_CHECK failure, and tests/scene/scene_writer_test.cpp fails until the writer writes
+/// every declared key and the reader reads it back to the same value.
 
 #include <algorithm>
 #include <string>

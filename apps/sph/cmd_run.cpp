@@ -265,7 +265,7 @@ int run(const RunOptions& opt) {
   if (opt.threads > 0) set_num_threads(opt.threads);
 
   SceneDesc desc = read_scene_file(opt.scene, sets);
-  desc.body2.sim.audit = desc.body3.sim.audit = opt.audit;
+  desc.set_audit(opt.audit);
   for (const auto& w : desc.warnings) fmt::print(stderr, "sph: warning: {}\n", w);
   const std::filesystem::path dir =
       opt.output.empty() ? std::filesystem::path("out") / desc.name : std::filesystem::path(opt.output);

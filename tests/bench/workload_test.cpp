@@ -146,7 +146,7 @@ TEST(DamBreakScene, IsAValidSceneWithSideCubedParticlesInTheDocumentedBox) {
     EXPECT_EQ(desc.dimension, 3);
     EXPECT_EQ(desc.precision, Precision::Float);
     EXPECT_EQ(desc.steps, 7);
-    const auto& body = desc.body3;
+    const auto& body = desc.body<3>();
     EXPECT_EQ(body.sim.neighbors, NeighborMode::Verlet);
     EXPECT_EQ(count_block_particles<3>(body), static_cast<std::size_t>(side * side * side));
     const double w = 0.02 * side;

@@ -10,7 +10,8 @@
 // A scene the reader accepts must keep the promises of SceneDesc (finite, positive sizes and
 // masses, unit emitter directions, everything inside the container: check_accepted below); a
 // broken promise is a finding too. It is then built (particles and Simulation) and stepped
-// twice when it is small, so values that pass validation are also shown to be usable.
+// twice when it is small, so values that pass validation are also shown to be usable. What
+// scene_to_json writes of it must read back to an equal SceneDesc.
 
 #include <cmath>
 #include <cstddef>
@@ -27,6 +28,7 @@
 #include <sph/scene/builders.h>
 #include <sph/scene/scene_desc.h>
 #include <sph/scene/scene_reader.h>
+#include <sph/scene/scene_writer.h>
 
 namespace {
 
@@ -99,6 +101,15 @@ void check_accepted(const sph::SceneDesc& desc) {
   promise(total >= 1 && total <= 2e9, "between 1 and 2e9 particles");
 }
 
+/// The writer's promise: the scene it writes reads back to an equal SceneDesc.
+void check_written(const sph::SceneDesc& desc) {
+  try {
+    promise(sph::parse_scene(sph::scene_text(desc), desc.source) == desc, "the written scene reads back equal");
+  } catch (const sph::Error& e) {
+    finding("a refusal of the written scene", e.what());
+  }
+}
+
 template <int D>
 double particle_budget(const sph::SceneDesc& desc) {
   const sph::SceneBody<D>& body = desc.body<D>();
@@ -143,6 +154,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     const sph::SceneDesc desc = sph::parse_scene(text, "fuzz", overrides);
     promise(desc.dimension == 2 || desc.dimension == 3, "dimension 2 or 3");
+    check_written(desc);
     if (desc.dimension == 2)
       check_and_simulate<2>(desc);
     else

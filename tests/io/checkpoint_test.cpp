@@ -65,6 +65,7 @@ void expect_resume_is_bitwise(const SceneDesc& desc, std::int64_t stop, std::int
   EXPECT_EQ(ck.header().step, stop);
   EXPECT_EQ(ck.header().dimension, D);
   const SceneDesc again = parse_scene(ck.header().scene_json, ck.header().scene_source);
+  EXPECT_TRUE(again == desc) << "the checkpoint holds the run's scene";
   Simulation<D, R> resumed = make_simulation<D, R>(again);
   RunOutput<D, R> out(dir, again, {"x", 1});
   EXPECT_EQ(ck.restore(resumed, out), "");

@@ -415,12 +415,12 @@ TEST(RunDirectory, ReadsTheSceneAndListsTheFrames) {
   EXPECT_EQ(run.dimension, 2);
   EXPECT_EQ(run.label, "dam_break_2d");
   const SceneDesc desc = read_scene_file(kDamBreak);
-  EXPECT_EQ(run.particle_radius, desc.body2.sim.particle_radius);
-  EXPECT_EQ(run.kernel_radius, desc.body2.sim.kernel_radius);
-  EXPECT_EQ(run.rest_density, desc.body2.sim.fluid.rest_density);
+  EXPECT_EQ(run.particle_radius, desc.body<2>().sim.particle_radius);
+  EXPECT_EQ(run.kernel_radius, desc.body<2>().sim.kernel_radius);
+  EXPECT_EQ(run.rest_density, desc.body<2>().sim.fluid.rest_density);
   EXPECT_EQ(run.particle_mass, 0.0125);
-  EXPECT_EQ(run.box_lo[0], desc.body2.sim.container.lo[0]);
-  EXPECT_EQ(run.box_hi[1], desc.body2.sim.container.hi[1]);
+  EXPECT_EQ(run.box_lo[0], desc.body<2>().sim.container.lo[0]);
+  EXPECT_EQ(run.box_hi[1], desc.body<2>().sim.container.hi[1]);
   EXPECT_EQ(run.box_hi[2], 0.0);
   EXPECT_EQ(open_run_directory(dir, FrameFormat::Ply).frames.back(), dir / "frames/frame_000003.ply");
   try {

@@ -19,7 +19,7 @@ SceneDesc scene(const std::string& name, const std::string& mode, bool audit, in
   SceneDesc d = read_scene_file(scene_path(name), {"Configuration.neighbors=\"" + mode + "\"",
                                                    "Configuration.fullRebuildPeriod=" + std::to_string(period),
                                                    "Configuration.reorderPeriod=50"});
-  d.body2.sim.audit = d.body3.sim.audit = audit;
+  d.set_audit(audit);
   return d;
 }
 

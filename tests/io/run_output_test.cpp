@@ -127,6 +127,7 @@ TEST(RunOutput, WritesFramesStatsAndSummary) {
                                                               "frame_000002.vtu", "frame_000003.vtu"}));
   EXPECT_EQ(entries(dir.path()),
             (std::vector<std::string>{"frames", "frames.pvd", "scene.json", "stats.csv", "summary.json"}));
+  EXPECT_TRUE(parse_scene(slurp(dir / "scene.json"), desc.source) == desc) << "scene.json is the run's scene";
   const auto rows = lines(slurp(dir / "stats.csv"));
   ASSERT_EQ(rows.size(), 6u);
   EXPECT_EQ(rows[0], kStatsColumns);

@@ -13,6 +13,7 @@
 #include <sph/core/error.h>
 #include <sph/scene/builders.h>
 #include <sph/scene/scene_reader.h>
+#include <sph/scene/scene_writer.h>
 
 #include "support/expect.h"
 
@@ -500,7 +501,8 @@ TEST(SceneReaderOverrides, MalformedOverride) {
 }
 
 TEST(SceneReaderOverrides, EffectiveSceneShowsOverrides) {
-  const std::string text = sph::parse_scene(valid_scene().dump(), "test.json", {"Fluid.stiffness=2000"}).effective_json;
+  const std::string text =
+      sph::scene_text(sph::parse_scene(valid_scene().dump(), "test.json", {"Fluid.stiffness=2000"}));
   EXPECT_EQ(json::parse(text)["Fluid"]["stiffness"], 2000);
 }
 
@@ -640,7 +642,7 @@ TEST(SceneReaderOutput, FormatsAndFieldsInTheirCanonicalOrder) {
   j["Configuration"]["outputFields"] = json::array();
   EXPECT_TRUE(parse(j).output.fields.empty()) << "positions only";
   // The effective scene keeps the keys, so that a checkpoint's scene reproduces them.
-  const sph::SceneDesc again = sph::parse_scene(d.effective_json, "again.json");
+  const sph::SceneDesc again = sph::parse_scene(sph::scene_text(d), "again.json");
   EXPECT_EQ(again.output.formats, d.output.formats);
   EXPECT_EQ(again.output.fields, d.output.fields);
 }

@@ -84,11 +84,6 @@ SceneDesc run_scene(const SceneDesc& base, NeighborMode mode, bool audit, std::i
   desc.body<D>().sim.neighbors = mode;
   desc.body<D>().sim.audit = audit;
   desc.steps = steps;
-  // scene.json of the run directory is written from this text: it names the run's mode, as
-  // `sph run --neighbors` writes it.
-  nlohmann::ordered_json scene = nlohmann::ordered_json::parse(desc.effective_json);
-  scene["Configuration"]["neighbors"] = std::string(to_string(mode));
-  desc.effective_json = scene.dump(2);
   return desc;
 }
 

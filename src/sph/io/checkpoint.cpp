@@ -9,6 +9,7 @@
 #include <sph/core/state_stream.h>
 #include <sph/core/version.h>
 #include <sph/io/atomic_file.h>
+#include <sph/scene/scene_writer.h>
 
 namespace sph {
 
@@ -37,7 +38,7 @@ void write_checkpoint(const fs::path& dir, const SceneDesc& desc, const Simulati
   w.put(static_cast<std::uint8_t>(D));
   w.put(static_cast<std::uint8_t>(std::is_same_v<R, float> ? 0 : 1));
   w.put(sim.steps_done());
-  w.put(desc.effective_json);
+  w.put(scene_text(desc));
   w.put(desc.source);
   w.put(static_cast<std::uint8_t>(sim.params().audit));
   w.put(checkpoint_every);

@@ -72,7 +72,8 @@ RunDirectory open_run_directory(const fs::path& dir, std::optional<FrameFormat> 
   run.dir = dir;
   run.scene = read_scene_file(scene_file.string());
   run.dimension = run.scene.dimension;
-  const auto fill = [&](const auto& sim, int D) {
+  run.scene.visit_body([&]<int D>(const SceneBody<D>& body) {
+    const SimulationParams<D>& sim = body.sim;
     run.particle_radius = sim.particle_radius;
     run.kernel_radius = sim.kernel_radius;
     run.particle_mass = sim.particle_mass;
@@ -85,11 +86,7 @@ RunDirectory open_run_directory(const fs::path& dir, std::optional<FrameFormat> 
     fs::path full = fs::absolute(dir, ec).lexically_normal();
     if (!full.has_filename()) full = full.parent_path();  // "DIR/" -> "DIR"
     if (fs::is_regular_file(full.parent_path() / kRunListFile, ec)) run.label = std::string(to_string(sim.neighbors));
-  };
-  if (run.dimension == 2)
-    fill(run.scene.body2.sim, 2);
-  else
-    fill(run.scene.body3.sim, 3);
+  });
 
   if (format) {
     run.format = *format;

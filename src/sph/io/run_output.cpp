@@ -12,6 +12,7 @@
 #include <sph/core/timer.h>
 #include <sph/core/version.h>
 #include <sph/io/atomic_file.h>
+#include <sph/scene/scene_writer.h>
 
 namespace sph {
 
@@ -97,7 +98,7 @@ template <int D, std::floating_point R>
 void RunOutput<D, R>::begin(const Simulation<D, R>& sim) {
   Stopwatch w;
   open_stats();
-  write_file_atomic(dir_ / "scene.json", desc_.effective_json + "\n");
+  write_file_atomic(dir_ / "scene.json", scene_text(desc_) + "\n");
   frames_.write_due(sim, false);  // frame 0, if the run writes frames
   output_seconds_ += w.lap();
 }
@@ -141,7 +142,7 @@ std::string RunOutput<D, R>::resume(const Simulation<D, R>& sim, StateReader& in
   in.get(last_checkpoint_step_);
   const std::int64_t steps = sim.steps_done();
   resumed_at_.push_back(steps);
-  write_file_atomic(dir_ / "scene.json", desc_.effective_json + "\n");
+  write_file_atomic(dir_ / "scene.json", scene_text(desc_) + "\n");
   std::error_code ec;
   fs::remove(dir_ / "summary.json", ec);
 

@@ -24,7 +24,7 @@ RunToResume open_run_to_resume(const std::filesystem::path& dir, std::int64_t st
   run.desc = parse_scene(h.scene_json, h.scene_source, sets);
   run.checkpoint_every = h.checkpoint_every;
   SceneDesc& desc = run.desc;
-  desc.body2.sim.audit = desc.body3.sim.audit = h.audit;
+  desc.set_audit(h.audit);
   if (desc.steps <= h.step)
     throw Error(steps > 0
                     ? fmt::format("--steps {} is not beyond the checkpoint, which is at step {}; give a larger total",

@@ -95,12 +95,12 @@ double estimated_bytes_of(const SceneBody<D>& body, std::size_t real_bytes) {
 }  // namespace
 
 std::size_t max_particles(const SceneDesc& desc) {
-  return desc.dimension == 2 ? max_particles_of<2>(desc.body2) : max_particles_of<3>(desc.body3);
+  return desc.visit_body([]<int D>(const SceneBody<D>& body) { return max_particles_of<D>(body); });
 }
 
 double estimated_run_bytes(const SceneDesc& desc) {
   const std::size_t real = desc.precision == Precision::Float ? sizeof(float) : sizeof(double);
-  return desc.dimension == 2 ? estimated_bytes_of<2>(desc.body2, real) : estimated_bytes_of<3>(desc.body3, real);
+  return desc.visit_body([&]<int D>(const SceneBody<D>& body) { return estimated_bytes_of<D>(body, real); });
 }
 
 template std::size_t count_block_particles<2>(const SceneBody<2>&);

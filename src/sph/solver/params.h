@@ -21,6 +21,8 @@ enum class NegativePressure {
 template <int D>
 struct Box {
   Vec<D, double> lo, hi;
+
+  friend bool operator==(const Box&, const Box&) = default;
 };
 
 /// How the pressure force is discretized.
@@ -58,6 +60,8 @@ struct FluidParams {
   NegativePressure negative_pressure = NegativePressure::Clamp;
   PressureForce pressure_force = PressureForce::Paper;
   GradientCorrection gradient_correction = GradientCorrection::None;
+
+  friend bool operator==(const FluidParams&, const FluidParams&) = default;
 };
 
 /// Damped penalty springs at the container walls and obstacle faces. They act on particles
@@ -66,6 +70,8 @@ struct FluidParams {
 struct WallParams {
   double stiffness = 1e5;  ///< 1/s^2 (force per unit mass per metre of penetration)
   double damping = 100;    ///< 1/s
+
+  friend bool operator==(const WallParams&, const WallParams&) = default;
 };
 
 /// An emitter: a rectangular nozzle of width x height particles (height ignored in 2D) at
@@ -84,6 +90,8 @@ struct EmitterParams {
   std::int64_t max_particles = 0;
   double start_time = 0;
   double end_time = std::numeric_limits<double>::infinity();
+
+  friend bool operator==(const EmitterParams&, const EmitterParams&) = default;
 };
 
 template <int D>
@@ -108,6 +116,8 @@ struct SimulationParams {
   /// Audit the lists every step against exact lists (StepInfo::audit); costs about one
   /// standard list build per step.
   bool audit = false;
+
+  friend bool operator==(const SimulationParams&, const SimulationParams&) = default;
 };
 
 }  // namespace sph

@@ -1,0 +1,104 @@
+#include <sph/scene/json_source.h>
+
+#include <algorithm>
+#include <set>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include <sph/core/error.h>
+
+namespace sph::detail {
+
+using json = nlohmann::json;
+
+std::string describe(const json& j) {
+  // Never dump containers whole: a deeply nested value would recurse without bound.
+  if (j.is_array()) return fmt::format("an array of {} element{}", j.size(), j.size() == 1 ? "" : "s");
+  if (j.is_object()) return fmt::format("an object with {} key{}", j.size(), j.size() == 1 ? "" : "s");
+  std::string text = j.dump();
+  if (text.size() > 40) text = text.substr(0, 37) + "...";
+  return std::string(j.type_name()) + " " + text;
+}
+
+json parse_json(const std::string& text, const std::string& source) {
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos)
+    throw Error("the scene file is empty; expected a JSON object (see docs/scene-format.md)", source);
+  // Duplicate keys would silently keep the last value: refuse them.
+  std::vector<std::set<std::string>> keys;
+  std::string duplicate;
+  json::parser_callback_t cb = [&](int depth, json::parse_event_t event, json& parsed) {
+    if (depth > kMaxJsonDepth)
+      throw Error(fmt::format("the JSON is nested more than {} levels deep", kMaxJsonDepth), source);
+    if (event == json::parse_event_t::object_start)
+      keys.emplace_back();
+    else if (event == json::parse_event_t::object_end)
+      keys.pop_back();
+    else if (event == json::parse_event_t::key && !keys.empty() && duplicate.empty()) {
+      const auto k = parsed.get<std::string>();
+      if (!keys.back().insert(k).second) duplicate = k;
+    }
+    return true;
+  };
+  try {
+    json j = json::parse(text, cb, /*allow_exceptions=*/true, /*ignore_comments=*/false);
+    if (!duplicate.empty()) throw Error("key \"" + duplicate + "\" appears twice in the same object", source);
+    return j;
+  } catch (const json::parse_error& e) {
+    // e.byte is the 1-based offset of the offending character.
+    std::size_t line = 1, col = 1;
+    const std::size_t end = std::min<std::size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
+    for (std::size_t k = 0; k < end; ++k) {
+      if (text[k] == '\n')
+        ++line, col = 1;
+      else
+        ++col;
+    }
+    std::string what = e.what();
+    const auto pos = what.find("syntax error");
+    if (pos != std::string::npos) what = what.substr(pos);
+    throw Error("JSON syntax error: " + what, fmt::format("{}:{}:{}", source, line, col));
+  } catch (const json::exception& e) {
+    // For example a number too large for a double (1e999).
+    std::string what = e.what();
+    const auto pos = what.find("] ");
+    throw Error("invalid JSON: " + (pos == std::string::npos ? what : what.substr(pos + 2)), source);
+  }
+}
+
+std::size_t invalid_utf8_at(const std::string& s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    // The length of the sequence a lead byte starts, and the range its second byte must be in
+    // (narrower after E0, ED, F0 and F4: no overlong forms, surrogates or code points > 10FFFF).
+    std::size_t len = 0;
+    unsigned char lo = 0x80, hi = 0xBF;
+    if (c >= 0xC2 && c <= 0xDF) {
+      len = 2;
+    } else if (c >= 0xE0 && c <= 0xEF) {
+      len = 3;
+      if (c == 0xE0) lo = 0xA0;
+      if (c == 0xED) hi = 0x9F;
+    } else if (c >= 0xF0 && c <= 0xF4) {
+      len = 4;
+      if (c == 0xF0) lo = 0x90;
+      if (c == 0xF4) hi = 0x8F;
+    } else {
+      return i;
+    }
+    if (len > s.size() - i) return i;
+    for (std::size_t k = 1; k < len; ++k) {
+      const auto b = static_cast<unsigned char>(s[i + k]);
+      if (b < (k == 1 ? lo : 0x80) || b > (k == 1 ? hi : 0xBF)) return i;
+    }
+    i += len;
+  }
+  return std::string::npos;
+}
+
+}  // namespace sph::detail

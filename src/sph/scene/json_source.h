@@ -1,0 +1,30 @@
+#pragma once
+/// \file JSON text as the scene reader takes it: parsed with line and column in syntax errors,
+/// duplicate keys and deep nesting refused, UTF-8 checked, values described in messages.
+
+#include <cstddef>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace sph::detail {
+
+/// JSON nested deeper than this is refused: copying, comparing and writing a json value recurse
+/// once per level, so a value nested some ten thousand levels deep overflows the stack (a --set
+/// value of 20,000 levels did).
+inline constexpr int kMaxJsonDepth = 64;
+
+/// Parses a scene's JSON text. Throws sph::Error for empty text, syntax errors (where:
+/// "SOURCE:LINE:COLUMN"), duplicate keys in one object, nesting deeper than kMaxJsonDepth and
+/// numbers out of a double's range.
+nlohmann::json parse_json(const std::string& text, const std::string& source);
+
+/// The offset of the first byte of `s` that is not part of well-formed UTF-8 (no overlong
+/// forms, no surrogates, nothing above U+10FFFF), or npos if all of `s` is well-formed.
+std::size_t invalid_utf8_at(const std::string& s);
+
+/// A short description of a value for messages ("number 3", "an array of 2 elements"): never
+/// the whole of a container, at most 40 characters of a scalar.
+std::string describe(const nlohmann::json& j);
+
+}  // namespace sph::detail

@@ -1,0 +1,137 @@
+#include <sph/scene/scene_writer.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string_view>
+
+#include <sph/core/error.h>
+#include <sph/scene/direction.h>
+#include <sph/scene/scene_keys.h>
+
+namespace sph {
+
+namespace {
+
+using ojson = nlohmann::ordered_json;
+
+/// Builds one object of the scene from the keys declared for it (scene_keys.h), which the
+/// reader also goes through: a key the reader would refuse is a bug found here.
+class ObjectWriter {
+ public:
+  explicit ObjectWriter(const std::vector<std::string>& keys) : keys_(keys) {}
+
+  template <class T>
+  ObjectWriter& put(const std::string& key, T&& value) {
+    SPH_CHECK(std::find(keys_.begin(), keys_.end(), key) != keys_.end(),
+              "scene writer: key \"" + key + "\" is not declared for its object");
+    j_[key] = std::forward<T>(value);
+    return *this;
+  }
+  ojson take() { return std::move(j_); }
+
+ private:
+  const std::vector<std::string>& keys_;
+  ojson j_ = ojson::object();
+};
+
+template <int D>
+ojson vec_json(const Vec<D, double>& v) {
+  ojson a = ojson::array();
+  for (int d = 0; d < D; ++d) a.push_back(v[d]);
+  return a;
+}
+
+template <int D>
+ojson configuration_json(const SceneDesc& desc, const SimulationParams<D>& sim) {
+  const OutputDesc& out = desc.output;
+  ojson formats = ojson::array();
+  for (FrameFormat f : out.formats) formats.push_back(frame_format_name(f));
+  ObjectWriter w(detail::kConfigurationKeys);
+  w.put("precision", detail::name_of(detail::kPrecisionNames, desc.precision))
+      .put("timeStepSize", sim.time_step)
+      .put("numberOfSteps", desc.steps)
+      .put("particleRadius", sim.particle_radius)
+      .put("kernelRadius", sim.kernel_radius)
+      .put("gravitation", vec_json<D>(sim.gravity))
+      .put("neighbors", std::string(to_string(sim.neighbors)))
+      .put("fullRebuildPeriod", sim.full_rebuild_period)
+      .put("verletSkin", sim.verlet_skin)
+      .put("reorderPeriod", sim.reorder_period)
+      .put("outputEveryNSteps", out.every_steps)
+      .put("outputFps", out.fps)
+      .put("outputFormats", std::move(formats))
+      .put("outputFields", out.fields);
+  return w.take();
+}
+
+template <int D>
+ojson fluid_json(const SimulationParams<D>& sim) {
+  const FluidParams& f = sim.fluid;
+  ObjectWriter w(detail::kFluidKeys);
+  w.put("density0", f.rest_density)
+      .put("stiffness", f.stiffness)
+      .put("viscosity", f.viscosity)
+      .put("negativePressure", detail::name_of(detail::kNegativePressureNames, f.negative_pressure))
+      .put("pressureForce", detail::name_of(detail::kPressureForceNames, f.pressure_force))
+      .put("gradientCorrection", detail::name_of(detail::kGradientCorrectionNames, f.gradient_correction))
+      .put("particleMass", sim.particle_mass);
+  return w.take();
+}
+
+template <int D>
+ojson emitter_json(const EmitterParams<D>& e) {
+  const std::vector<std::string> keys = detail::emitter_keys(D);
+  ObjectWriter w(keys);
+  w.put("translation", vec_json<D>(e.origin))
+      .put("direction", vec_json<D>(detail::direction_giving<D>(e.direction)))
+      .put("velocity", e.speed)
+      .put("width", e.width);
+  if constexpr (D == 3) w.put("height", e.height);
+  w.put("emitEveryNSteps", e.every_steps).put("maxParticles", e.max_particles).put("emitStartTime", e.start_time);
+  if (std::isfinite(e.end_time)) w.put("emitEndTime", e.end_time);  // JSON has no infinity: absent is never
+  return w.take();
+}
+
+template <int D>
+void write_body(const SceneDesc& desc, const SceneBody<D>& body, ObjectWriter& root) {
+  const SimulationParams<D>& sim = body.sim;
+  ojson blocks = ojson::array(), obstacles = ojson::array(), emitters = ojson::array();
+  for (const FluidBlockDesc<D>& b : body.blocks)
+    blocks.push_back(ObjectWriter(detail::kFluidBlockKeys)
+                         .put("start", vec_json<D>(b.box.lo))
+                         .put("end", vec_json<D>(b.box.hi))
+                         .put("velocity", vec_json<D>(b.velocity))
+                         .take());
+  for (const Box<D>& o : sim.obstacles)
+    obstacles.push_back(
+        ObjectWriter(detail::kObstacleKeys).put("start", vec_json<D>(o.lo)).put("end", vec_json<D>(o.hi)).take());
+  for (const EmitterParams<D>& e : sim.emitters) emitters.push_back(emitter_json<D>(e));
+  root.put("Configuration", configuration_json<D>(desc, sim))
+      .put("Fluid", fluid_json<D>(sim))
+      .put("Container", ObjectWriter(detail::kContainerKeys)
+                            .put("start", vec_json<D>(sim.container.lo))
+                            .put("end", vec_json<D>(sim.container.hi))
+                            .put("wallStiffness", sim.walls.stiffness)
+                            .put("wallDamping", sim.walls.damping)
+                            .take())
+      .put("FluidBlocks", std::move(blocks))
+      .put("Obstacles", std::move(obstacles))
+      .put("Emitters", std::move(emitters));
+}
+
+}  // namespace
+
+ojson scene_to_json(const SceneDesc& desc) {
+  ObjectWriter root(detail::kRootKeys);
+  root.put("version", desc.version)
+      .put("name", desc.name)
+      .put("description", desc.description)
+      .put("units", "SI")
+      .put("dimension", desc.dimension);
+  desc.visit_body([&]<int D>(const SceneBody<D>& body) { write_body<D>(desc, body, root); });
+  return root.take();
+}
+
+std::string scene_text(const SceneDesc& desc) { return scene_to_json(desc).dump(2); }
+
+}  // namespace sph

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <sph/core/error.h>
+#include <sph/neighbors/neighbor_mode.h>
 #include <sph/solver/time_step.h>
 #include <sph/solver/wcsph.h>
 
@@ -465,8 +466,7 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
                                sim.kernel_radius, kMaxKernelSpacings, 2 * sim.particle_radius,
                                kMaxKernelSpacings * 2.0 * sim.particle_radius));
     sim.gravity = c.vec<D>("gravitation", "the gravity acceleration in m/s^2", default_g);
-    sim.neighbors = parse_neighbor_mode(
-        c.choice("neighbors", {"standard", "adaptive", "verlet", "brute_force"}, "standard"), c.child("neighbors"));
+    sim.neighbors = parse_neighbor_mode(c.choice("neighbors", neighbor_mode_names(), "standard"), c.child("neighbors"));
     sim.full_rebuild_period = static_cast<int>(
         c.integer("fullRebuildPeriod", "a full-rebuild period of at least 1 step", 1, 1'000'000'000, 200));
     sim.reorder_period = static_cast<int>(c.integer("reorderPeriod",

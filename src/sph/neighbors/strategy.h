@@ -37,10 +37,10 @@ class NeighborStrategy {
  public:
   virtual ~NeighborStrategy() = default;
   virtual NeighborMode mode() const = 0;
-  /// Called once per step, before density, with the current positions and velocities and the
-  /// step size: afterwards lists() holds, for each particle, its neighbors for this step.
-  /// Particles may have been appended since the last call (emitters); none are removed.
-  virtual void update(const ParticleSet<D, R>& particles, R dt) = 0;
+  /// Called once per step, before density, with the current positions: afterwards lists()
+  /// holds, for each particle, its neighbors for this step. Particles may have been appended
+  /// since the last call (emitters); none are removed.
+  virtual void update(const ParticleSet<D, R>& particles) = 0;
   virtual const NeighborLists& lists() const = 0;
   /// Counters of the last update().
   virtual const NeighborCounters& counters() const = 0;

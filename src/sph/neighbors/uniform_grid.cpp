@@ -47,7 +47,6 @@ void UniformGrid<D, R>::build(std::span<const V> positions, R radius) {
   }
 
   origin_ = lo;
-  cell_size_ = cs;
   inv_cell_ = R(1) / cs;
   std::size_t cells = 1;
   for (int d = 0; d < D; ++d) {

@@ -76,6 +76,11 @@ class UniformGrid {
   static constexpr std::size_t kMaxCellsPerPoint = 8;
 
  private:
+  /// Sets origin_, inv_cell_ and dims_ for `positions` (cells of size >= radius, at most
+  /// kMaxCellsPerPoint per point plus a constant); returns the number of cells.
+  std::size_t lay_out_cells(std::span<const V> positions, R radius);
+  /// Fills cell_of_, cell_start_ and sorted_ (a stable counting sort of the points by cell).
+  void sort_by_cell(std::span<const V> positions, std::size_t cells);
   std::array<std::int64_t, D> cell_coords(const V& x) const {
     std::array<std::int64_t, D> c;
     for (int d = 0; d < D; ++d) {

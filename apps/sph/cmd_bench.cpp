@@ -13,6 +13,7 @@
 #include <sph/bench/bench.h>
 #include <sph/core/error.h>
 #include <sph/core/timer.h>
+#include <sph/neighbors/neighbor_mode.h>
 
 #include "commands.h"
 
@@ -25,7 +26,7 @@ struct BenchCliOptions {
   std::string size = "small";
   std::string threads;
   std::string precisions;
-  std::string modes = "standard,adaptive,verlet";
+  std::string modes = join_neighbor_mode_names(NeighborModeSet::Compared, ",", ",");
   int repeats = 5;
   int step_runs = 3;
   std::string output = "out/bench";
@@ -116,7 +117,7 @@ std::function<int()> add_bench_command(CLI::App& app) {
                   "size's, e.g. 10000000")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{2'000'000'000}));
   cmd->add_option("--modes", opt->modes, "Neighbor modes of the steps and tank suites")
-      ->default_str("standard,adaptive,verlet");
+      ->default_str(join_neighbor_mode_names(NeighborModeSet::Compared, ",", ","));
   cmd->add_option("--warmup-steps", opt->warmup_steps,
                   "Steps suite: untimed steps before timing (default: 10 at size small, else 20 to 3 by size)")
       ->check(CLI::Range(std::int64_t{0}, std::int64_t{1'000'000}));

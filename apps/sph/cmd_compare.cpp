@@ -14,6 +14,9 @@
 #include <sph/core/parallel.h>
 #include <sph/core/timer.h>
 #include <sph/run/memory.h>
+#include <sph/io/atomic_file.h>
+#include <sph/io/frames.h>
+#include <sph/neighbors/neighbor_mode.h>
 #include <sph/scene/scene_reader.h>
 
 #include "commands.h"
@@ -27,7 +30,7 @@ namespace fs = std::filesystem;
 struct CompareCliOptions {
   std::string scene;
   std::string output;
-  std::string modes = "standard,adaptive,verlet";
+  std::string modes = join_neighbor_mode_names(NeighborModeSet::Compared, ",", ",");
   std::int64_t steps = 0;
   int threads = 0;
   int frames = 3;
@@ -43,16 +46,21 @@ std::vector<NeighborMode> parse_modes(const std::string& list) {
   std::stringstream ss(list);
   for (std::string item; std::getline(ss, item, ',');) {
     if (item.empty())
-      throw Error("empty mode name in \"" + list + "\"; expected e.g. standard,adaptive,verlet", "--modes");
+      throw Error("empty mode name in \"" + list + "\"; expected e.g. " +
+                      join_neighbor_mode_names(NeighborModeSet::Compared, ",", ","),
+                  "--modes");
     const NeighborMode m = parse_neighbor_mode(item, "--modes");
     if (m == NeighborMode::BruteForce)
-      throw Error("brute_force is the test oracle, too slow to compare; expected standard, adaptive or verlet",
+      throw Error("brute_force is the test oracle, too slow to compare; expected " +
+                      join_neighbor_mode_names(NeighborModeSet::Compared, ", ", " or "),
                   "--modes");
     if (std::find(modes.begin(), modes.end(), m) != modes.end())
       throw Error("mode \"" + item + "\" is listed twice", "--modes");
     modes.push_back(m);
   }
-  if (modes.empty()) throw Error("no mode given; expected e.g. standard,adaptive,verlet", "--modes");
+  if (modes.empty())
+    throw Error("no mode given; expected e.g. " + join_neighbor_mode_names(NeighborModeSet::Compared, ",", ","),
+                "--modes");
   return modes;
 }
 
@@ -123,7 +131,7 @@ std::function<int()> add_compare_command(CLI::App& app) {
   cmd->add_option("scene", opt->scene, "Scene file (JSON; see docs/scene-format.md)")->required();
   cmd->add_option("-o,--output", opt->output, "Output directory (default: out/<scene name>_compare)");
   cmd->add_option("--modes", opt->modes, "Comma-separated modes to run (standard is always run: it is the reference)")
-      ->default_str("standard,adaptive,verlet");
+      ->default_str(join_neighbor_mode_names(NeighborModeSet::Compared, ",", ","));
   cmd->add_option("--steps", opt->steps, "Number of steps, overriding Configuration.numberOfSteps")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1'000'000'000}));
   cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));

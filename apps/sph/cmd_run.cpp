@@ -19,6 +19,8 @@
 #include <sph/run/driver.h>
 #include <sph/run/resume.h>
 #include <sph/scene/dispatch.h>
+#include <sph/neighbors/neighbor_mode.h>
+#include <sph/scene/builders.h>
 #include <sph/scene/scene_reader.h>
 
 #include "commands.h"
@@ -280,7 +282,7 @@ std::function<int()> add_run_command(CLI::App& app) {
   cmd->add_option("scene", opt->scene, "Scene file (JSON; see docs/scene-format.md); required unless --resume");
   cmd->add_option("-o,--output", opt->output, "Output directory (default: out/<scene name>)");
   cmd->add_option("--neighbors", opt->neighbors, "Neighbor strategy, overriding the scene's Configuration.neighbors")
-      ->check(CLI::IsMember({"standard", "adaptive", "verlet", "brute_force"}));
+      ->check(CLI::IsMember(neighbor_mode_names()));
   cmd->add_option("--steps", opt->steps, "Number of steps, overriding Configuration.numberOfSteps")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1'000'000'000'000}));
   cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));

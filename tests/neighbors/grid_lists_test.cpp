@@ -38,7 +38,7 @@ class GridLists : public ::testing::Test {
     ParticleSet<D, R> ps;
     for (const V& p : x) ps.add(p, V{}, R(1));
     StandardNeighbors<D, R> grid(radius);
-    grid.update(ps, R(0));
+    grid.update(ps);
     const NeighborLists bf = brute_force_lists<D, R>(ps.position, radius);
     const NeighborLists& gl = grid.lists();
     ASSERT_EQ(gl.particle_count(), x.size());
@@ -126,10 +126,10 @@ TYPED_TEST(GridLists, SameListsForAnyThreadCount) {
   for (const auto& p : this->random_points(5000, 0, 1, 7)) ps.add(p, {}, R(1));
   set_num_threads(1);
   StandardNeighbors<D, R> one(R(0.05));
-  one.update(ps, R(0));
+  one.update(ps);
   set_num_threads(2);
   StandardNeighbors<D, R> two(R(0.05));
-  two.update(ps, R(0));
+  two.update(ps);
   EXPECT_TRUE(one.lists() == two.lists());
 }
 

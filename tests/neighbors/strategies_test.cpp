@@ -48,7 +48,7 @@ constexpr double kH = 0.1;
 TEST(Adaptive, FirstUpdateBuildsEveryListExactly) {
   auto ps = random_particles(3000, 1.0, 1);
   AdaptiveNeighbors<3, double> a(kH, 200);
-  a.update(ps, 0.01);
+  a.update(ps);
   const NeighborLists bf = brute_force_lists<3, double>(ps.position, kH);
   EXPECT_EQ(a.counters().lists_rebuilt, ps.size());
   ASSERT_EQ(a.lists().entry_count(), bf.entry_count());
@@ -60,19 +60,19 @@ TEST(Adaptive, FirstUpdateBuildsEveryListExactly) {
 TEST(Adaptive, RebuildsOnlyFlaggedListsAndKeepsTheOthers) {
   auto ps = random_particles(3000, 1.0, 2);
   AdaptiveNeighbors<3, double> a(kH, 200);
-  a.update(ps, 0.01);
+  a.update(ps);
   const NeighborLists before = a.lists();
 
   // Nothing flagged: the particles moved, but no list changes and nothing is rebuilt.
   jitter(ps, 0.02, 3);
-  a.update(ps, 0.01);
+  a.update(ps);
   EXPECT_EQ(a.counters().lists_rebuilt, 0u);
   EXPECT_EQ(a.lists(), before);
 
   // Flag a few: exactly their lists are rebuilt, at the current positions.
   const std::vector<std::size_t> flagged{0, 17, 1023, 1024, 2999};
   for (std::size_t i : flagged) a.pair_exit_flags()[i] = 1;
-  a.update(ps, 0.01);
+  a.update(ps);
   EXPECT_EQ(a.counters().lists_rebuilt, flagged.size());
   const NeighborLists now = brute_force_lists<3, double>(ps.position, kH);
   std::size_t changed = 0;
@@ -93,17 +93,17 @@ TEST(Adaptive, RebuildsOnlyFlaggedListsAndKeepsTheOthers) {
 TEST(Adaptive, AppendedParticlesGetListsAndFullRebuildComesOnSchedule) {
   auto ps = random_particles(500, 0.5, 4);
   AdaptiveNeighbors<3, double> a(kH, 3);
-  a.update(ps, 0.01);  // update 0: full
+  a.update(ps);  // update 0: full
   for (int k = 0; k < 20; ++k) ps.add(V3{0.25 + 0.001 * k, 0.25, 0.25}, V3{}, 1.0);
-  a.update(ps, 0.01);  // update 1: only the 20 new particles
+  a.update(ps);  // update 1: only the 20 new particles
   EXPECT_EQ(a.counters().lists_rebuilt, 20u);
   ASSERT_EQ(a.lists().particle_count(), ps.size());
   const NeighborLists bf = brute_force_lists<3, double>(ps.position, kH);
   for (std::size_t i = 500; i < ps.size(); ++i) EXPECT_EQ(sorted(a.lists().of(i)), sorted(bf.of(i)));
-  a.update(ps, 0.01);  // update 2: nothing flagged
+  a.update(ps);  // update 2: nothing flagged
   EXPECT_EQ(a.counters().lists_rebuilt, 0u);
   jitter(ps, 0.01, 5);
-  a.update(ps, 0.01);  // update 3: the period's full rebuild
+  a.update(ps);  // update 3: the period's full rebuild
   EXPECT_EQ(a.counters().lists_rebuilt, ps.size());
   const NeighborLists bf2 = brute_force_lists<3, double>(ps.position, kH);
   for (std::size_t i = 0; i < ps.size(); ++i) ASSERT_EQ(sorted(a.lists().of(i)), sorted(bf2.of(i)));
@@ -116,10 +116,10 @@ TEST(Adaptive, PartialRebuildIsIdenticalForAnyThreadCount) {
     set_num_threads(t);
     auto ps = random_particles(5000, 1.0, 6);
     AdaptiveNeighbors<3, double> a(kH, 200);
-    a.update(ps, 0.01);
+    a.update(ps);
     jitter(ps, 0.02, 7);
     for (std::size_t i = 0; i < ps.size(); i += 7) a.pair_exit_flags()[i] = 1;
-    a.update(ps, 0.01);
+    a.update(ps);
     result[t - 1] = a.lists();
   }
   EXPECT_EQ(result[0], result[1]);
@@ -130,7 +130,7 @@ TEST(Verlet, NeverMissesAPairWithinHAndRebuildsAtHalfTheSkin) {
   const double skin = 0.02;
   VerletNeighbors<3, double> v(kH, skin);
   ListAuditor<3, double> auditor;
-  v.update(ps, 0.01);
+  v.update(ps);
   EXPECT_EQ(v.counters().lists_rebuilt, ps.size());
   // Lists hold exactly the pairs within h + skin.
   const NeighborLists wide = brute_force_lists<3, double>(ps.position, kH + skin);
@@ -146,7 +146,7 @@ TEST(Verlet, NeverMissesAPairWithinHAndRebuildsAtHalfTheSkin) {
     for (auto& x : ps.position) x += V3{u(rng), u(rng), u(rng)};
     double max_move = 0;
     for (std::size_t i = 0; i < ps.size(); ++i) max_move = std::max(max_move, norm(ps.position[i] - built[i]));
-    v.update(ps, 0.01);
+    v.update(ps);
     if (v.counters().lists_rebuilt > 0) {
       ++rebuilds;
       EXPECT_GT(max_move, 0.4999 * skin) << "rebuilt before any particle moved skin / 2";
@@ -165,11 +165,11 @@ TEST(Verlet, NeverMissesAPairWithinHAndRebuildsAtHalfTheSkin) {
 TEST(Verlet, RebuildsWhenParticlesAreAdded) {
   auto ps = random_particles(300, 0.5, 10);
   VerletNeighbors<3, double> v(kH, 0.02);
-  v.update(ps, 0.01);
-  v.update(ps, 0.01);
+  v.update(ps);
+  v.update(ps);
   EXPECT_EQ(v.counters().lists_rebuilt, 0u);
   ps.add(V3{0.25, 0.25, 0.25}, V3{}, 1.0);
-  v.update(ps, 0.01);
+  v.update(ps);
   EXPECT_EQ(v.counters().lists_rebuilt, ps.size());
   EXPECT_EQ(v.lists().particle_count(), ps.size());
 }
@@ -201,10 +201,10 @@ TEST(Audit, FindsWhatAdaptiveListsMissWhenParticlesApproach) {
   ps.add(V3{0.15, 0, 0}, V3{}, 1.0);
   AdaptiveNeighbors<3, double> a(kH, 200);
   ListAuditor<3, double> auditor;
-  a.update(ps, 0.01);
+  a.update(ps);
   EXPECT_EQ(a.lists().entry_count(), 0u);
   ps.position[1][0] = 0.05;
-  a.update(ps, 0.01);
+  a.update(ps);
   const ListAudit audit = auditor.audit(ps.position, a.lists(), kH);
   EXPECT_EQ(audit.missed_pairs, 2u);
   EXPECT_NEAR(audit.max_penetration, 0.5, 1e-12);

@@ -400,8 +400,8 @@ TEST(Walls, ContactForceIsNeverAttractive) {
   p.walls.damping = 1e4;  // strong damping: a plain damped spring would pull a leaving particle back
   ParticleSet<2, double> ps;
   ps.add({{0.5, 0.005}}, {{0, 3.0}}, p.particle_mass);  // inside the contact zone, moving away
-  add_wall_accelerations(ps, p.container, p.obstacles, 0.01, p.walls);
-  EXPECT_GE(ps.acceleration[0][1], 0.0);
+  const WallContact<2, double> contact(p.container, p.obstacles, 0.01, p.walls);
+  EXPECT_GE(contact(ps.position[0], ps.velocity[0])[1], 0.0);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// Paper Eq. 7 inside the density pass: exactly the particles of listed pairs whose predicted
+// Paper Eq. 7 inside the force pass: exactly the particles of listed pairs whose predicted
 // distance |x_i - x_j + dt (u_i - u_j)| exceeds h are flagged, both i and j, even when only
 // one of them lists the other; the pairs-within-h count; and the simulation-level contract
 // that adaptive with a full-rebuild period of 1 is the standard algorithm, bit for bit.
@@ -34,7 +34,9 @@ TEST(PairExitTest, FlagsBothParticlesOfExactlyThePairsPredictedToLeave) {
   fluid.stiffness = 1;
   const std::uint64_t within = compute_density_pressure<2, double>(ps, lists, h, fluid);
   // The Eq. 7 test runs in the force pass, which gathers every neighbor's velocity anyway.
-  compute_fluid_accelerations<2, double>(ps, lists, h, fluid, V2{}, flags, dt);
+  const std::vector<Box<2>> no_obstacles;
+  const WallContact<2, double> no_walls({V2{-100, -100}, V2{100, 100}}, no_obstacles, 0.0, WallParams{});
+  compute_accelerations<2, double>(ps, lists, h, fluid, V2{}, no_walls, flags, dt);
   const std::vector<std::uint8_t> expected{1, 1, 0, 0, 0, 0, 1, 1};
   EXPECT_EQ(flags, expected);
   // Listed pairs closer than h: 0->1 (0.9), 0->2 (0.5), 2->0, 4->5 (0.4), 5->4, 7->6 (0.5).
@@ -42,10 +44,10 @@ TEST(PairExitTest, FlagsBothParticlesOfExactlyThePairsPredictedToLeave) {
 
   // Without flags the test is skipped and the forces are the same; flags are only ever set.
   const auto acc_with_test = ps.acceleration;
-  compute_fluid_accelerations<2, double>(ps, lists, h, fluid, V2{});
+  compute_accelerations<2, double>(ps, lists, h, fluid, V2{}, no_walls);
   EXPECT_TRUE(ps.acceleration == acc_with_test);
   std::vector<std::uint8_t> all(ps.size(), 1);
-  compute_fluid_accelerations<2, double>(ps, lists, h, fluid, V2{}, all, dt);
+  compute_accelerations<2, double>(ps, lists, h, fluid, V2{}, no_walls, all, dt);
   EXPECT_EQ(all, std::vector<std::uint8_t>(ps.size(), 1));
 }
 

@@ -18,7 +18,7 @@ namespace sph {
 struct CompareOptions {
   /// Modes to run; the first standard run is the reference. "standard" is added in front if
   /// missing (every comparison is against it).
-  std::vector<NeighborMode> modes{NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet};
+  std::vector<NeighborMode> modes = neighbor_modes(NeighborModeSet::Compared);
   std::int64_t steps = 0;  ///< steps per run (the scene's numberOfSteps when 0)
   int samples = 100;       ///< positions are compared at about this many steps
   int frames = 3;          ///< side-by-side images at this many evenly spaced steps

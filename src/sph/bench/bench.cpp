@@ -8,6 +8,7 @@
 
 #include <sph/core/error.h>
 #include <sph/io/atomic_file.h>
+#include <sph/neighbors/neighbor_mode.h>
 #include <sph/scene/scene_reader.h>
 
 #ifndef SPH_BENCH_SCENE_DIR
@@ -128,8 +129,11 @@ std::vector<Precision> parse_precisions(std::string_view list, const std::string
 std::vector<NeighborMode> parse_bench_modes(std::string_view list, const std::string& where) {
   std::vector<NeighborMode> out;
   for (std::string_view item : split(list)) {
-    if (item != "standard" && item != "adaptive" && item != "verlet")
-      throw Error(fmt::format("unknown neighbor mode \"{}\"; expected standard, adaptive or verlet", item), where);
+    const std::vector<std::string> accepted = neighbor_mode_names(NeighborModeSet::Compared);
+    if (std::find(accepted.begin(), accepted.end(), item) == accepted.end())
+      throw Error(fmt::format("unknown neighbor mode \"{}\"; expected {}", item,
+                              join_neighbor_mode_names(NeighborModeSet::Compared, ", ", " or ")),
+                  where);
     const NeighborMode m = parse_neighbor_mode(item, where);
     if (std::find(out.begin(), out.end(), m) == out.end()) out.push_back(m);
   }
@@ -151,10 +155,13 @@ void validate_bench_options(const BenchOptions& o) {
   if (o.warmup_steps < -1) throw Error("expected 0 or more warm-up steps", "--warmup-steps");
   if (o.timed_steps == 0 || o.timed_steps < -1) throw Error("expected 1 or more timed steps", "--timed-steps");
   if (o.tank_steps < 0) throw Error("expected 1 or more steps", "--steps");
-  if (o.modes.empty()) throw Error("no neighbor mode; expected standard, adaptive and/or verlet", "--modes");
+  if (o.modes.empty())
+    throw Error("no neighbor mode; expected " + join_neighbor_mode_names(NeighborModeSet::Compared, ", ", " and/or "),
+                "--modes");
   for (NeighborMode m : o.modes)
     if (m == NeighborMode::BruteForce)
-      throw Error("brute_force is the test oracle, too slow to benchmark; expected standard, adaptive or verlet",
+      throw Error("brute_force is the test oracle, too slow to benchmark; expected " +
+                      join_neighbor_mode_names(NeighborModeSet::Compared, ", ", " or "),
                   "--modes");
   if (std::find(o.suites.begin(), o.suites.end(), "tank") != o.suites.end()) {
     // Refuse a missing or broken tank scene before anything runs or is written.

@@ -43,7 +43,7 @@ struct BenchOptions {
   std::int64_t warmup_steps = -1;     ///< steps: untimed steps before timing (-1: by size)
   std::int64_t timed_steps = -1;      ///< steps: timed steps (-1: by size)
   std::int64_t tank_steps = 0;        ///< tank: steps per run (0: the scene's, or 1000 at size small)
-  std::vector<NeighborMode> modes{NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet};
+  std::vector<NeighborMode> modes = neighbor_modes(NeighborModeSet::Compared);
   std::filesystem::path scene_dir;  ///< tank: directory of tank_fill_3d.json (empty: default_scene_dir())
 };
 

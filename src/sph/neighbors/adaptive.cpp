@@ -15,7 +15,7 @@ AdaptiveNeighbors<D, R>::AdaptiveNeighbors(R radius, int full_rebuild_period)
 }
 
 template <int D, std::floating_point R>
-void AdaptiveNeighbors<D, R>::update(const ParticleSet<D, R>& particles, R /*dt*/) {
+void AdaptiveNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
   // Algorithm 2. The Eq. 7 test itself runs in the solver's force pass, which sets flags_.
   Stopwatch watch;
   const std::size_t n = particles.size();

@@ -9,9 +9,10 @@ namespace sph {
 
 /// Adaptive neighbor pairing. One flag per particle, set at the start and for every particle
 /// added later. Each update() rebuilds the lists of the flagged particles (all of them every
-/// `full_rebuild_period` steps) from a fresh grid and clears their flags; the solver's density
+/// `full_rebuild_period` steps) from a fresh grid and clears their flags; the solver's force
 /// pass then sets the flags of both particles of any listed pair whose predicted distance
-/// after the step, |x_i - x_j + dt (u_i - u_j)| (Eq. 7), exceeds h (pair_exit_flags()).
+/// after the step, |x_i - x_j + dt (u_i - u_j)| (Eq. 7, with the solver's step size dt),
+/// exceeds h (pair_exit_flags()).
 ///
 /// The test only watches pairs that are listed: a particle coming into range of a particle
 /// whose list is not rebuilt is missed until the next rebuild of that list. Lists can also be
@@ -26,7 +27,7 @@ class AdaptiveNeighbors final : public NeighborStrategy<D, R> {
  public:
   AdaptiveNeighbors(R radius, int full_rebuild_period);
   NeighborMode mode() const override { return NeighborMode::Adaptive; }
-  void update(const ParticleSet<D, R>& particles, R dt) override;
+  void update(const ParticleSet<D, R>& particles) override;
   const NeighborLists& lists() const override { return lists_; }
   const NeighborCounters& counters() const override { return counters_; }
   std::span<std::uint8_t> pair_exit_flags() override { return flags_; }

@@ -1,17 +1,10 @@
 #include <sph/neighbors/list_builder.h>
 
 #include <algorithm>
-#include <cstring>
-
-#if defined(__AVX512F__) && defined(__AVX512VL__)
-#include <immintrin.h>
-#define SPH_HAVE_AVX512 1
-#else
-#define SPH_HAVE_AVX512 0
-#endif
 
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
+#include <sph/core/simd.h>  // SPH_SIMD_AVX512 and, where it is 1, <immintrin.h>
 
 namespace sph {
 
@@ -59,7 +52,7 @@ std::uint32_t gather_scalar(const UniformGrid<D, R>& grid, const Stencil<D, R>& 
   return m;
 }
 
-#if SPH_HAVE_AVX512
+#if SPH_SIMD_AVX512
 template <int D>
 std::uint32_t gather_vector(const UniformGrid<D, double>& grid, const Stencil<D, double>& st, const Vec<D, double>& x,
                             std::uint32_t self, double r2, std::uint32_t* out) {
@@ -125,7 +118,7 @@ std::uint32_t gather_vector(const UniformGrid<D, float>& grid, const Stencil<D, 
 template <int D, std::floating_point R>
 std::uint32_t gather(bool vector, const UniformGrid<D, R>& grid, const Stencil<D, R>& st, const Vec<D, R>& x,
                      std::uint32_t self, R r2, std::uint32_t* out) {
-#if SPH_HAVE_AVX512
+#if SPH_SIMD_AVX512
   if (vector) return gather_vector<D>(grid, st, x, self, r2, out);
 #else
   (void)vector;
@@ -147,11 +140,6 @@ constexpr std::size_t kRoom = 16;
 static_assert(kRoom >= NeighborLists::kPadding);
 
 }  // namespace
-
-template <int D, std::floating_point R>
-bool ListBuilder<D, R>::vector_kernel_available() {
-  return SPH_HAVE_AVX512 != 0;
-}
 
 template <int D, std::floating_point R>
 void ListBuilder<D, R>::build(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> positions, R radius,

@@ -31,10 +31,8 @@ class ListBuilder {
   void rebuild_some(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> positions, R radius,
                     std::span<const std::uint8_t> rebuild, NeighborLists& lists);
 
-  /// Whether this build has the vector (AVX-512) distance kernel.
-  static bool vector_kernel_available();
-  /// Uses the vector kernel when available (default) or the portable scalar one (tests check
-  /// that both give the same lists).
+  /// Uses the vector kernel where the build has one (SPH_SIMD_AVX512, default) or the portable
+  /// scalar one (tests check that both give the same lists).
   void use_vector_kernel(bool on) { vector_ = on; }
 
  private:

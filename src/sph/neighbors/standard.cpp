@@ -11,7 +11,7 @@ StandardNeighbors<D, R>::StandardNeighbors(R radius) : radius_(radius) {
 }
 
 template <int D, std::floating_point R>
-void StandardNeighbors<D, R>::update(const ParticleSet<D, R>& particles, R /*dt*/) {
+void StandardNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
   Stopwatch watch;
   grid_.build(particles.position, radius_);
   counters_.grid_seconds = watch.lap();
@@ -38,7 +38,7 @@ BruteForceNeighbors<D, R>::BruteForceNeighbors(R radius) : radius_(radius) {
 }
 
 template <int D, std::floating_point R>
-void BruteForceNeighbors<D, R>::update(const ParticleSet<D, R>& particles, R /*dt*/) {
+void BruteForceNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
   Stopwatch watch;
   lists_ = brute_force_lists<D, R>(particles.position, radius_);
   counters_.grid_seconds = 0;

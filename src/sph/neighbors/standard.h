@@ -12,7 +12,7 @@ class StandardNeighbors final : public NeighborStrategy<D, R> {
  public:
   explicit StandardNeighbors(R radius);
   NeighborMode mode() const override { return NeighborMode::Standard; }
-  void update(const ParticleSet<D, R>& particles, R dt) override;
+  void update(const ParticleSet<D, R>& particles) override;
   const NeighborLists& lists() const override { return lists_; }
   const NeighborCounters& counters() const override { return counters_; }
   void invalidate() override {}  // every update rebuilds everything anyway
@@ -31,7 +31,7 @@ class BruteForceNeighbors final : public NeighborStrategy<D, R> {
  public:
   explicit BruteForceNeighbors(R radius);
   NeighborMode mode() const override { return NeighborMode::BruteForce; }
-  void update(const ParticleSet<D, R>& particles, R dt) override;
+  void update(const ParticleSet<D, R>& particles) override;
   const NeighborLists& lists() const override { return lists_; }
   const NeighborCounters& counters() const override { return counters_; }
   void invalidate() override {}  // every update rebuilds everything anyway

@@ -7,30 +7,6 @@
 
 namespace sph {
 
-std::string_view to_string(NeighborMode mode) {
-  switch (mode) {
-    case NeighborMode::Standard:
-      return "standard";
-    case NeighborMode::Adaptive:
-      return "adaptive";
-    case NeighborMode::Verlet:
-      return "verlet";
-    case NeighborMode::BruteForce:
-      return "brute_force";
-  }
-  return "unknown";
-}
-
-NeighborMode parse_neighbor_mode(std::string_view name, const std::string& where) {
-  if (name == "standard") return NeighborMode::Standard;
-  if (name == "adaptive") return NeighborMode::Adaptive;
-  if (name == "verlet") return NeighborMode::Verlet;
-  if (name == "brute_force") return NeighborMode::BruteForce;
-  throw Error("unknown neighbor mode \"" + std::string(name) +
-                  "\"; expected one of \"standard\", \"adaptive\", \"verlet\", \"brute_force\"",
-              where);
-}
-
 template <int D, std::floating_point R>
 std::unique_ptr<NeighborStrategy<D, R>> make_neighbor_strategy(NeighborMode mode, const NeighborOptions& options) {
   const R radius = static_cast<R>(options.radius);

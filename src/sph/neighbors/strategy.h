@@ -2,25 +2,16 @@
 /// \file NeighborStrategy: the policy interface the solver calls once per step.
 
 #include <memory>
-#include <string>
-#include <string_view>
+#include <span>
 
 #include <sph/core/particle_set.h>
 #include <sph/neighbors/neighbor_lists.h>
+#include <sph/neighbors/neighbor_mode.h>
 
 namespace sph {
 
 class StateWriter;
 class StateReader;
-
-/// Neighbor strategies. `standard` rebuilds every list every step (paper Section 4);
-/// `adaptive` is the paper's Algorithm 2; `verlet` keeps exact lists with a skin radius.
-enum class NeighborMode { Standard, Adaptive, Verlet, BruteForce };
-
-/// "standard", "adaptive", "verlet" or "brute_force".
-std::string_view to_string(NeighborMode mode);
-/// Parses a mode name; throws sph::Error naming the accepted values otherwise.
-NeighborMode parse_neighbor_mode(std::string_view name, const std::string& where = {});
 
 /// What one update() did.
 struct NeighborCounters {
@@ -46,10 +37,10 @@ class NeighborStrategy {
  public:
   virtual ~NeighborStrategy() = default;
   virtual NeighborMode mode() const = 0;
-  /// Called once per step, before density, with the current positions and velocities and the
-  /// step size: afterwards lists() holds, for each particle, its neighbors for this step.
-  /// Particles may have been appended since the last call (emitters); none are removed.
-  virtual void update(const ParticleSet<D, R>& particles, R dt) = 0;
+  /// Called once per step, before density, with the current positions: afterwards lists()
+  /// holds, for each particle, its neighbors for this step. Particles may have been appended
+  /// since the last call (emitters); none are removed.
+  virtual void update(const ParticleSet<D, R>& particles) = 0;
   virtual const NeighborLists& lists() const = 0;
   /// Counters of the last update().
   virtual const NeighborCounters& counters() const = 0;

@@ -13,8 +13,21 @@ template <int D, std::floating_point R>
 void UniformGrid<D, R>::build(std::span<const V> positions, R radius) {
   SPH_CHECK(radius > R(0) && std::isfinite(radius), "grid radius must be positive and finite");
   SPH_CHECK(positions.size() < std::numeric_limits<std::uint32_t>::max(), "too many points for 32-bit indices");
+  const std::size_t cells = lay_out_cells(positions, radius);
+  sort_by_cell(positions, cells);
+  // Coordinates in sorted order, one array per axis.
   const std::size_t n = positions.size();
+  for (auto& c : coords_) c.resize(n + kPad);
+  parallel_for(n, [&](std::size_t k) {
+    const V& x = positions[sorted_[k]];
+    for (int d = 0; d < D; ++d) coords_[static_cast<std::size_t>(d)][k] = x[d];
+  });
+  for (auto& c : coords_) std::fill(c.begin() + static_cast<std::ptrdiff_t>(n), c.end(), R(0));
+}
 
+template <int D, std::floating_point R>
+std::size_t UniformGrid<D, R>::lay_out_cells(std::span<const V> positions, R radius) {
+  const std::size_t n = positions.size();
   // Bounding box (min/max are exact, so the result does not depend on evaluation order).
   V lo = V::filled(R(0)), hi = V::filled(R(0));
   if (n > 0) {
@@ -47,7 +60,6 @@ void UniformGrid<D, R>::build(std::span<const V> positions, R radius) {
   }
 
   origin_ = lo;
-  cell_size_ = cs;
   inv_cell_ = R(1) / cs;
   std::size_t cells = 1;
   for (int d = 0; d < D; ++d) {
@@ -56,7 +68,12 @@ void UniformGrid<D, R>::build(std::span<const V> positions, R radius) {
   }
 
   SPH_CHECK(cells < std::numeric_limits<std::uint32_t>::max(), "too many grid cells for 32-bit cell indices");
+  return cells;
+}
 
+template <int D, std::floating_point R>
+void UniformGrid<D, R>::sort_by_cell(std::span<const V> positions, std::size_t cells) {
+  const std::size_t n = positions.size();
   // Counting sort by cell, stable in the point index.
   cell_of_.resize(n);
   parallel_for(n, [&](std::size_t i) { cell_of_[i] = static_cast<std::uint32_t>(linear(cell_coords(positions[i]))); });
@@ -101,14 +118,6 @@ void UniformGrid<D, R>::build(std::span<const V> positions, R radius) {
     cell_start_[0] = 0;
   }
   std::fill(sorted_.begin() + static_cast<std::ptrdiff_t>(n), sorted_.end(), 0u);
-
-  // Coordinates in sorted order, one array per axis.
-  for (auto& c : coords_) c.resize(n + kPad);
-  parallel_for(n, [&](std::size_t k) {
-    const V& x = positions[sorted_[k]];
-    for (int d = 0; d < D; ++d) coords_[static_cast<std::size_t>(d)][k] = x[d];
-  });
-  for (auto& c : coords_) std::fill(c.begin() + static_cast<std::ptrdiff_t>(n), c.end(), R(0));
 }
 
 template class UniformGrid<2, float>;

@@ -25,8 +25,6 @@ class UniformGrid {
   /// Sorts `positions` into cells of size >= radius. radius must be > 0 and finite.
   void build(std::span<const V> positions, R radius);
 
-  R cell_size() const { return cell_size_; }
-  std::size_t cell_count() const { return cell_start_.empty() ? 0 : cell_start_.size() - 1; }
   const std::array<std::int64_t, D>& dims() const { return dims_; }
 
   /// Cell (linear index) of point i, as built.
@@ -74,34 +72,15 @@ class UniformGrid {
     return k;
   }
 
-  /// Calls f(j) for every point j (index into the built positions) in the 3^D cells around x,
-  /// in a deterministic order. Candidates may be farther than the radius: callers test distance.
-  template <class F>
-  void for_each_candidate(const V& x, F&& f) const {
-    std::array<std::int64_t, D> c = cell_coords(x);
-    std::array<std::int64_t, D> lo, hi;
-    for (int d = 0; d < D; ++d) {
-      lo[d] = c[d] > 0 ? c[d] - 1 : 0;
-      hi[d] = c[d] + 1 < dims_[d] ? c[d] + 1 : dims_[d] - 1;
-    }
-    if constexpr (D == 2) {
-      for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
-        const std::int64_t row = y * dims_[0];
-        visit_range(row + lo[0], row + hi[0], f);
-      }
-    } else {
-      for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
-        for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
-          const std::int64_t row = (z * dims_[1] + y) * dims_[0];
-          visit_range(row + lo[0], row + hi[0], f);
-        }
-    }
-  }
-
   /// Maximum number of dense cells, relative to the point count (plus a constant).
   static constexpr std::size_t kMaxCellsPerPoint = 8;
 
  private:
+  /// Sets origin_, inv_cell_ and dims_ for `positions` (cells of size >= radius, at most
+  /// kMaxCellsPerPoint per point plus a constant); returns the number of cells.
+  std::size_t lay_out_cells(std::span<const V> positions, R radius);
+  /// Fills cell_of_, cell_start_ and sorted_ (a stable counting sort of the points by cell).
+  void sort_by_cell(std::span<const V> positions, std::size_t cells);
   std::array<std::int64_t, D> cell_coords(const V& x) const {
     std::array<std::int64_t, D> c;
     for (int d = 0; d < D; ++d) {
@@ -115,16 +94,7 @@ class UniformGrid {
     for (int d = D - 2; d >= 0; --d) l = l * dims_[d] + c[d];
     return static_cast<std::size_t>(l);
   }
-  template <class F>
-  void visit_range(std::int64_t first_cell, std::int64_t last_cell, F& f) const {
-    // Cells of one row are contiguous in the sorted order: one loop covers the whole row.
-    const std::uint32_t b = cell_start_[static_cast<std::size_t>(first_cell)];
-    const std::uint32_t e = cell_start_[static_cast<std::size_t>(last_cell) + 1];
-    for (std::uint32_t k = b; k < e; ++k) f(sorted_[k]);
-  }
-
   V origin_{};
-  R cell_size_ = 0;
   R inv_cell_ = 0;
   std::array<std::int64_t, D> dims_{};
   std::vector<std::uint32_t> cell_start_;  // size cells + 1

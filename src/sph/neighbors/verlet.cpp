@@ -17,7 +17,7 @@ VerletNeighbors<D, R>::VerletNeighbors(R radius, R skin) : radius_(radius), skin
 }
 
 template <int D, std::floating_point R>
-void VerletNeighbors<D, R>::update(const ParticleSet<D, R>& particles, R /*dt*/) {
+void VerletNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
   Stopwatch watch;
   const std::size_t n = particles.size();
   bool rebuild = n != built_at_.size() || lists_.particle_count() != n;

@@ -17,7 +17,7 @@ class VerletNeighbors final : public NeighborStrategy<D, R> {
  public:
   VerletNeighbors(R radius, R skin);
   NeighborMode mode() const override { return NeighborMode::Verlet; }
-  void update(const ParticleSet<D, R>& particles, R dt) override;
+  void update(const ParticleSet<D, R>& particles) override;
   const NeighborLists& lists() const override { return lists_; }
   const NeighborCounters& counters() const override { return counters_; }
   void invalidate() override { built_at_.clear(); }  // the next update rebuilds

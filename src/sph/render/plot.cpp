@@ -158,9 +158,31 @@ class DashPen {
   double phase_ = 0.0;
 };
 
-}  // namespace
+/// Where everything goes: text sizes, the plot area in pixels and its two axes.
+struct PlotLayout {
+  bool log_y = false;
+  int ts = 1, th = 0, pad = 0;  ///< text scale, text height, padding
+  int left = 0, top = 0, plot_w = 0, plot_h = 0;
+  int x_label_top = 0;  ///< top of the x tick labels
+  Axis x_axis, y_axis;
 
-Image render_plot(const PlotSpec& spec, int width, int height) {
+  /// Pixel coordinates of data values.
+  double sx(double x) const { return double(left) + (x - x_axis.lo) / (x_axis.hi - x_axis.lo) * double(plot_w); }
+  double sy(double y) const { return sy_axis(log_y ? std::log10(y) : y); }
+  /// Pixel row of a value in y-axis units (log10 of the data on a log axis).
+  double sy_axis(double v) const {
+    return double(top) + double(plot_h) - (v - y_axis.lo) / (y_axis.hi - y_axis.lo) * double(plot_h);
+  }
+};
+
+/// Pixel coordinate of a grid line or tick: a value range that overflows (e.g. -1e308 .. 1e308)
+/// gives NaN or inf, whose conversion to int is undefined; such lines are drawn off the image.
+int to_pixel(double p) {
+  if (!std::isfinite(p)) return -1;
+  return static_cast<int>(std::floor(std::clamp(p, -1e6, 1e6)));
+}
+
+void check_plot_inputs(const PlotSpec& spec, int width, int height) {
   if (width < 160 || height < 120 || width > 16384 || height > 16384)
     throw Error(fmt::format("plot size {} x {} is out of range (160 x 120 to 16384 x 16384 pixels)", width, height));
   for (std::size_t k = 0; k < spec.series.size(); ++k) {
@@ -169,162 +191,169 @@ Image render_plot(const PlotSpec& spec, int width, int height) {
       throw Error(fmt::format("series \"{}\" has {} x values but {} y values", s.name, s.x.size(), s.y.size()),
                   fmt::format("plot series {}", k));
   }
-  const bool log_y = spec.log_y;
+}
 
-  // Data extent over the drawable points.
-  Range xr, yr;
-  for (const Series& s : spec.series)
-    for (std::size_t i = 0; i < s.x.size(); ++i)
-      if (drawable(s.x[i], s.y[i], log_y)) {
-        xr.add(s.x[i]);
-        yr.add(s.y[i]);
-      }
-  const bool has_data = xr.valid();
-
+/// The layout for data extents xr and yr (over the drawable points).
+PlotLayout layout_plot(const PlotSpec& spec, int width, int height, const Range& xr, const Range& yr) {
+  PlotLayout L;
+  L.log_y = spec.log_y;
   // Text sizes: scale 2 for normal sizes, 1 for small images.
-  const int ts = (width >= 600 && height >= 380) ? 2 : 1;
-  const int th = text_height(ts);
-  const int pad = 6 * ts;
+  L.ts = (width >= 600 && height >= 380) ? 2 : 1;
+  L.th = text_height(L.ts);
+  L.pad = 6 * L.ts;
+  const int ts = L.ts, th = L.th, pad = L.pad;
 
   // Vertical layout first: the y ticks depend on the plot height.
-  const int top = pad + (spec.title.empty() ? 0 : th + pad);
+  L.top = pad + (spec.title.empty() ? 0 : th + pad);
   const int bottom = kTick + pad / 2 + th + (spec.x_label.empty() ? 0 : pad + th) + pad;
-  const int plot_h = std::max(20, height - top - bottom);
+  L.plot_h = std::max(20, height - L.top - bottom);
 
-  const int y_target = std::max(2, plot_h / (th * 4));
-  Axis y_axis = log_y ? log_axis(yr, std::max(2, plot_h / (th * 2)), true) : linear_axis(yr, y_target);
-  if (log_y) {
+  const int y_target = std::max(2, L.plot_h / (th * 4));
+  L.y_axis = L.log_y ? log_axis(yr, std::max(2, L.plot_h / (th * 2)), true) : linear_axis(yr, y_target);
+  if (L.log_y) {
     // Minor ticks only where a decade is tall enough to show them.
-    const double decade_px = plot_h / std::max(1.0, y_axis.hi - y_axis.lo);
-    if (decade_px < 8.0 * ts) std::erase_if(y_axis.ticks, [](const Tick& t) { return t.minor; });
+    const double decade_px = L.plot_h / std::max(1.0, L.y_axis.hi - L.y_axis.lo);
+    if (decade_px < 8.0 * ts) std::erase_if(L.y_axis.ticks, [](const Tick& t) { return t.minor; });
   }
   int y_label_w = 0;
-  for (const Tick& t : y_axis.ticks) y_label_w = std::max(y_label_w, text_width(t.label, ts));
-  const int left = pad + (spec.y_label.empty() ? 0 : th + pad) + y_label_w + pad / 2 + kTick;
+  for (const Tick& t : L.y_axis.ticks) y_label_w = std::max(y_label_w, text_width(t.label, ts));
+  L.left = pad + (spec.y_label.empty() ? 0 : th + pad) + y_label_w + pad / 2 + kTick;
 
   // Horizontal layout: the x ticks depend on the plot width; leave room for the last label.
-  const int approx_w = std::max(20, width - left - 3 * pad);
-  const Axis x_axis = linear_axis(xr, std::max(2, approx_w / (text_width("-0.000", ts) + 4 * pad)));
-  const int last_label_w = x_axis.ticks.empty() ? 0 : text_width(x_axis.ticks.back().label, ts);
+  const int approx_w = std::max(20, width - L.left - 3 * pad);
+  L.x_axis = linear_axis(xr, std::max(2, approx_w / (text_width("-0.000", ts) + 4 * pad)));
+  const int last_label_w = L.x_axis.ticks.empty() ? 0 : text_width(L.x_axis.ticks.back().label, ts);
   const int right = std::max(3 * pad, last_label_w / 2 + pad);
-  const int plot_w = std::max(20, width - left - right);
+  L.plot_w = std::max(20, width - L.left - right);
+  L.x_label_top = L.top + L.plot_h + 1 + kTick + pad / 2;
+  return L;
+}
 
-  const double px0 = left, py0 = top, pw = plot_w, ph = plot_h;
-  auto sx = [&](double x) { return px0 + (x - x_axis.lo) / (x_axis.hi - x_axis.lo) * pw; };
-  auto sy = [&](double y) {
-    const double v = log_y ? std::log10(y) : y;
-    return py0 + ph - (v - y_axis.lo) / (y_axis.hi - y_axis.lo) * ph;
-  };
-  auto sy_axis = [&](double v) { return py0 + ph - (v - y_axis.lo) / (y_axis.hi - y_axis.lo) * ph; };
-
-  // Pixel coordinate of a grid line or tick: a value range that overflows (e.g. -1e308 .. 1e308)
-  // gives NaN or inf, whose conversion to int is undefined; such lines are drawn off the image.
-  const auto to_pixel = [](double p) {
-    if (!std::isfinite(p)) return -1;
-    return static_cast<int>(std::floor(std::clamp(p, -1e6, 1e6)));
-  };
-
-  Image img(width, height, kWhite);
-
-  // Grid (minor first so that major lines stay on top).
-  for (const Tick& t : y_axis.ticks) {
-    const int y = to_pixel(sy_axis(t.value));
-    img.fill_rect(left, y, plot_w, 1, t.minor ? kMinorGrid : kGrid);
+/// Grid lines (minor first so that major lines stay on top).
+void draw_grid(Image& img, const PlotLayout& L) {
+  for (const Tick& t : L.y_axis.ticks) {
+    const int y = to_pixel(L.sy_axis(t.value));
+    img.fill_rect(L.left, y, L.plot_w, 1, t.minor ? kMinorGrid : kGrid);
   }
-  for (const Tick& t : x_axis.ticks) {
-    const int x = to_pixel(sx(t.value));
-    img.fill_rect(x, top, 1, plot_h, kGrid);
+  for (const Tick& t : L.x_axis.ticks) {
+    const int x = to_pixel(L.sx(t.value));
+    img.fill_rect(x, L.top, 1, L.plot_h, kGrid);
   }
+}
 
-  // Series.
+void draw_series(Image& img, const PlotSpec& spec, const PlotLayout& L) {
   for (const Series& s : spec.series) {
     DashPen pen(img, s.color, s.dashed);
     const std::size_t n = s.x.size();
     for (std::size_t i = 0; i < n; ++i) {
-      if (!drawable(s.x[i], s.y[i], log_y)) continue;
-      const bool prev = i > 0 && drawable(s.x[i - 1], s.y[i - 1], log_y);
-      const bool next = i + 1 < n && drawable(s.x[i + 1], s.y[i + 1], log_y);
+      if (!drawable(s.x[i], s.y[i], L.log_y)) continue;
+      const bool prev = i > 0 && drawable(s.x[i - 1], s.y[i - 1], L.log_y);
+      const bool next = i + 1 < n && drawable(s.x[i + 1], s.y[i + 1], L.log_y);
       if (!prev) pen.restart();
-      if (next) pen.segment(sx(s.x[i]), sy(s.y[i]), sx(s.x[i + 1]), sy(s.y[i + 1]));
-      if (!prev && !next) img.fill_disc(sx(s.x[i]), sy(s.y[i]), kLineWidth + 0.5, s.color);
+      if (next) pen.segment(L.sx(s.x[i]), L.sy(s.y[i]), L.sx(s.x[i + 1]), L.sy(s.y[i + 1]));
+      if (!prev && !next) img.fill_disc(L.sx(s.x[i]), L.sy(s.y[i]), kLineWidth + 0.5, s.color);
     }
   }
+}
 
-  // Frame, ticks and tick labels.
-  img.draw_rect(left - 1, top - 1, plot_w + 2, plot_h + 2, kFrame);
-  for (const Tick& t : y_axis.ticks) {
+/// The frame, ticks and tick labels, the axis labels, the title, and "no data" when nothing
+/// was drawable.
+void draw_frame_and_text(Image& img, const PlotSpec& spec, const PlotLayout& L, bool has_data) {
+  const int ts = L.ts, th = L.th, pad = L.pad, left = L.left, top = L.top;
+  img.draw_rect(left - 1, top - 1, L.plot_w + 2, L.plot_h + 2, kFrame);
+  for (const Tick& t : L.y_axis.ticks) {
     if (t.minor) continue;
-    const int y = to_pixel(sy_axis(t.value));
+    const int y = to_pixel(L.sy_axis(t.value));
     img.fill_rect(left - 1 - kTick, y, kTick, 1, kFrame);
     if (!t.label.empty())
       draw_text(img, left - 1 - kTick - pad / 2 - text_width(t.label, ts), y - text_height(ts) * 7 / 18, t.label, kInk,
                 ts);
   }
-  const int x_label_top = top + plot_h + 1 + kTick + pad / 2;
-  for (const Tick& t : x_axis.ticks) {
-    const int x = to_pixel(sx(t.value));
-    img.fill_rect(x, top + plot_h + 1, 1, kTick, kFrame);
-    draw_text(img, x - text_width(t.label, ts) / 2, x_label_top, t.label, kInk, ts);
+  for (const Tick& t : L.x_axis.ticks) {
+    const int x = to_pixel(L.sx(t.value));
+    img.fill_rect(x, top + L.plot_h + 1, 1, kTick, kFrame);
+    draw_text(img, x - text_width(t.label, ts) / 2, L.x_label_top, t.label, kInk, ts);
   }
 
-  // Axis labels and title.
   if (!spec.x_label.empty())
-    draw_text(img, left + (plot_w - text_width(spec.x_label, ts)) / 2, x_label_top + th + pad, spec.x_label, kInk, ts);
+    draw_text(img, left + (L.plot_w - text_width(spec.x_label, ts)) / 2, L.x_label_top + th + pad, spec.x_label, kInk,
+              ts);
   if (!spec.y_label.empty())
-    draw_text_vertical(img, pad, top + (plot_h - text_width(spec.y_label, ts)) / 2, spec.y_label, kInk, ts);
+    draw_text_vertical(img, pad, top + (L.plot_h - text_width(spec.y_label, ts)) / 2, spec.y_label, kInk, ts);
   if (!spec.title.empty()) {
     const int tw = text_width(spec.title, ts);
-    const int tx = std::max(pad, left + (plot_w - tw) / 2);
+    const int tx = std::max(pad, left + (L.plot_w - tw) / 2);
     draw_text(img, tx, pad, spec.title, kInk, ts);  // drawn twice, one pixel apart: bold
     draw_text(img, tx + 1, pad, spec.title, kInk, ts);
   }
 
   if (!has_data) {
     const std::string_view msg = "no data";
-    draw_text(img, left + (plot_w - text_width(msg, ts)) / 2, top + (plot_h - th) / 2, msg, kMuted, ts);
+    draw_text(img, left + (L.plot_w - text_width(msg, ts)) / 2, top + (L.plot_h - th) / 2, msg, kMuted, ts);
   }
+}
 
-  // Legend in the corner of the plot area covering the fewest data points.
-  if (!spec.series.empty()) {
-    const int sample_w = 14 * ts;
-    const int row_h = th + 2 * ts;
-    std::vector<std::string> names;
-    int name_w = 0;
-    for (std::size_t k = 0; k < spec.series.size(); ++k) {
-      names.push_back(spec.series[k].name.empty() ? fmt::format("series {}", k + 1) : spec.series[k].name);
-      name_w = std::max(name_w, text_width(names.back(), ts));
-    }
-    const int box_w = pad + sample_w + pad + name_w + pad;
-    const int box_h = pad + static_cast<int>(names.size()) * row_h - 2 * ts + pad;
-    const int margin = pad;
-    const std::array<std::array<int, 2>, 4> corners = {{
-        {left + plot_w - margin - box_w, top + margin},  // top right (preferred)
-        {left + margin, top + margin},                   // top left
-        {left + plot_w - margin - box_w, top + plot_h - margin - box_h},
-        {left + margin, top + plot_h - margin - box_h},
-    }};
-    std::array<long, 4> hits{};
-    for (const Series& s : spec.series)
-      for (std::size_t i = 0; i < s.x.size(); ++i) {
-        if (!drawable(s.x[i], s.y[i], log_y)) continue;
-        const double x = sx(s.x[i]), y = sy(s.y[i]);
-        for (std::size_t c = 0; c < corners.size(); ++c)
-          if (x >= corners[c][0] - pad && x <= corners[c][0] + box_w + pad && y >= corners[c][1] - pad &&
-              y <= corners[c][1] + box_h + pad)
-            ++hits[c];
-      }
-    const std::size_t best = static_cast<std::size_t>(std::min_element(hits.begin(), hits.end()) - hits.begin());
-    const int bx = corners[best][0], by = corners[best][1];
-    img.blend_rect(bx, by, box_w, box_h, kWhite, 0.9);
-    img.draw_rect(bx, by, box_w, box_h, Rgb{170, 170, 170});
-    for (std::size_t k = 0; k < names.size(); ++k) {
-      const int ry = by + pad + static_cast<int>(k) * row_h;
-      const double ly = ry + th * 7.0 / 18.0;
-      DashPen pen(img, spec.series[k].color, spec.series[k].dashed);
-      pen.segment(bx + pad, ly, bx + pad + sample_w, ly);
-      draw_text(img, bx + pad + sample_w + pad, ry, names[k], kInk, ts);
-    }
+/// The legend, in the corner of the plot area covering the fewest data points.
+void draw_legend(Image& img, const PlotSpec& spec, const PlotLayout& L) {
+  const int ts = L.ts, th = L.th, pad = L.pad, left = L.left, top = L.top;
+  const int sample_w = 14 * ts;
+  const int row_h = th + 2 * ts;
+  std::vector<std::string> names;
+  int name_w = 0;
+  for (std::size_t k = 0; k < spec.series.size(); ++k) {
+    names.push_back(spec.series[k].name.empty() ? fmt::format("series {}", k + 1) : spec.series[k].name);
+    name_w = std::max(name_w, text_width(names.back(), ts));
   }
+  const int box_w = pad + sample_w + pad + name_w + pad;
+  const int box_h = pad + static_cast<int>(names.size()) * row_h - 2 * ts + pad;
+  const int margin = pad;
+  const std::array<std::array<int, 2>, 4> corners = {{
+      {left + L.plot_w - margin - box_w, top + margin},  // top right (preferred)
+      {left + margin, top + margin},                     // top left
+      {left + L.plot_w - margin - box_w, top + L.plot_h - margin - box_h},
+      {left + margin, top + L.plot_h - margin - box_h},
+  }};
+  std::array<long, 4> hits{};
+  for (const Series& s : spec.series)
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      if (!drawable(s.x[i], s.y[i], L.log_y)) continue;
+      const double x = L.sx(s.x[i]), y = L.sy(s.y[i]);
+      for (std::size_t c = 0; c < corners.size(); ++c)
+        if (x >= corners[c][0] - pad && x <= corners[c][0] + box_w + pad && y >= corners[c][1] - pad &&
+            y <= corners[c][1] + box_h + pad)
+          ++hits[c];
+    }
+  const std::size_t best = static_cast<std::size_t>(std::min_element(hits.begin(), hits.end()) - hits.begin());
+  const int bx = corners[best][0], by = corners[best][1];
+  img.blend_rect(bx, by, box_w, box_h, kWhite, 0.9);
+  img.draw_rect(bx, by, box_w, box_h, Rgb{170, 170, 170});
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const int ry = by + pad + static_cast<int>(k) * row_h;
+    const double ly = ry + th * 7.0 / 18.0;
+    DashPen pen(img, spec.series[k].color, spec.series[k].dashed);
+    pen.segment(bx + pad, ly, bx + pad + sample_w, ly);
+    draw_text(img, bx + pad + sample_w + pad, ry, names[k], kInk, ts);
+  }
+}
+
+}  // namespace
+
+Image render_plot(const PlotSpec& spec, int width, int height) {
+  check_plot_inputs(spec, width, height);
+  // Data extent over the drawable points.
+  Range xr, yr;
+  for (const Series& s : spec.series)
+    for (std::size_t i = 0; i < s.x.size(); ++i)
+      if (drawable(s.x[i], s.y[i], spec.log_y)) {
+        xr.add(s.x[i]);
+        yr.add(s.y[i]);
+      }
+  const PlotLayout layout = layout_plot(spec, width, height, xr, yr);
+  Image img(width, height, kWhite);
+  draw_grid(img, layout);
+  draw_series(img, spec, layout);
+  draw_frame_and_text(img, spec, layout, xr.valid());
+  if (!spec.series.empty()) draw_legend(img, spec, layout);
   return img;
 }
 

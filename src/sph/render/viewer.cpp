@@ -3,10 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <optional>
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include <sph/core/error.h>
 #include <sph/io/frames.h>
@@ -25,50 +23,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr char kBase64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-
-/// Base64 length of n bytes.
-constexpr std::size_t b64_size(std::size_t n) { return 4 * ((n + 2) / 3); }
-
-/// JSON text of a string, safe inside a <script> element: "</" would end the element, so '<' is
-/// written as its escape.
-std::string json_string(const std::string& s) {
-  std::string out;
-  for (char c : nlohmann::json(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)) {
-    if (c == '<')
-      out += "\\u003c";
-    else
-      out += c;
-  }
-  return out;
-}
-
-/// Text for HTML (element content or a quoted attribute).
-std::string html_escape(std::string_view s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
-/// The number as JSON (finite values only; JSON has no NaN).
-std::string json_number(double x) { return std::isfinite(x) ? fmt::format("{}", x) : "0"; }
+using detail::append_base64;
+using detail::base64_size;
+using detail::html_escape;
+using detail::json_number;
+using detail::json_string;
+using detail::little_endian;
 
 /// Positions are quantized over the container grown by a tenth of its largest side, so that
 /// spray above the walls and particles pressed into the penalty walls keep their place.
@@ -104,36 +64,6 @@ struct EncodedRun {
   std::vector<std::uint8_t> rgb;  ///< initial-position colors by particle index, when shared
   bool rgb_per_frame = false;
 };
-
-void append_b64(std::string& out, std::span<const std::uint8_t> bytes) {
-  const std::size_t n = bytes.size();
-  out.reserve(out.size() + b64_size(n));
-  std::size_t i = 0;
-  for (; i + 3 <= n; i += 3) {
-    const std::uint32_t v = (bytes[i] << 16) | (bytes[i + 1] << 8) | bytes[i + 2];
-    out += kBase64[v >> 18];
-    out += kBase64[(v >> 12) & 63];
-    out += kBase64[(v >> 6) & 63];
-    out += kBase64[v & 63];
-  }
-  if (i < n) {
-    const std::uint32_t v = (bytes[i] << 16) | (i + 1 < n ? bytes[i + 1] << 8 : 0);
-    out += kBase64[v >> 18];
-    out += kBase64[(v >> 12) & 63];
-    out += i + 1 < n ? kBase64[(v >> 6) & 63] : '=';
-    out += '=';
-  }
-}
-
-/// The uint16 values as little-endian bytes (what the page reads whatever this machine is).
-std::vector<std::uint8_t> little_endian(const std::vector<std::uint16_t>& v) {
-  std::vector<std::uint8_t> out(2 * v.size());
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    out[2 * i] = static_cast<std::uint8_t>(v[i] & 0xff);
-    out[2 * i + 1] = static_cast<std::uint8_t>(v[i] >> 8);
-  }
-  return out;
-}
 
 /// Replaces each @SPH_NAME@ marker of the template by its text, in one pass (inserted text is
 /// never scanned again, so data that happens to contain a marker is left alone).
@@ -216,52 +146,6 @@ std::vector<std::size_t> subsample_frames(std::size_t total, std::size_t max_fra
   return idx;
 }
 
-std::uint16_t quantize_position(double x, double lo, double hi) {
-  if (std::isnan(x)) return 0;
-  const double t = std::clamp((x - lo) / (hi - lo), 0.0, 1.0);
-  return static_cast<std::uint16_t>(std::lround(t * 65535.0));
-}
-
-std::uint8_t quantize_scalar(double x, double lo, double hi) {
-  if (std::isnan(x)) return 255;
-  const double t = std::clamp((x - lo) / (hi - lo), 0.0, 1.0);
-  return static_cast<std::uint8_t>(std::lround(t * 254.0));
-}
-
-std::string base64_encode(std::span<const std::uint8_t> bytes) {
-  std::string out;
-  append_b64(out, bytes);
-  return out;
-}
-
-std::vector<std::uint8_t> base64_decode(std::string_view text) {
-  if (text.size() % 4 != 0) throw Error("base64 text of a length that is not a multiple of 4");
-  std::vector<std::uint8_t> out;
-  out.reserve(text.size() / 4 * 3);
-  const auto value = [](char c) -> int {
-    const char* p = std::find(std::begin(kBase64), std::end(kBase64) - 1, c);
-    return p == std::end(kBase64) - 1 ? -1 : static_cast<int>(p - kBase64);
-  };
-  for (std::size_t i = 0; i < text.size(); i += 4) {
-    int v[4];
-    int pad = 0;
-    for (int k = 0; k < 4; ++k) {
-      const char c = text[i + k];
-      if (c == '=' && i + 4 == text.size() && k >= 2) {
-        v[k] = 0;
-        ++pad;
-        continue;
-      }
-      if (pad > 0 || (v[k] = value(c)) < 0) throw Error(fmt::format("bad base64 character at offset {}", i + k));
-    }
-    const std::uint32_t w = (v[0] << 18) | (v[1] << 12) | (v[2] << 6) | v[3];
-    out.push_back(static_cast<std::uint8_t>(w >> 16));
-    if (pad < 2) out.push_back(static_cast<std::uint8_t>((w >> 8) & 0xff));
-    if (pad < 1) out.push_back(static_cast<std::uint8_t>(w & 0xff));
-  }
-  return out;
-}
-
 std::string view_page_data(std::string_view html) {
   const std::string_view open = "<script id=\"sph-data\" type=\"application/json\">";
   const std::size_t a = html.find(open);
@@ -270,190 +154,206 @@ std::string view_page_data(std::string_view html) {
   return std::string(html.substr(a + open.size(), b - a - open.size()));
 }
 
-ViewPage build_view_page(const fs::path& dir, const ViewOptions& options) {
-  if (options.max_frames < 2) throw Error("must be at least 2", "--max-frames");
+namespace {
+
+/// The runs of `dir` (one, or each run of a compare directory), all of one dimension.
+std::vector<RunDirectory> open_runs(const fs::path& dir) {
   std::vector<RunDirectory> runs;
   for (const fs::path& d : run_directories(dir)) runs.push_back(open_run_directory(d));
-  const RunDirectory& run0 = runs.front();
-  const int dim = run0.dimension;
+  const int dim = runs.front().dimension;
   for (const RunDirectory& r : runs)
     if (r.dimension != dim)
       throw Error(fmt::format("its runs mix {}D and {}D scenes; expected runs of one scene", dim, r.dimension),
                   dir.string());
-  const auto picks = pick_frames(runs, options.max_frames);
+  return runs;
+}
 
-  // First and last frames: the fields the runs hold, and particle counts for the size estimate
-  // (refused before the other frames are read; emitters only ever add particles).
-  std::vector<FrameData> first_frames;
-  std::size_t max_particles = 0;
-  for (std::size_t r = 0; r < runs.size(); ++r) {
-    first_frames.push_back(read_frame(runs[r].frames[picks[r].front()]));
-    max_particles = std::max(max_particles, first_frames.back().size);
-    if (picks[r].size() > 1) max_particles = std::max(max_particles, read_frame(runs[r].frames[picks[r].back()]).size);
-  }
-  const std::vector<ColorBy> quantities = offered_quantities(options.color_by, runs, first_frames);
+/// The colorings the page offers: all of them in order (the first is the default), the scalar
+/// ones, and whether the initial-position colors are among them.
+struct PageQuantities {
+  std::vector<ColorBy> all;
   std::vector<ColorBy> scalars;
-  bool with_rgb = false;
-  for (ColorBy by : quantities) {
+  bool rgb = false;
+};
+
+PageQuantities page_quantities(const std::vector<ColorBy>& asked, const std::vector<RunDirectory>& runs,
+                               const std::vector<FrameData>& first_frames) {
+  PageQuantities q;
+  q.all = offered_quantities(asked, runs, first_frames);
+  for (ColorBy by : q.all) {
     if (color_by_is_scalar(by))
-      scalars.push_back(by);
+      q.scalars.push_back(by);
     else
-      with_rgb = true;
+      q.rgb = true;
   }
-  {
-    std::size_t frames = 0;
-    for (const auto& p : picks) frames += p.size();
-    const std::size_t per_particle = 2 * static_cast<std::size_t>(dim) + scalars.size();
-    const std::size_t estimate = b64_size(per_particle * max_particles) * frames + 100 * frames +
-                                 (with_rgb ? b64_size(3 * max_particles) * runs.size() : 0) +
-                                 detail::viewer_html().size() + detail::viewer_css().size() +
-                                 detail::viewer_js().size();
-    if (estimate > options.max_bytes) {
-      const std::size_t per_frame = std::max<std::size_t>(1, estimate / std::max<std::size_t>(1, frames));
-      const std::size_t fit = options.max_bytes / per_frame / runs.size();
-      throw Error(fmt::format("the page would be about {:.0f} MB ({} frames of up to {} particles), more than the "
-                              "limit of {:.0f} MB; use --max-frames {} (or fewer), fewer quantities with --color-by, "
-                              "or raise the limit with --max-size",
-                              static_cast<double>(estimate) / 1e6, frames, max_particles,
-                              static_cast<double>(options.max_bytes) / 1e6, std::max<std::size_t>(2, fit)),
-                  dir.string());
-    }
-  }
+  return q;
+}
 
-  // Read every kept frame once: positions quantized now, scalars kept until their run-wide
-  // range is known. The range comes from a sample of at most ~4 million values per quantity
-  // (a percentile does not need them all).
-  std::size_t total_values = 0;
-  for (const auto& p : picks) total_values += p.size() * max_particles;
-  const std::size_t stride = std::max<std::size_t>(1, total_values / 4'000'000);
-  std::vector<std::vector<std::vector<double>>> samples(scalars.size());
-  std::vector<EncodedRun> encoded(runs.size());
-  for (std::size_t r = 0; r < runs.size(); ++r) {
-    const RunDirectory& run = runs[r];
-    const QuantBox qb = quant_box(run0);
-    EncodedRun& er = encoded[r];
-    er.label = run.label;
-    bool ids_dense = true;
-    std::vector<std::uint8_t> rgb_by_id;
-    for (std::size_t k = 0; k < picks[r].size(); ++k) {
-      const std::size_t index = picks[r][k];
-      FrameData frame = r < first_frames.size() && k == 0 ? std::move(first_frames[r]) : read_frame(run.frames[index]);
-      const std::size_t n = frame.size;
-      // Particles in id order: frames are written in the solver's (Morton) order, which changes.
-      std::vector<std::size_t> order(n);
-      std::iota(order.begin(), order.end(), std::size_t{0});
-      if (const FrameField* id = frame.field("id"); id != nullptr && id->values.size() == n) {
-        std::stable_sort(order.begin(), order.end(),
-                         [&](std::size_t a, std::size_t b) { return id->values[a] < id->values[b]; });
-        for (std::size_t i = 0; i < n && ids_dense; ++i) ids_dense = id->values[order[i]] == static_cast<double>(i);
-      } else {
-        ids_dense = false;
-      }
-      EncodedFrame ef;
-      ef.time = frame.time;
-      ef.size = n;
-      ef.position.resize(n * static_cast<std::size_t>(dim));
-      for (std::size_t i = 0; i < n; ++i)
-        for (int d = 0; d < dim; ++d)
-          ef.position[i * dim + d] = quantize_position(frame.position[3 * order[i] + d], qb.lo[d], qb.hi[d]);
-      for (std::size_t s = 0; s < scalars.size(); ++s) {
-        const std::vector<double> v = color_values(frame, scalars[s], run);
-        std::vector<float>& out = ef.values.emplace_back(n);
-        for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<float>(v[order[i]]);
-        std::vector<double>& sample = samples[s].emplace_back();
-        for (std::size_t i = 0; i < n; i += stride) sample.push_back(v[i]);
-      }
-      if (with_rgb) {
-        const std::vector<Rgb> c = particle_colors(frame, ColorSpec{ColorBy::InitialPosition}, run);
-        ef.rgb.resize(3 * n);
-        for (std::size_t i = 0; i < n; ++i) {
-          ef.rgb[3 * i] = c[order[i]].r;
-          ef.rgb[3 * i + 1] = c[order[i]].g;
-          ef.rgb[3 * i + 2] = c[order[i]].b;
-        }
-        if (ef.rgb.size() > rgb_by_id.size()) rgb_by_id = ef.rgb;
-      }
-      max_particles = std::max(max_particles, n);
-      er.frames.push_back(std::move(ef));
-    }
-    // A particle keeps its id, and so its initial position: when every frame holds ids 0..n-1,
-    // one color per id serves all frames.
-    if (with_rgb) {
-      er.rgb_per_frame = !ids_dense;
-      if (ids_dense) {
-        er.rgb = std::move(rgb_by_id);
-        for (EncodedFrame& f : er.frames) f.rgb.clear();
-      }
+/// Refuses, before the frames are read, a page whose estimated size is above options.max_bytes.
+void check_page_estimate(const fs::path& dir, const ViewOptions& options,
+                         const std::vector<std::vector<std::size_t>>& picks, const PageQuantities& q, int dim,
+                         std::size_t max_particles) {
+  const std::size_t runs = picks.size();
+  std::size_t frames = 0;
+  for (const auto& p : picks) frames += p.size();
+  const std::size_t per_particle = 2 * static_cast<std::size_t>(dim) + q.scalars.size();
+  const std::size_t estimate = base64_size(per_particle * max_particles) * frames + 100 * frames +
+                               (q.rgb ? base64_size(3 * max_particles) * runs : 0) + detail::viewer_html().size() +
+                               detail::viewer_css().size() + detail::viewer_js().size();
+  if (estimate <= options.max_bytes) return;
+  const std::size_t per_frame = std::max<std::size_t>(1, estimate / std::max<std::size_t>(1, frames));
+  const std::size_t fit = options.max_bytes / per_frame / runs;
+  throw Error(fmt::format("the page would be about {:.0f} MB ({} frames of up to {} particles), more than the "
+                          "limit of {:.0f} MB; use --max-frames {} (or fewer), fewer quantities with --color-by, "
+                          "or raise the limit with --max-size",
+                          static_cast<double>(estimate) / 1e6, frames, max_particles,
+                          static_cast<double>(options.max_bytes) / 1e6, std::max<std::size_t>(2, fit)),
+              dir.string());
+}
+
+/// Per scalar quantity, the samples of its values its run-wide range is taken from, one
+/// vector per encoded frame.
+using ScalarSamples = std::vector<std::vector<std::vector<double>>>;
+
+/// One frame with its particles in id order (frames are written in the solver's Morton order,
+/// which changes): positions quantized in `qb`, scalars as floats (every `stride`-th value
+/// also appended to `samples`), initial-position colors if q.rgb. Clears `ids_dense` unless
+/// the frame holds the ids 0..n-1.
+EncodedFrame encode_frame(const FrameData& frame, const RunDirectory& run, const QuantBox& qb, const PageQuantities& q,
+                          std::size_t stride, ScalarSamples& samples, bool& ids_dense) {
+  const std::size_t n = frame.size;
+  const int dim = run.dimension;
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  if (const FrameField* id = frame.field("id"); id != nullptr && id->values.size() == n) {
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return id->values[a] < id->values[b]; });
+    for (std::size_t i = 0; i < n && ids_dense; ++i) ids_dense = id->values[order[i]] == static_cast<double>(i);
+  } else {
+    ids_dense = false;
+  }
+  EncodedFrame ef;
+  ef.time = frame.time;
+  ef.size = n;
+  ef.position.resize(n * static_cast<std::size_t>(dim));
+  for (std::size_t i = 0; i < n; ++i)
+    for (int d = 0; d < dim; ++d)
+      ef.position[i * dim + d] = quantize_position(frame.position[3 * order[i] + d], qb.lo[d], qb.hi[d]);
+  for (std::size_t s = 0; s < q.scalars.size(); ++s) {
+    const std::vector<double> v = color_values(frame, q.scalars[s], run);
+    std::vector<float>& out = ef.values.emplace_back(n);
+    for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<float>(v[order[i]]);
+    std::vector<double>& sample = samples[s].emplace_back();
+    for (std::size_t i = 0; i < n; i += stride) sample.push_back(v[i]);
+  }
+  if (q.rgb) {
+    const std::vector<Rgb> c = particle_colors(frame, ColorSpec{ColorBy::InitialPosition}, run);
+    ef.rgb.resize(3 * n);
+    for (std::size_t i = 0; i < n; ++i) {
+      ef.rgb[3 * i] = c[order[i]].r;
+      ef.rgb[3 * i + 1] = c[order[i]].g;
+      ef.rgb[3 * i + 2] = c[order[i]].b;
     }
   }
+  return ef;
+}
 
-  // The quantities' run-wide ranges, shared by every run of a compare directory so that a
-  // color means the same in every panel.
-  struct Offered {
-    ColorBy by;
-    double lo = 0, hi = 1;
-    bool clipped = false;
-  };
-  std::vector<Offered> offered;
+/// The kept frames `picks` of one run, `first` being the first of them, already read; raises
+/// `max_particles` to the largest frame.
+EncodedRun encode_run(const RunDirectory& run, const std::vector<std::size_t>& picks, FrameData first,
+                      const QuantBox& qb, const PageQuantities& q, std::size_t stride, ScalarSamples& samples,
+                      std::size_t& max_particles) {
+  EncodedRun er;
+  er.label = run.label;
+  bool ids_dense = true;
+  std::vector<std::uint8_t> rgb_by_id;
+  for (std::size_t k = 0; k < picks.size(); ++k) {
+    const FrameData frame = k == 0 ? std::move(first) : read_frame(run.frames[picks[k]]);
+    EncodedFrame ef = encode_frame(frame, run, qb, q, stride, samples, ids_dense);
+    if (ef.rgb.size() > rgb_by_id.size()) rgb_by_id = ef.rgb;
+    max_particles = std::max(max_particles, frame.size);
+    er.frames.push_back(std::move(ef));
+  }
+  // A particle keeps its id, and so its initial position: when every frame holds ids 0..n-1,
+  // one color per id serves all frames.
+  if (q.rgb) {
+    er.rgb_per_frame = !ids_dense;
+    if (ids_dense) {
+      er.rgb = std::move(rgb_by_id);
+      for (EncodedFrame& f : er.frames) f.rgb.clear();
+    }
+  }
+  return er;
+}
+
+/// A scalar quantity's run-wide range, and whether some value lies above it.
+struct OfferedScalar {
+  ColorBy by;
+  double lo = 0, hi = 1;
+  bool clipped = false;
+};
+
+/// The scalars' ranges, shared by every run of a compare directory so that a color means the
+/// same in every panel. Frees the samples.
+std::vector<OfferedScalar> scalar_ranges(const std::vector<ColorBy>& scalars, ScalarSamples& samples) {
+  std::vector<OfferedScalar> offered;
   for (std::size_t s = 0; s < scalars.size(); ++s) {
     const auto [lo, hi] = color_range(scalars[s], samples[s]);
     offered.push_back({scalars[s], lo, hi, false});
     samples[s].clear();
     samples[s].shrink_to_fit();
   }
+  return offered;
+}
 
-  // The data block: frames first (the bulk), the small header around them.
-  std::string runs_json = "[";
+/// The runs' part of the data block (the bulk): scalars quantized to the ranges of `offered`,
+/// whose `clipped` it sets. Frees the encoded frames as it goes.
+std::string runs_json(std::vector<EncodedRun>& encoded, std::vector<OfferedScalar>& offered, bool rgb) {
+  std::string out = "[";
   for (std::size_t r = 0; r < encoded.size(); ++r) {
     EncodedRun& er = encoded[r];
-    runs_json += (r ? ",{" : "{") + std::string("\"label\":") + json_string(er.label);
-    if (with_rgb && !er.rgb_per_frame) {
-      runs_json += ",\"rgb\":\"";
-      append_b64(runs_json, er.rgb);
-      runs_json += '"';
+    out += (r ? ",{" : "{") + std::string("\"label\":") + json_string(er.label);
+    if (rgb && !er.rgb_per_frame) {
+      out += ",\"rgb\":\"";
+      append_base64(out, er.rgb);
+      out += '"';
     }
-    runs_json += ",\"frames\":[";
+    out += ",\"frames\":[";
     for (std::size_t k = 0; k < er.frames.size(); ++k) {
       EncodedFrame& f = er.frames[k];
-      runs_json += fmt::format("{}{{\"t\":{},\"n\":{},\"pos\":\"", k ? "," : "", json_number(f.time), f.size);
-      append_b64(runs_json, little_endian(f.position));
-      runs_json += "\",\"f\":{";
+      out += fmt::format("{}{{\"t\":{},\"n\":{},\"pos\":\"", k ? "," : "", json_number(f.time), f.size);
+      append_base64(out, little_endian(f.position));
+      out += "\",\"f\":{";
       for (std::size_t s = 0; s < offered.size(); ++s) {
         std::vector<std::uint8_t> q(f.size);
         for (std::size_t i = 0; i < f.size; ++i) {
           q[i] = quantize_scalar(f.values[s][i], offered[s].lo, offered[s].hi);
           offered[s].clipped = offered[s].clipped || f.values[s][i] > offered[s].hi;
         }
-        runs_json += fmt::format("{}\"{}\":\"", s ? "," : "", color_by_name(offered[s].by));
-        append_b64(runs_json, q);
-        runs_json += '"';
+        out += fmt::format("{}\"{}\":\"", s ? "," : "", color_by_name(offered[s].by));
+        append_base64(out, q);
+        out += '"';
       }
-      runs_json += '}';
+      out += '}';
       if (!f.rgb.empty()) {
-        runs_json += ",\"rgb\":\"";
-        append_b64(runs_json, f.rgb);
-        runs_json += '"';
+        out += ",\"rgb\":\"";
+        append_base64(out, f.rgb);
+        out += '"';
       }
-      runs_json += '}';
+      out += '}';
       f = EncodedFrame{};  // free as we go
     }
-    runs_json += "]}";
+    out += "]}";
   }
-  runs_json += ']';
+  out += ']';
+  return out;
+}
 
-  ViewPage page;
-  page.runs = runs.size();
-  page.frames_total = run0.frames.size();
-  page.frames_shown = picks.front().size();
-  page.max_particles = max_particles;
-  if (page.frames_shown < page.frames_total)
-    page.notes.push_back(
-        fmt::format("Showing {} of the run's {} frames, evenly spaced (sph view --max-frames N "
-                    "keeps up to N).",
-                    page.frames_shown, page.frames_total));
-
+/// The page's colorings: each scalar with its range and colormap, the initial-position colors,
+/// or one plain color when the frames hold neither.
+std::string colors_json(const std::vector<OfferedScalar>& offered, bool rgb, int dim) {
   std::string colors = "[";
-  for (const Offered& o : offered) {
+  for (const OfferedScalar& o : offered) {
     std::vector<std::uint8_t> lut;
     const Colormap map = default_colormap(o.by);
     for (int i = 0; i < 256; ++i) {
@@ -466,11 +366,11 @@ ViewPage build_view_page(const fs::path& dir, const ViewOptions& options) {
         colors.size() > 1 ? "," : "", color_by_name(o.by), json_string(color_by_label(o.by, dim)), json_number(o.lo),
         json_number(o.hi), o.clipped ? "true" : "false", colormap_name(map), base64_encode(lut));
   }
-  if (with_rgb)
+  if (rgb)
     colors += fmt::format("{}{{\"name\":\"{}\",\"label\":{},\"scalar\":false}}", colors.size() > 1 ? "," : "",
                           color_by_name(ColorBy::InitialPosition),
                           json_string(color_by_label(ColorBy::InitialPosition, dim)));
-  if (offered.empty() && !with_rgb) {
+  if (offered.empty() && !rgb) {
     // Frames with positions only: one plain color (every particle at the middle of this map).
     const std::vector<std::uint8_t> lut(3 * 256, 0);
     std::vector<std::uint8_t> blue = lut;
@@ -481,26 +381,80 @@ ViewPage build_view_page(const fs::path& dir, const ViewOptions& options) {
         base64_encode(blue));
   }
   colors += ']';
+  return colors;
+}
 
-  const QuantBox qb = quant_box(run0);
-  const auto vec3 = [](const std::array<double, 3>& v) {
-    return fmt::format("[{},{},{}]", json_number(v[0]), json_number(v[1]), json_number(v[2]));
-  };
+std::string json_vec3(const std::array<double, 3>& v) {
+  return fmt::format("[{},{},{}]", json_number(v[0]), json_number(v[1]), json_number(v[2]));
+}
+
+/// The data block: the header (scene, boxes, colorings, notes) around the runs, which are freed.
+std::string data_json(const RunDirectory& run0, const QuantBox& qb, const std::string& colors,
+                      const std::string& default_color, const std::vector<std::string>& page_notes, std::string& runs) {
   std::string notes = "[";
-  for (const std::string& n : page.notes) notes += (notes.size() > 1 ? "," : "") + json_string(n);
+  for (const std::string& n : page_notes) notes += (notes.size() > 1 ? "," : "") + json_string(n);
   notes += ']';
-  const std::string default_color =
-      !quantities.empty() ? std::string(color_by_name(quantities.front())) : std::string("uniform");
   std::string data = fmt::format(
       "{{\"format\":\"sph-view\",\"version\":1,\"title\":{},\"description\":{},\"dimension\":{},"
       "\"box\":{{\"lo\":{},\"hi\":{}}},\"qbox\":{{\"lo\":{},\"hi\":{}}},\"radius\":{},\"colors\":{},"
       "\"defaultColor\":\"{}\",\"notes\":{},\"runs\":",
-      json_string(run0.scene.name), json_string(run0.scene.description), dim, vec3(run0.box_lo), vec3(run0.box_hi),
-      vec3(qb.lo), vec3(qb.hi), json_number(run0.particle_radius), colors, default_color, notes);
-  data += runs_json;
-  runs_json.clear();
-  runs_json.shrink_to_fit();
+      json_string(run0.scene.name), json_string(run0.scene.description), run0.dimension, json_vec3(run0.box_lo),
+      json_vec3(run0.box_hi), json_vec3(qb.lo), json_vec3(qb.hi), json_number(run0.particle_radius), colors,
+      default_color, notes);
+  data += runs;
+  runs.clear();
+  runs.shrink_to_fit();
   data += '}';
+  return data;
+}
+
+}  // namespace
+
+ViewPage build_view_page(const fs::path& dir, const ViewOptions& options) {
+  if (options.max_frames < 2) throw Error("must be at least 2", "--max-frames");
+  const std::vector<RunDirectory> runs = open_runs(dir);
+  const RunDirectory& run0 = runs.front();
+  const auto picks = pick_frames(runs, options.max_frames);
+
+  // First and last frames: the fields the runs hold, and particle counts for the size estimate
+  // (refused before the other frames are read; emitters only ever add particles).
+  std::vector<FrameData> first_frames;
+  std::size_t max_particles = 0;
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    first_frames.push_back(read_frame(runs[r].frames[picks[r].front()]));
+    max_particles = std::max(max_particles, first_frames.back().size);
+    if (picks[r].size() > 1) max_particles = std::max(max_particles, read_frame(runs[r].frames[picks[r].back()]).size);
+  }
+  const PageQuantities q = page_quantities(options.color_by, runs, first_frames);
+  check_page_estimate(dir, options, picks, q, run0.dimension, max_particles);
+
+  // Read every kept frame once: positions quantized now, scalars kept until their run-wide
+  // range is known. The range comes from a sample of at most ~4 million values per quantity
+  // (a percentile does not need them all).
+  std::size_t total_values = 0;
+  for (const auto& p : picks) total_values += p.size() * max_particles;
+  const std::size_t stride = std::max<std::size_t>(1, total_values / 4'000'000);
+  ScalarSamples samples(q.scalars.size());
+  const QuantBox qb = quant_box(run0);
+  std::vector<EncodedRun> encoded;
+  for (std::size_t r = 0; r < runs.size(); ++r)
+    encoded.push_back(encode_run(runs[r], picks[r], std::move(first_frames[r]), qb, q, stride, samples, max_particles));
+  std::vector<OfferedScalar> offered = scalar_ranges(q.scalars, samples);
+  std::string runs_part = runs_json(encoded, offered, q.rgb);
+
+  ViewPage page;
+  page.runs = runs.size();
+  page.frames_total = run0.frames.size();
+  page.frames_shown = picks.front().size();
+  page.max_particles = max_particles;
+  if (page.frames_shown < page.frames_total)
+    page.notes.push_back(
+        fmt::format("Showing {} of the run's {} frames, evenly spaced (sph view --max-frames N "
+                    "keeps up to N).",
+                    page.frames_shown, page.frames_total));
+  const std::string default_color = !q.all.empty() ? std::string(color_by_name(q.all.front())) : "uniform";
+  const std::string data =
+      data_json(run0, qb, colors_json(offered, q.rgb, run0.dimension), default_color, page.notes, runs_part);
 
   const std::string html_title = html_escape(run0.scene.name) + " - sph view";
   const std::string generator = html_escape(options.generator);

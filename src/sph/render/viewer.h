@@ -5,14 +5,13 @@
 /// run's frames are inlined, quantized, as base64 (docs/visualization.md).
 
 #include <cstddef>
-#include <cstdint>
 #include <filesystem>
-#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include <sph/render/color_by.h>
+#include <sph/render/view_codec.h>  // the page's encodings (quantization, base64)
 
 namespace sph {
 
@@ -50,17 +49,6 @@ ViewPage build_view_page(const std::filesystem::path& dir, const ViewOptions& op
 /// The indices of at most `max_frames` (>= 2) of `total` frames, evenly spaced, ascending, the
 /// first and the last included; all of them if total <= max_frames.
 std::vector<std::size_t> subsample_frames(std::size_t total, std::size_t max_frames);
-
-/// A coordinate as 0..65535 over [lo, hi] (clamped; NaN gives 0). Precondition: lo < hi.
-std::uint16_t quantize_position(double x, double lo, double hi);
-/// A scalar as 0..254 over [lo, hi] (clamped); NaN gives 255 ("no value"). Precondition: lo < hi.
-std::uint8_t quantize_scalar(double x, double lo, double hi);
-
-/// Standard base64 (RFC 4648, with padding).
-std::string base64_encode(std::span<const std::uint8_t> bytes);
-/// The bytes of standard base64 text; throws sph::Error on a character outside the alphabet or
-/// a length that is not a multiple of 4.
-std::vector<std::uint8_t> base64_decode(std::string_view text);
 
 /// The JSON data block of a page built by build_view_page (for tests and tools); throws
 /// sph::Error if `html` holds none.

@@ -16,6 +16,7 @@
 #include <sph/scene/object_reader.h>
 #include <sph/scene/overrides.h>
 #include <sph/scene/scene_keys.h>
+#include <sph/neighbors/neighbor_mode.h>
 #include <sph/solver/time_step.h>
 #include <sph/solver/wcsph.h>
 
@@ -118,7 +119,7 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
                              kMaxKernelSpacings * 2.0 * sim.particle_radius));
   sim.gravity = c.vec<D>("gravitation", "the gravity acceleration in m/s^2", default_g);
   sim.neighbors = parse_neighbor_mode(
-      c.choice("neighbors", {"standard", "adaptive", "verlet", "brute_force"}, "standard"), c.child("neighbors"));
+      c.choice("neighbors", neighbor_mode_names(), "standard"), c.child("neighbors"));
   sim.full_rebuild_period = static_cast<int>(
       c.integer("fullRebuildPeriod", "a full-rebuild period of at least 1 step", 1, 1'000'000'000, 200));
   sim.reorder_period = static_cast<int>(c.integer("reorderPeriod",

@@ -72,7 +72,7 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
   // from a throwaway standard strategy: the run's own strategy starts at step 0.
   if (!particles_.empty()) {
     auto exact = make_neighbor_strategy<D, R>(NeighborMode::Standard, opt);
-    exact->update(particles_, static_cast<R>(params_.time_step));
+    exact->update(particles_);
     compute_density_pressure(particles_, exact->lists(), static_cast<R>(params_.kernel_radius), params_.fluid);
   }
 }
@@ -133,7 +133,7 @@ const StepInfo& Simulation<D, R>::step() {
   // Emit after reordering, so that this step's new particles are the last ones (callers, like
   // sph compare's perturbation, rely on that).
   info.emitted = emit();
-  neighbors_->update(particles_, dt);
+  neighbors_->update(particles_);
   info.neighbors = neighbors_->counters();
   info.seconds.grid = info.neighbors.grid_seconds + reorder_seconds;
   info.seconds.lists = info.neighbors.lists_seconds;
@@ -146,7 +146,6 @@ const StepInfo& Simulation<D, R>::step() {
   Stopwatch watch;
   info.pairs_within_h = compute_density_pressure(particles_, lists, h, params_.fluid);
   info.seconds.density = watch.lap();
-  // Fluid forces and walls in one pass (compute_fluid_accelerations + add_wall_accelerations).
   const WallContact<D, R> walls(params_.container, params_.obstacles, static_cast<R>(params_.particle_radius),
                                 params_.walls);
   compute_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity), walls,
@@ -164,7 +163,7 @@ const StepInfo& Simulation<D, R>::step() {
 
 template <int D, std::floating_point R>
 void Simulation<D, R>::integrate_and_check(R dt) {
-  // Symplectic Euler (integrate_symplectic_euler) and the blow-up check in one pass.
+  // Symplectic Euler (v += dt a; x += dt v) and the blow-up check in one pass.
   const std::size_t n = particles_.size();
   const double limit2 = speed_limit_ * speed_limit_;
   std::vector<std::uint8_t>& bad = bad_;

@@ -58,7 +58,8 @@ class Simulation {
   Simulation(SimulationParams<D> params, ParticleSet<D, R> particles);
 
   /// Advances one time step. Throws sph::Error if a particle's state becomes non-finite or
-  /// its speed runs away (above speed_limit()), naming the step and the particle id.
+  /// its speed runs away, naming the step and the particle id. The speed limit is 20 times the
+  /// sound speed sqrt(k) plus the speed of free fall over the container's size.
   const StepInfo& step();
 
   const ParticleSet<D, R>& particles() const { return particles_; }
@@ -68,10 +69,6 @@ class Simulation {
   double time() const { return static_cast<double>(steps_) * params_.time_step; }
   const StepInfo& last_step() const { return info_; }
   const std::vector<EmitterState>& emitter_states() const { return emitters_; }
-
-  /// Speed above which the run is declared to have blown up: 20 times the sound speed
-  /// sqrt(k) plus the speed of free fall over the container's size. m/s.
-  double speed_limit() const { return speed_limit_; }
 
   /// Total kinetic energy, J (J/m in 2D). Deterministic for any thread count. (This and the
   /// other reductions use a shared scratch buffer: do not call them concurrently.)
@@ -112,7 +109,7 @@ class Simulation {
   mutable std::vector<std::uint8_t> bad_;  // per-chunk blow-up flags
   std::vector<EmitterState> emitters_;
   std::int64_t steps_ = 0;
-  double speed_limit_ = 0;
+  double speed_limit_ = 0;  // m/s: a faster particle means the run blew up (step() throws)
   StepInfo info_;
 };
 

@@ -94,18 +94,18 @@ std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
   return total;
 }
 
-template <PressureForce kForm, bool kExitTest, int D, std::floating_point R>
+/// The force pass: viscosity, the Eq. 7 test when kExitTest, gravity, the walls, and the pressure
+/// term of form kForm when kPressure (false with a gradient correction, whose pressure term
+/// corrected_pressure_pass adds).
+template <PressureForce kForm, bool kPressure, bool kExitTest, int D, std::floating_point R>
 void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                const Vec<D, R>& gravity, const WallContact<D, R>* walls, std::span<std::uint8_t> flags, R dt) {
+                const Vec<D, R>& gravity, const WallContact<D, R>& walls, std::span<std::uint8_t> flags, R dt) {
   using P = simd::Pack<R>;
   constexpr int W = simd::kLanes<R>;
   const P hv = P::set1(h), h2v = P::set1(h * h), zero = P::set1(R(0)), one = P::set1(R(1)), minus_one = P::set1(R(-1)),
           half = P::set1(R(0.5));
   const P grad_c = P::set1(R(-3) * SpikyKernel<D, R>(h).norm());
   const P grad6_c = P::set1(R(-6) * Poly6Kernel<D, R>(h).norm());
-  // With a gradient correction the pressure term is added by corrected_pressure_pass instead
-  // (times 1 leaves every other result bitwise as it was).
-  const P pressure_on = P::set1(fluid.gradient_correction == GradientCorrection::None ? R(1) : R(0));
   const R lap_c = ViscosityKernel<D, R>(h).laplacian_norm();
   const R mu = static_cast<R>(fluid.viscosity);
   const R* pos = flat(ps.position);
@@ -134,33 +134,38 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
       const Mask valid = simd::first_lanes<R>(nb.size() - k0);
       P rij[D];
       const P r2 = pair_offsets<D>(xi, pos, idx + k0, rij);
-      const Mask near = valid & (r2 < h2v);   // inside the support
-      const Mask apart = near & (r2 > zero);  // and not coincident (gradient defined)
+      const Mask near = valid & (r2 < h2v);  // inside the support
       const P r = sqrt(select(near, r2, h2v));
       const P dh = hv - r;
       const P inv_rhoj = one / P::template gather<1>(rho, idx + k0, 0);
-      const P pj = P::template gather<1>(prs, idx + k0, 0);
       const P mj = P::template gather<1>(mass, idx + k0, 0);
-      P pij;
-      if constexpr (kForm == PressureForce::Paper)
-        pij = (pi_half + half * pj * inv_rhoi_v) * inv_rhoj;
-      else
-        pij = pi_sym + pj * inv_rhoj * inv_rhoj;
       // -m_j P_ij times the spiky gradient -3 C (h - r)^2 rij / r (Eq. 5), and the viscosity
       // term mu m_j (v_j - v_i) C_lap (h - r) / (rho_i rho_j) (Eq. 6).
       // Variational: the density kernel's gradient -6 C6 (h^2 - r^2)^2 rij instead.
-      P fp;
-      if constexpr (kForm == PressureForce::Variational) {
-        const P d2 = h2v - r2;
-        fp = select(near, grad6_c * d2 * d2 * (minus_one * mj * pij), zero) * pressure_on;
-      } else {
-        fp = select(apart, (grad_c * dh * dh / select(apart, r, one)) * (minus_one * mj * pij), zero) * pressure_on;
+      P fp = zero;
+      if constexpr (kPressure) {
+        const P pj = P::template gather<1>(prs, idx + k0, 0);
+        P pij;
+        if constexpr (kForm == PressureForce::Paper)
+          pij = (pi_half + half * pj * inv_rhoi_v) * inv_rhoj;
+        else
+          pij = pi_sym + pj * inv_rhoj * inv_rhoj;
+        if constexpr (kForm == PressureForce::Variational) {
+          const P d2 = h2v - r2;
+          fp = select(near, grad6_c * d2 * d2 * (minus_one * mj * pij), zero);
+        } else {
+          const Mask apart = near & (r2 > zero);  // and not coincident (gradient defined)
+          fp = select(apart, (grad_c * dh * dh / select(apart, r, one)) * (minus_one * mj * pij), zero);
+        }
       }
       const P fv = select(near, visc_i * mj * inv_rhoj * dh, zero);
       P q2 = zero;  // Eq. 7: squared pair distance after the step, predicted with today's velocities
       for (int d = 0; d < D; ++d) {
         const P vj = P::template gather<D>(vel, idx + k0, d);
-        acc[d] = acc[d] + (rij[d] * fp + (vj - vi[d]) * fv);
+        if constexpr (kPressure)
+          acc[d] = acc[d] + (rij[d] * fp + (vj - vi[d]) * fv);
+        else
+          acc[d] = acc[d] + (vj - vi[d]) * fv;
         if constexpr (kExitTest) {
           const P t = rij[d] + (vi[d] - vj) * dtv;
           q2 = q2 + t * t;
@@ -176,7 +181,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
       if (flag_i) set_flag(i);
     Vec<D, R> a = gravity;
     for (int d = 0; d < D; ++d) a[d] += simd::sum_lanes(acc[d]);
-    if (walls != nullptr) a += (*walls)(ps.position[i], ps.velocity[i]);
+    a += walls(ps.position[i], ps.velocity[i]);
     ps.acceleration[i] = a;
   });
 }
@@ -277,61 +282,34 @@ std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborList
   return density_pass(ps, lists, h, fluid, within);
 }
 
-namespace {
-template <int D, std::floating_point R>
-void dispatch_force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                         const Vec<D, R>& gravity, const WallContact<D, R>* walls, std::span<std::uint8_t> exit_flags,
-                         R dt) {
-  SPH_CHECK(exit_flags.empty() || exit_flags.size() == ps.size(), "one exit flag per particle");
-  check_pass_inputs(ps, lists);
-  const auto run = [&]<PressureForce kForm>() {
-    if (exit_flags.empty())
-      force_pass<kForm, false>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
-    else
-      force_pass<kForm, true>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
-  };
-  switch (fluid.pressure_force) {
-    case PressureForce::Paper:
-      run.template operator()<PressureForce::Paper>();
-      break;
-    case PressureForce::Symmetric:
-      run.template operator()<PressureForce::Symmetric>();
-      break;
-    case PressureForce::Variational:
-      run.template operator()<PressureForce::Variational>();
-      break;
-  }
-}
-}  // namespace
-
-template <int D, std::floating_point R>
-void compute_fluid_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                                 const Vec<D, R>& gravity, std::span<std::uint8_t> exit_flags, R dt) {
-  dispatch_force_pass<D, R>(ps, lists, h, fluid, gravity, nullptr, exit_flags, dt);
-  if (fluid.gradient_correction == GradientCorrection::Renormalize) corrected_pressure_pass(ps, lists, h, fluid);
-}
-
-template <int D, std::floating_point R>
-void add_wall_accelerations(ParticleSet<D, R>& ps, const Box<D>& container, const std::vector<Box<D>>& obstacles,
-                            R particle_radius, const WallParams& walls) {
-  const WallContact<D, R> contact(container, obstacles, particle_radius, walls);
-  parallel_for(ps.size(), [&](std::size_t i) { ps.acceleration[i] += contact(ps.position[i], ps.velocity[i]); });
-}
-
 template <int D, std::floating_point R>
 void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                            const Vec<D, R>& gravity, const WallContact<D, R>& walls, std::span<std::uint8_t> exit_flags,
                            R dt) {
-  dispatch_force_pass(ps, lists, h, fluid, gravity, &walls, exit_flags, dt);
-  if (fluid.gradient_correction == GradientCorrection::Renormalize) corrected_pressure_pass(ps, lists, h, fluid);
-}
-
-template <int D, std::floating_point R>
-void integrate_symplectic_euler(ParticleSet<D, R>& ps, R dt) {
-  parallel_for(ps.size(), [&](std::size_t i) {
-    ps.velocity[i] += ps.acceleration[i] * dt;
-    ps.position[i] += ps.velocity[i] * dt;
-  });
+  SPH_CHECK(exit_flags.empty() || exit_flags.size() == ps.size(), "one exit flag per particle");
+  check_pass_inputs(ps, lists);
+  const auto run = [&]<PressureForce kForm, bool kPressure>() {
+    if (exit_flags.empty())
+      force_pass<kForm, kPressure, false>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
+    else
+      force_pass<kForm, kPressure, true>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
+  };
+  if (fluid.gradient_correction == GradientCorrection::Renormalize) {
+    run.template operator()<PressureForce::Paper, false>();  // the form only matters to the pressure term
+    corrected_pressure_pass(ps, lists, h, fluid);
+    return;
+  }
+  switch (fluid.pressure_force) {
+    case PressureForce::Paper:
+      run.template operator()<PressureForce::Paper, true>();
+      break;
+    case PressureForce::Symmetric:
+      run.template operator()<PressureForce::Symmetric, true>();
+      break;
+    case PressureForce::Variational:
+      run.template operator()<PressureForce::Variational, true>();
+      break;
+  }
 }
 
 template <int D>
@@ -352,16 +330,11 @@ double lattice_mass(double rest_density, double spacing, double h) {
   return rest_density / sum;
 }
 
-#define SPH_INSTANTIATE(D, R)                                                                                        \
-  template std::uint64_t compute_density_pressure<D, R>(ParticleSet<D, R>&, const NeighborLists&, R,                 \
-                                                        const FluidParams&);                                         \
-  template void compute_fluid_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&,   \
-                                                  const Vec<D, R>&, std::span<std::uint8_t>, R);                     \
-  template void add_wall_accelerations<D, R>(ParticleSet<D, R>&, const Box<D>&, const std::vector<Box<D>>&, R,       \
-                                             const WallParams&);                                                     \
-  template void compute_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&,         \
-                                            const Vec<D, R>&, const WallContact<D, R>&, std::span<std::uint8_t>, R); \
-  template void integrate_symplectic_euler<D, R>(ParticleSet<D, R>&, R);
+#define SPH_INSTANTIATE(D, R)                                                                                \
+  template std::uint64_t compute_density_pressure<D, R>(ParticleSet<D, R>&, const NeighborLists&, R,         \
+                                                        const FluidParams&);                                 \
+  template void compute_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&, \
+                                            const Vec<D, R>&, const WallContact<D, R>&, std::span<std::uint8_t>, R);
 SPH_INSTANTIATE(2, float)
 SPH_INSTANTIATE(2, double)
 SPH_INSTANTIATE(3, float)

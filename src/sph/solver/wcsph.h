@@ -20,24 +20,6 @@ template <int D, std::floating_point R>
 std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h,
                                        const FluidParams& fluid);
 
-/// Accelerations from pressure (Eq. 5, spiky gradient), viscosity (Eq. 6 with (v_j - v_i),
-/// viscosity-kernel Laplacian) and gravity:
-///   a_i = g + sum_j m_j [ -P_ij grad W_spiky(x_i - x_j) + mu (v_j - v_i) / (rho_i rho_j) lap W_visc ]
-/// with P_ij = (p_i + p_j) / (2 rho_i rho_j) (PressureForce::Paper: Eq. 5's force density
-/// divided by rho_i) or p_i / rho_i^2 + p_j / rho_j^2 (PressureForce::Symmetric; and
-/// PressureForce::Variational, which takes poly6's gradient in place of the spiky one).
-/// Every pair term is antisymmetric (m_i a_i = -m_j a_j), so total momentum is conserved when
-/// lists are symmetric.
-///
-/// If `exit_flags` is not empty (one per particle), the same pass also evaluates paper Eq. 7
-/// for every listed pair, |x_i - x_j + dt (u_i - u_j)|^2 > h^2, and sets exit_flags[i] and
-/// exit_flags[j] to 1 when it holds (flags are only ever set, never cleared, so concurrent
-/// setting is race-free and the result is the same for any thread count). This pass gathers
-/// every neighbor's position and velocity anyway, so the test costs a few operations per pair.
-template <int D, std::floating_point R>
-void compute_fluid_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                                 const Vec<D, R>& gravity, std::span<std::uint8_t> exit_flags = {}, R dt = 0);
-
 /// The damped penalty acceleration of the container walls and the obstacles on one particle.
 /// A particle interacts with a wall plane when closer than `particle_radius` to it; the contact
 /// pushes along the wall's normal and never pulls.
@@ -95,22 +77,26 @@ class WallContact {
   R radius_, ks_, kd_;
 };
 
-/// Adds the damped penalty accelerations of the container walls and of the obstacles.
-/// A particle interacts with a wall plane when closer than `particle_radius` to it.
-template <int D, std::floating_point R>
-void add_wall_accelerations(ParticleSet<D, R>& ps, const Box<D>& container, const std::vector<Box<D>>& obstacles,
-                            R particle_radius, const WallParams& walls);
-
-/// compute_fluid_accelerations and then the walls' accelerations, in one pass over the
-/// particles (what Simulation::step runs; the same values as the two calls).
+/// Accelerations from pressure (Eq. 5, spiky gradient), viscosity (Eq. 6 with (v_j - v_i),
+/// viscosity-kernel Laplacian), gravity and the walls (`walls`), in one pass over the particles:
+///   a_i = g + sum_j m_j [ -P_ij grad W_spiky(x_i - x_j) + mu (v_j - v_i) / (rho_i rho_j) lap W_visc ]
+///         + walls(x_i, v_i)
+/// with P_ij = (p_i + p_j) / (2 rho_i rho_j) (PressureForce::Paper: Eq. 5's force density
+/// divided by rho_i) or p_i / rho_i^2 + p_j / rho_j^2 (PressureForce::Symmetric; and
+/// PressureForce::Variational, which takes poly6's gradient in place of the spiky one). With
+/// GradientCorrection::Renormalize the pressure term's gradient is (L_i + L_j) / 2 grad W_ij
+/// (a second pass over the pairs). Every pair term is antisymmetric (m_i a_i = -m_j a_j), so
+/// total momentum is conserved when lists are symmetric.
+///
+/// If `exit_flags` is not empty (one per particle), the same pass also evaluates paper Eq. 7
+/// for every listed pair, |x_i - x_j + dt (u_i - u_j)|^2 > h^2, and sets exit_flags[i] and
+/// exit_flags[j] to 1 when it holds (flags are only ever set, never cleared, so concurrent
+/// setting is race-free and the result is the same for any thread count). This pass gathers
+/// every neighbor's position and velocity anyway, so the test costs a few operations per pair.
 template <int D, std::floating_point R>
 void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                            const Vec<D, R>& gravity, const WallContact<D, R>& walls,
                            std::span<std::uint8_t> exit_flags = {}, R dt = 0);
-
-/// Symplectic Euler: v += dt a; x += dt v.
-template <int D, std::floating_point R>
-void integrate_symplectic_euler(ParticleSet<D, R>& ps, R dt);
 
 /// Particle mass such that a particle inside a lattice of spacing dx (square in 2D, cubic in
 /// 3D) has exactly density rho0 under the poly6 sum of Eq. 4 with support h.

@@ -1,0 +1,54 @@
+#pragma once
+/// \file The neighbor modes: one descriptor table that names, describes and selects them.
+/// Scenes, flags, `sph compare` and `sph bench` take their names and defaults from it.
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sph {
+
+/// Neighbor strategies (kNeighborModes describes each).
+enum class NeighborMode { Standard, Adaptive, Verlet, BruteForce };
+
+/// One neighbor mode as users name and select it.
+struct NeighborModeInfo {
+  NeighborMode mode;
+  std::string_view name;         ///< in scenes (Configuration.neighbors) and flags
+  std::string_view description;  ///< one line: what the mode does
+  /// Run by `sph compare` and `sph bench` by default, and accepted by them. The brute-force
+  /// oracle of the tests (O(N^2)) is not: it is too slow to time.
+  bool compared;
+};
+
+/// Every mode, in the enum's order.
+inline constexpr NeighborModeInfo kNeighborModes[] = {
+    {NeighborMode::Standard, "standard", "rebuilds every list every step (paper Section 4)", true},
+    {NeighborMode::Adaptive, "adaptive",
+     "the paper's Algorithm 2: rebuilds the lists flagged by the Eq. 7 test, all of them every full-rebuild period",
+     true},
+    {NeighborMode::Verlet, "verlet", "exact lists of radius h + skin, all rebuilt once a particle moved half the skin",
+     true},
+    {NeighborMode::BruteForce, "brute_force", "compares every pair, O(N^2): the tests' oracle, for tiny scenes", false},
+};
+
+/// Which modes a list holds: all of them, or those with `compared` set.
+enum class NeighborModeSet { All, Compared };
+
+/// The table's entry of `mode`.
+const NeighborModeInfo& neighbor_mode_info(NeighborMode mode);
+/// The mode's name: "standard", "adaptive", "verlet" or "brute_force".
+std::string_view to_string(NeighborMode mode);
+/// Parses a mode name; throws sph::Error naming the accepted values otherwise.
+NeighborMode parse_neighbor_mode(std::string_view name, const std::string& where = {});
+
+/// The names of the modes of `set`, in the table's order.
+std::vector<std::string> neighbor_mode_names(NeighborModeSet set = NeighborModeSet::All);
+/// The modes of `set`, in the table's order.
+std::vector<NeighborMode> neighbor_modes(NeighborModeSet set);
+/// The names of the modes of `set` joined for a message or a default value: `separator`
+/// between them, `last_separator` before the last one ("standard, adaptive or verlet" with
+/// ", " and " or ").
+std::string join_neighbor_mode_names(NeighborModeSet set, std::string_view separator, std::string_view last_separator);
+
+}  // namespace sph

@@ -8,19 +8,23 @@
 
 namespace sph::detail {
 
-FrameData read_ply(const Source& src) {
+namespace {
+
+struct Prop {
+  std::string name;
+  Num type;
+};
+
+/// Reads the PLY header into `b` (time, vertex count) and returns the vertex properties in
+/// order and, in `data`, where the vertex records start.
+std::vector<Prop> read_ply_header(const Source& src, FrameBuilder& b, std::size_t& data) {
   const std::string& f = src.bytes;
   const std::string end_marker = "end_header\n";
   if (f.rfind("ply\n", 0) != 0) src.fail("is not a PLY file (it does not start with \"ply\")");
   const std::size_t he = f.find(end_marker);
   if (he == std::string::npos) src.fail("its PLY header has no end_header line: the file is truncated or corrupt");
   std::istringstream header(f.substr(4, he - 4));
-  FrameBuilder b(src);
   bool have_format = false, have_vertex = false;
-  struct Prop {
-    std::string name;
-    Num type;
-  };
   std::vector<Prop> props;
   for (std::string line; std::getline(header, line);) {
     const auto w = split(line);
@@ -63,9 +67,19 @@ FrameData read_ply(const Source& src) {
     }
   }
   if (!have_format || !have_vertex) src.fail("has no format or no vertex element in its PLY header");
+  data = he + end_marker.size();
+  return props;
+}
+
+}  // namespace
+
+FrameData read_ply(const Source& src) {
+  const std::string& f = src.bytes;
+  FrameBuilder b(src);
+  std::size_t data = 0;
+  const std::vector<Prop> props = read_ply_header(src, b, data);
   std::size_t record = 0;
   for (const Prop& p : props) record += num_size(p.type);
-  const std::size_t data = he + end_marker.size();
   const std::size_t n = b.data.size;
   if (record == 0 || (f.size() - data) / record != n || (f.size() - data) % record != 0)
     src.fail(fmt::format("holds {} bytes of vertex data; expected {} for {} vertices: the file is truncated or corrupt",

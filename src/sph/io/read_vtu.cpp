@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -51,9 +52,62 @@ std::vector<XmlTag> xml_tags(const Source& src, std::string_view xml) {
   return tags;
 }
 
-}  // namespace
+/// The raw appended array of DataArray tag `t` (data starts at byte `data` of the file, in the
+/// byte order `big`): `tuples` tuples into `out`; returns its components. Fails on anything sph
+/// does not write and on sizes that do not fit the file.
+int read_array(const Source& src, std::size_t data, bool big, const XmlTag& t, std::uint64_t tuples,
+               std::vector<double>& out) {
+  const std::string& f = src.bytes;
+  const auto get = [&](const char* key) -> std::string {
+    const auto it = t.attr.find(key);
+    return it == t.attr.end() ? std::string() : it->second;
+  };
+  const std::string type = get("type"), name = get("Name");
+  Num num;
+  if (type == "Float32")
+    num = Num::F32;
+  else if (type == "Float64")
+    num = Num::F64;
+  else if (type == "UInt8")
+    num = Num::U8;
+  else if (type == "UInt32")
+    num = Num::U32;
+  else if (type == "Int32")
+    num = Num::I32;
+  else if (type == "UInt64")
+    num = Num::U64;
+  else if (type == "Int64")
+    num = Num::I64;
+  else
+    src.fail("the array \"" + name + "\" has type \"" + type + "\", which sph does not write");
+  if (get("format") != "appended")
+    src.fail("the array \"" + name + "\" is not in the raw appended data, as sph writes it");
+  const auto comps = parse_count(get("NumberOfComponents").empty() ? "1" : get("NumberOfComponents"));
+  const auto offset = parse_count(get("offset"));
+  if (!comps || *comps < 1 || *comps > 3 || !offset)
+    src.fail("the array \"" + name + "\" has a bad NumberOfComponents or offset");
+  const std::uint64_t avail = f.size() - data;
+  if (*offset > avail || avail - *offset < 8)
+    src.fail("the array \"" + name + "\" lies beyond the end of the file: the file is truncated");
+  std::uint64_t bytes = 0;
+  std::memcpy(&bytes, f.data() + data + *offset, 8);
+  if (big != (std::endian::native == std::endian::big))
+    bytes = static_cast<std::uint64_t>(load(f.data() + data + *offset, Num::U64, big));
+  const std::uint64_t want = tuples * *comps * num_size(num);  // tuples <= file size: no overflow
+  if (bytes != want)
+    src.fail(fmt::format("the array \"{}\" holds {} bytes; expected {} for {} points", name, bytes, want, tuples));
+  if (avail - *offset - 8 < bytes)
+    src.fail("the array \"" + name + "\" ends beyond the end of the file: the file is truncated");
+  const char* p = f.data() + data + *offset + 8;
+  const std::size_t count = static_cast<std::size_t>(tuples * *comps);
+  out.resize(count);
+  for (std::size_t i = 0; i < count; ++i) out[i] = load(p + i * num_size(num), num, big);
+  return static_cast<int>(*comps);
+}
 
-FrameData read_vtu(const Source& src) {
+/// Checks the frame's envelope (the XML header, the raw appended data, the closing tags) and
+/// returns where the appended data starts (after its '_') and where the header ends.
+std::pair<std::size_t, std::size_t> appended_data(const Source& src) {
   const std::string& f = src.bytes;
   const std::string open = "<AppendedData encoding=\"raw\">";
   if (f.rfind("<?xml", 0) != 0 || f.find("<VTKFile type=\"UnstructuredGrid\"") == std::string::npos)
@@ -63,66 +117,26 @@ FrameData read_vtu(const Source& src) {
   std::size_t data = f.find_first_not_of(" \t\r\n", ad + open.size());
   if (data == std::string::npos || f[data] != '_')
     src.fail("the appended data does not start with '_': the file is truncated or corrupt");
-  ++data;
-  const std::vector<XmlTag> tags = xml_tags(src, std::string_view(f).substr(0, ad));
-  {
-    // The file ends with the closing tags sph writes: a file cut short at a block boundary is refused too.
-    const std::size_t last = f.find_last_not_of(" \t\r\n");
-    const std::string close = "</AppendedData>\n</VTKFile>";
-    if (last == std::string::npos || last + 1 < close.size() ||
-        f.compare(last + 1 - close.size(), close.size(), close) != 0)
-      src.fail("does not end with </VTKFile>: the file is truncated");
-  }
+  // The file ends with the closing tags sph writes: a file cut short at a block boundary is refused too.
+  const std::size_t last = f.find_last_not_of(" \t\r\n");
+  const std::string close = "</AppendedData>\n</VTKFile>";
+  if (last == std::string::npos || last + 1 < close.size() ||
+      f.compare(last + 1 - close.size(), close.size(), close) != 0)
+    src.fail("does not end with </VTKFile>: the file is truncated");
+  return {data + 1, ad};
+}
 
+}  // namespace
+
+FrameData read_vtu(const Source& src) {
+  const std::pair<std::size_t, std::size_t> envelope = appended_data(src);
+  const std::size_t data = envelope.first;
+  const std::vector<XmlTag> tags = xml_tags(src, std::string_view(src.bytes).substr(0, envelope.second));
   bool big = false, have_piece = false, have_position = false;
   FrameBuilder b(src);
   std::string section;
-  const auto array = [&](const XmlTag& t, std::uint64_t tuples, std::vector<double>& out) -> int {
-    const auto get = [&](const char* key) -> std::string {
-      const auto it = t.attr.find(key);
-      return it == t.attr.end() ? std::string() : it->second;
-    };
-    const std::string type = get("type"), name = get("Name");
-    Num num;
-    if (type == "Float32")
-      num = Num::F32;
-    else if (type == "Float64")
-      num = Num::F64;
-    else if (type == "UInt8")
-      num = Num::U8;
-    else if (type == "UInt32")
-      num = Num::U32;
-    else if (type == "Int32")
-      num = Num::I32;
-    else if (type == "UInt64")
-      num = Num::U64;
-    else if (type == "Int64")
-      num = Num::I64;
-    else
-      src.fail("the array \"" + name + "\" has type \"" + type + "\", which sph does not write");
-    if (get("format") != "appended")
-      src.fail("the array \"" + name + "\" is not in the raw appended data, as sph writes it");
-    const auto comps = parse_count(get("NumberOfComponents").empty() ? "1" : get("NumberOfComponents"));
-    const auto offset = parse_count(get("offset"));
-    if (!comps || *comps < 1 || *comps > 3 || !offset)
-      src.fail("the array \"" + name + "\" has a bad NumberOfComponents or offset");
-    const std::uint64_t avail = f.size() - data;
-    if (*offset > avail || avail - *offset < 8)
-      src.fail("the array \"" + name + "\" lies beyond the end of the file: the file is truncated");
-    std::uint64_t bytes = 0;
-    std::memcpy(&bytes, f.data() + data + *offset, 8);
-    if (big != (std::endian::native == std::endian::big))
-      bytes = static_cast<std::uint64_t>(load(f.data() + data + *offset, Num::U64, big));
-    const std::uint64_t want = tuples * *comps * num_size(num);  // tuples <= file size: no overflow
-    if (bytes != want)
-      src.fail(fmt::format("the array \"{}\" holds {} bytes; expected {} for {} points", name, bytes, want, tuples));
-    if (avail - *offset - 8 < bytes)
-      src.fail("the array \"" + name + "\" ends beyond the end of the file: the file is truncated");
-    const char* p = f.data() + data + *offset + 8;
-    const std::size_t count = static_cast<std::size_t>(tuples * *comps);
-    out.resize(count);
-    for (std::size_t i = 0; i < count; ++i) out[i] = load(p + i * num_size(num), num, big);
-    return static_cast<int>(*comps);
+  const auto array = [&](const XmlTag& t, std::uint64_t tuples, std::vector<double>& out) {
+    return read_array(src, data, big, t, tuples, out);
   };
   for (const XmlTag& t : tags) {
     if (t.name == "VTKFile" && !t.closing) {

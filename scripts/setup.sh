@@ -14,6 +14,8 @@ packages=(
   # scripts/sanitize.sh: clang, its sanitizer and libFuzzer runtimes, llvm-symbolizer for the
   # reports' stacks, and libomp with Archer (libarcher.so), which makes OpenMP visible to TSan.
   clang-14 libclang-rt-14-dev llvm-14 libomp-14-dev
+  # scripts/lint.sh: the format and clang-tidy checks.
+  clang-format-14 clang-tidy-14
 )
 
 missing=()

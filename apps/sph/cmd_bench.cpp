@@ -128,7 +128,7 @@ std::function<int()> add_bench_command(CLI::App& app) {
                   "Tank suite: steps per run (default: the whole scene, 1000 at size small)")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1'000'000'000}));
   cmd->add_option("--scene-dir", opt->scene_dir,
-                  "Directory holding tank_fill_3d.json (default: the source tree's scenes/paper)");
+                  "Directory holding tank_fill_3d.json (default: the paper scenes installed with sph)");
   cmd->add_flag("--no-progress", opt->no_progress, "No progress lines on stderr (the tables still go to stdout)");
   return [opt, cmd]() -> int {
     if (!cmd->parsed()) return kBadInput;

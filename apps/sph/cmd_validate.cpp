@@ -10,15 +10,12 @@
 #include <fmt/format.h>
 
 #include <sph/analysis/validation.h>
+#include <sph/core/data_dir.h>
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 #include <sph/core/timer.h>
 
 #include "commands.h"
-
-#ifndef SPH_VALIDATION_SCENE_DIR
-#define SPH_VALIDATION_SCENE_DIR "scenes/validation"
-#endif
 
 namespace sph::app {
 
@@ -29,7 +26,7 @@ namespace fs = std::filesystem;
 struct ValidateCliOptions {
   std::string cases = "all";
   std::string output = "out/validation";
-  std::string scenes = SPH_VALIDATION_SCENE_DIR;
+  std::string scenes;  // empty: the validation scenes installed with sph (scene_dir)
   int threads = 0;
   bool quick = false;
   bool no_progress = false;
@@ -59,7 +56,7 @@ int validate(const ValidateCliOptions& opt) {
   ValidationOptions vo;
   vo.cases = parse_cases(opt.cases);
   vo.quick = opt.quick;
-  vo.scene_dir = opt.scenes;
+  vo.scene_dir = opt.scenes.empty() ? scene_dir("validation") : fs::path(opt.scenes);
   if (!fs::is_directory(vo.scene_dir))
     throw Error("not a directory; expected the directory of the validation scenes (scenes/validation)", opt.scenes);
   if (opt.threads > 0) set_num_threads(opt.threads);
@@ -70,6 +67,7 @@ int validate(const ValidateCliOptions& opt) {
   for (const auto& c : vo.cases) list += (list.empty() ? "" : ",") + c;
   fmt::print(stderr, "sph: validate {}{} ({} thread{}) -> {}\n", list, opt.quick ? " (quick)" : "", num_threads(),
              num_threads() == 1 ? "" : "s", dir.string());
+  fmt::print(stderr, "sph: scenes from {}\n", vo.scene_dir.string());
   const ValidationProgress progress = [&](const std::string& line) {
     if (!opt.no_progress) fmt::print(stderr, "sph: {}\n", line);
   };
@@ -105,7 +103,8 @@ std::function<int()> add_validate_command(CLI::App& app) {
                 "Coarse, short versions (under a minute) with regression bounds instead of the targets (CI)");
   cmd->add_option("-o,--output", opt->output, "Output directory (report.md, CSVs, plots)")
       ->default_str("out/validation");
-  cmd->add_option("--scenes", opt->scenes, "Directory of the validation scenes")->default_str(SPH_VALIDATION_SCENE_DIR);
+  cmd->add_option("--scenes", opt->scenes, "Directory of the validation scenes")
+      ->default_str("the validation scenes of sph's data: <prefix>/share/sph/scenes/validation");
   cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
   cmd->add_flag("--no-progress", opt->no_progress, "No progress lines");
   return [opt, cmd]() -> int {

@@ -6,14 +6,11 @@
 
 #include <fmt/format.h>
 
+#include <sph/core/data_dir.h>
 #include <sph/core/error.h>
 #include <sph/io/atomic_file.h>
 #include <sph/neighbors/neighbor_mode.h>
 #include <sph/scene/scene_reader.h>
-
-#ifndef SPH_BENCH_SCENE_DIR
-#define SPH_BENCH_SCENE_DIR "scenes/paper"
-#endif
 
 namespace sph {
 
@@ -39,7 +36,7 @@ int logical_cores() { return std::max(1, static_cast<int>(std::thread::hardware_
 
 }  // namespace
 
-std::filesystem::path default_scene_dir() { return SPH_BENCH_SCENE_DIR; }
+std::filesystem::path default_scene_dir() { return scene_dir("paper"); }
 
 const char* to_string(BenchSize size) {
   switch (size) {

@@ -47,7 +47,7 @@ struct BenchOptions {
   std::filesystem::path scene_dir;  ///< tank: directory of tank_fill_3d.json (empty: default_scene_dir())
 };
 
-/// The source tree's scenes/paper directory (fixed at configure time).
+/// The paper scenes installed with sph: scene_dir("paper") (sph/core/data_dir.h).
 std::filesystem::path default_scene_dir();
 
 /// Median, minimum and maximum of some timings (seconds, in the order measured).

@@ -13,10 +13,10 @@
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 #include <sph/core/timer.h>
-#include <sph/run/memory.h>
 #include <sph/io/atomic_file.h>
 #include <sph/io/frames.h>
 #include <sph/neighbors/neighbor_mode.h>
+#include <sph/run/memory.h>
 #include <sph/scene/scene_reader.h>
 
 #include "commands.h"

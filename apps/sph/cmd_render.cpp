@@ -245,7 +245,8 @@ std::function<int()> add_render_command(CLI::App& app) {
       ->check(CLI::Range(-90.0, 90.0))
       ->default_str("20");
   cmd->add_flag("--flat", opt->flat, "Flat discs instead of shaded spheres");
-  cmd->add_option("--format", opt->format, "Which frames to read when the run wrote several formats: " + frame_format_list());
+  cmd->add_option("--format", opt->format,
+                  "Which frames to read when the run wrote several formats: " + frame_format_list());
   cmd->add_flag("--mp4", opt->mp4, "Also encode the images as movie.mp4 in the output directory (needs ffmpeg)");
   cmd->add_option("--video-fps", opt->video_fps, "Frames per second of the movie")
       ->check(CLI::Range(1.0, 240.0))

@@ -16,11 +16,11 @@
 #include <sph/core/parallel.h>
 #include <sph/io/checkpoint.h>
 #include <sph/io/run_output.h>
+#include <sph/neighbors/neighbor_mode.h>
 #include <sph/run/driver.h>
 #include <sph/run/resume.h>
-#include <sph/scene/dispatch.h>
-#include <sph/neighbors/neighbor_mode.h>
 #include <sph/scene/builders.h>
+#include <sph/scene/dispatch.h>
 #include <sph/scene/scene_reader.h>
 
 #include "commands.h"
@@ -295,8 +295,8 @@ std::function<int()> add_run_command(CLI::App& app) {
                       ", overriding Configuration.outputFormats (default: vtu)")
       ->type_name("LIST");
   cmd->add_option("--fields", opt->fields,
-                  "Point fields of each frame besides the positions, a comma-separated list of " +
-                      frame_field_list() + ", or none; overrides Configuration.outputFields (default: all)")
+                  "Point fields of each frame besides the positions, a comma-separated list of " + frame_field_list() +
+                      ", or none; overrides Configuration.outputFields (default: all)")
       ->type_name("LIST");
   cmd->add_option("--every", opt->every,
                   "A frame every N steps (0: no frames), overriding Configuration.outputEveryNSteps and outputFps")

@@ -106,8 +106,8 @@ int main(int argc, char** argv) {
     // Point at the help of the subcommand the user typed, if any.
     std::string sub = "run";
     for (int i = 1; i < argc; ++i)
-      if (const std::string a = argv[i]; a == "run" || a == "compare" || a == "bench" || a == "validate" ||
-                                             a == "render" || a == "view") {
+      if (const std::string a = argv[i];
+          a == "run" || a == "compare" || a == "bench" || a == "validate" || a == "render" || a == "view") {
         sub = a;
         break;
       }

@@ -119,7 +119,7 @@ TEST(AddedField, BadSpecsAreRefused) {
   EXPECT_THROW(ps.add_field({"density", FieldKind::Real, "", "", ""}), Error);  // a built-in field's name
   EXPECT_THROW(ps.add_field({"tag", FieldKind::Id, "", "", ""}), Error);
   ps.add_field(kTemperature);
-  EXPECT_THROW(ps.add_field(kTemperature), Error);  // twice
+  EXPECT_THROW(ps.add_field(kTemperature), Error);     // twice
   EXPECT_THROW(ps.vector_field(0), std::logic_error);  // a real field asked for as a vector
 }
 
@@ -140,7 +140,7 @@ void check_frame_round_trip(FrameFormat f) {
   std::vector<std::string> names, mem_names;
   for (const FrameField& ff : fr.fields) names.push_back(ff.name);
   for (const FrameField& ff : mem.fields) mem_names.push_back(ff.name);
-  const std::vector<std::string> expected{"velocity", "density",   "pressure", "id",
+  const std::vector<std::string> expected{"velocity",         "density",     "pressure", "id",
                                           "initial_position", "temperature", "vorticity"};
   EXPECT_EQ(names, expected) << "the built-in fields in table order, then the added ones";
   EXPECT_EQ(mem_names, expected);

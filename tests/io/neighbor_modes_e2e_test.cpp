@@ -1,6 +1,7 @@
 // The neighbor modes on the paper scenes, read from their files: verlet lists never miss a
 // pair within h (audited every step), adaptive with a full-rebuild period of 1 is the standard
-// run bit for bit (with particles reordered in memory at the same steps), and the adaptive audit sees the pairs the paper's test cannot.
+// run bit for bit (with particles reordered in memory at the same steps), and the adaptive audit sees the pairs the
+// paper's test cannot.
 
 #include <string>
 

@@ -74,8 +74,8 @@ TEST(OutputDirectory, RemovesOldRunFilesButKeepsOthers) {
   TempDir dir;
   const fs::path out = dir.path();
   fs::create_directories(out / "frames");
-  for (const char* f : {"frames.pvd", "stats.csv", "summary.json", "scene.json", "notes.txt", "my_frame_000001.vtu",
-                        "stats.csv.bak"})
+  for (const char* f :
+       {"frames.pvd", "stats.csv", "summary.json", "scene.json", "notes.txt", "my_frame_000001.vtu", "stats.csv.bak"})
     spit(out / f, "old");
   for (const char* f : {"frame_000000.vtu", "frame_000001.vtu", "frame_123456.vtu", "keep.vtu", "frame_notes.txt",
                         "other_frame_000000.vtu"})
@@ -87,7 +87,8 @@ TEST(OutputDirectory, RemovesOldRunFilesButKeepsOthers) {
 
   EXPECT_EQ(entries(out),
             (std::vector<std::string>{"frames", "my_frame_000001.vtu", "notes.txt", "results", "stats.csv.bak"}));
-  EXPECT_EQ(entries(out / "frames"), (std::vector<std::string>{"frame_notes.txt", "keep.vtu", "other_frame_000000.vtu"}));
+  EXPECT_EQ(entries(out / "frames"),
+            (std::vector<std::string>{"frame_notes.txt", "keep.vtu", "other_frame_000000.vtu"}));
   EXPECT_EQ(entries(out / "results"), std::vector<std::string>{"frame_000000.vtu"});
   EXPECT_EQ(slurp(out / "notes.txt"), "old");
 }
@@ -123,8 +124,8 @@ TEST(RunOutput, WritesFramesStatsAndSummary) {
   }
   out.finish(sim, "completed", 0.5);
   EXPECT_EQ(out.frames_written(), 4u) << "steps 0, 2, 4 and the last step 5";
-  EXPECT_EQ(entries(dir / "frames"), (std::vector<std::string>{"frame_000000.vtu", "frame_000001.vtu",
-                                                              "frame_000002.vtu", "frame_000003.vtu"}));
+  EXPECT_EQ(entries(dir / "frames"),
+            (std::vector<std::string>{"frame_000000.vtu", "frame_000001.vtu", "frame_000002.vtu", "frame_000003.vtu"}));
   EXPECT_EQ(entries(dir.path()),
             (std::vector<std::string>{"frames", "frames.pvd", "scene.json", "stats.csv", "summary.json"}));
   EXPECT_TRUE(parse_scene(slurp(dir / "scene.json"), desc.source) == desc) << "scene.json is the run's scene";

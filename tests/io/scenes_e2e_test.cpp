@@ -89,10 +89,11 @@ void check_state(const Simulation<D, R>& sim, const Expect& ex, const std::strin
   EXPECT_GE(mean_neighbors, ex.min_mean_neighbors);
   EXPECT_LE(mean_neighbors, ex.max_mean_neighbors);
 
-  std::printf("  %s: %zu particles, t = %.4g s, max speed %.3f m/s (bound %.2f), KE %.4g, mean neighbors %.2f, "
-              "density %.1f..%.1f (mean %.1f), max pressure %.4g\n",
-              what.c_str(), n, sim.time(), sim.max_speed(), speed_bound, ke, mean_neighbors, rho_min, rho_max,
-              rho_sum / static_cast<double>(n), p_max);
+  std::printf(
+      "  %s: %zu particles, t = %.4g s, max speed %.3f m/s (bound %.2f), KE %.4g, mean neighbors %.2f, "
+      "density %.1f..%.1f (mean %.1f), max pressure %.4g\n",
+      what.c_str(), n, sim.time(), sim.max_speed(), speed_bound, ke, mean_neighbors, rho_min, rho_max,
+      rho_sum / static_cast<double>(n), p_max);
 }
 
 // The sanity runs use one thread: results do not depend on the thread count (the determinism

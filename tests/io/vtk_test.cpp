@@ -16,8 +16,8 @@
 #include <sph/core/error.h>
 #include <sph/io/vtk.h>
 
-#include "support/test_particles.h"
 #include "support/temp_dir.h"
+#include "support/test_particles.h"
 
 namespace sph {
 namespace {
@@ -104,8 +104,7 @@ Vtu parse_vtu(const fs::path& path, std::size_t n_expected) {
   static const std::regex da(R"(<DataArray([^>]*)/>)");
   for (std::sregex_iterator it(header.begin(), header.end(), da), end; it != end; ++it)
     v.arrays.push_back({attributes((*it)[1])});
-  EXPECT_EQ(v.arrays.size(), 10u)
-      << "TimeValue, velocity, density, pressure, id, initial_position, position, cells x3";
+  EXPECT_EQ(v.arrays.size(), 10u) << "TimeValue, velocity, density, pressure, id, initial_position, position, cells x3";
 
   // Walk the blocks in offset order: each starts where the previous one ended, and each byte
   // count matches N * components * sizeof(type).
@@ -136,7 +135,6 @@ Vtu parse_vtu(const fs::path& path, std::size_t n_expected) {
   v.blob = file.substr(data_start, pos);
   return v;
 }
-
 
 template <int D, class R>
 void check_round_trip(std::size_t n) {

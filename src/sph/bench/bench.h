@@ -92,18 +92,18 @@ struct StepsRow {
   int threads = 1;
   bool oversubscribed = false;
   std::int64_t warmup_steps = 0, timed_steps = 0;
-  PhaseTimes ms_per_step;                ///< milliseconds per timed step, by phase
-  double wall_ms_per_step = 0;           ///< wall time of the timed loop per step (phases plus bookkeeping)
-  int runs = 1;                          ///< runs of this workload; the row is the run of median wall time
+  PhaseTimes ms_per_step;                   ///< milliseconds per timed step, by phase
+  double wall_ms_per_step = 0;              ///< wall time of the timed loop per step (phases plus bookkeeping)
+  int runs = 1;                             ///< runs of this workload; the row is the run of median wall time
   double wall_ms_min = 0, wall_ms_max = 0;  ///< fastest and slowest run's wall ms per step
-  double particle_steps_per_second = 0;  ///< particles * steps / wall seconds
-  double ns_per_particle_step = 0;       ///< the scaling figure: wall ns per particle and step
-  double lists_rebuilt_per_step = 0;     ///< mean over the timed steps
-  double neighbors_per_particle = 0;     ///< entries stored / particles after the last step
-  std::int64_t baseline_rss_bytes = -1;  ///< VmRSS before the simulation was built
-  std::int64_t peak_rss_bytes = -1;      ///< VmHWM after the run
-  bool peak_reset = false;               ///< the peak counter was reset before the build
-  double bytes_per_particle = 0;         ///< (peak - baseline) / particles
+  double particle_steps_per_second = 0;     ///< particles * steps / wall seconds
+  double ns_per_particle_step = 0;          ///< the scaling figure: wall ns per particle and step
+  double lists_rebuilt_per_step = 0;        ///< mean over the timed steps
+  double neighbors_per_particle = 0;        ///< entries stored / particles after the last step
+  std::int64_t baseline_rss_bytes = -1;     ///< VmRSS before the simulation was built
+  std::int64_t peak_rss_bytes = -1;         ///< VmHWM after the run
+  bool peak_reset = false;                  ///< the peak counter was reset before the build
+  double bytes_per_particle = 0;            ///< (peak - baseline) / particles
   double heap_bytes_per_particle =
       -1;  ///< malloc'd bytes held by the simulation after the run / particles (-1: unknown)
 };

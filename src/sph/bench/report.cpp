@@ -293,8 +293,8 @@ std::string steps_csv(const BenchResult& r) {
         x.warmup_steps, x.timed_steps, x.ms_per_step.grid, x.ms_per_step.lists, x.ms_per_step.density,
         x.ms_per_step.forces, x.ms_per_step.integrate, x.ms_per_step.total(), x.wall_ms_per_step,
         x.particle_steps_per_second, x.ns_per_particle_step, x.lists_rebuilt_per_step, x.neighbors_per_particle,
-        x.baseline_rss_bytes, x.peak_rss_bytes, x.bytes_per_particle, x.heap_bytes_per_particle, x.runs,
-        x.wall_ms_min, x.wall_ms_max);
+        x.baseline_rss_bytes, x.peak_rss_bytes, x.bytes_per_particle, x.heap_bytes_per_particle, x.runs, x.wall_ms_min,
+        x.wall_ms_max);
   return s;
 }
 

@@ -14,8 +14,8 @@
 #include <sph/core/parallel.h>
 #include <sph/core/timer.h>
 #include <sph/run/driver.h>
-#include <sph/scene/dispatch.h>
 #include <sph/scene/builders.h>
+#include <sph/scene/dispatch.h>
 #include <sph/scene/scene_reader.h>
 
 namespace sph {

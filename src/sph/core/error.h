@@ -33,7 +33,7 @@ namespace detail {
 
 /// Internal invariant (a bug if it fails, never a user error): throws std::logic_error
 /// naming the expression, file and line. Always on, also in Release builds.
-#define SPH_CHECK(cond, msg)                                                   \
-  do {                                                                         \
+#define SPH_CHECK(cond, msg)                                                    \
+  do {                                                                          \
     if (!(cond)) ::sph::detail::check_failed(#cond, __FILE__, __LINE__, (msg)); \
   } while (false)

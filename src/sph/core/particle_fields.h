@@ -62,8 +62,8 @@ inline constexpr FieldDesc kParticleFields[] = {
 
 /// Indices into kParticleFields (ParticleSet's members, in that order).
 namespace field {
-inline constexpr std::size_t kPosition = 0, kVelocity = 1, kDensity = 2, kPressure = 3, kId = 4,
-                             kInitialPosition = 5, kAcceleration = 6, kMass = 7;
+inline constexpr std::size_t kPosition = 0, kVelocity = 1, kDensity = 2, kPressure = 3, kId = 4, kInitialPosition = 5,
+                             kAcceleration = 6, kMass = 7;
 }  // namespace field
 
 namespace detail {

@@ -17,10 +17,10 @@ class StateReader;
 
 /// A field added to a ParticleSet at run time (ParticleSet::add_field).
 struct FieldSpec {
-  std::string name;                    ///< valid_field_name(), not a built-in field's
-  FieldKind kind = FieldKind::Real;    ///< Real or Vector
-  std::string unit2, unit3;            ///< SI unit in 2D and 3D
-  std::string what;                    ///< one line for documentation
+  std::string name;                  ///< valid_field_name(), not a built-in field's
+  FieldKind kind = FieldKind::Real;  ///< Real or Vector
+  std::string unit2, unit3;          ///< SI unit in 2D and 3D
+  std::string what;                  ///< one line for documentation
 };
 
 /// Structure of arrays holding all per-particle state. This is the only place that resizes,

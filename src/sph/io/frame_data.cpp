@@ -12,9 +12,11 @@ FrameData frame_data_of(const ParticleSet<D, R>& ps, double time, const FrameFie
   out.size = n;
   out.position.assign(3 * n, 0.0);
   for (std::size_t i = 0; i < n; ++i)
-    for (int d = 0; d < D; ++d) out.position[3 * i + static_cast<std::size_t>(d)] = static_cast<double>(ps.position[i][d]);
+    for (int d = 0; d < D; ++d)
+      out.position[3 * i + static_cast<std::size_t>(d)] = static_cast<double>(ps.position[i][d]);
   for_each_frame_field(ps, fields, [&](const FieldDesc& f, const auto& column) {
-    FrameField ff{std::string(f.name), f.components(), std::vector<double>(n * static_cast<std::size_t>(f.components()))};
+    FrameField ff{std::string(f.name), f.components(),
+                  std::vector<double>(n * static_cast<std::size_t>(f.components()))};
     for (std::size_t i = 0; i < n; ++i) {
       using T = typename std::decay_t<decltype(column)>::value_type;
       if constexpr (std::is_same_v<T, Vec<D, R>>) {

@@ -48,7 +48,7 @@ void for_each_frame_field(const ParticleSet<D, R>& ps, const FrameFields& fields
 
 /// Writes one frame file of `format` (write_vtu, write_legacy_vtk or write_ply), atomically.
 template <int D, std::floating_point R>
-void write_frame(FrameFormat format, const std::filesystem::path& path, const ParticleSet<D, R>& particles,
-                 double time, const FrameFields& fields = {});
+void write_frame(FrameFormat format, const std::filesystem::path& path, const ParticleSet<D, R>& particles, double time,
+                 const FrameFields& fields = {});
 
 }  // namespace sph

@@ -111,7 +111,6 @@ std::vector<std::string_view> split(std::string_view line) {
   return out;
 }
 
-
 void FrameBuilder::set_size(std::uint64_t n, std::size_t min_bytes) {
   if (n > src_.bytes.size() / min_bytes)
     src_.fail(fmt::format("declares {} points, more than its {} bytes can hold: the file is truncated or corrupt", n,

@@ -54,7 +54,10 @@ void FrameSchedule::written(double time) {
 
 template <int D, std::floating_point R>
 FrameWriter<D, R>::FrameWriter(fs::path dir, OutputDesc output)
-    : dir_(std::move(dir)), output_(std::move(output)), fields_(FrameFields::only(output_.fields)), schedule_(output_) {}
+    : dir_(std::move(dir)),
+      output_(std::move(output)),
+      fields_(FrameFields::only(output_.fields)),
+      schedule_(output_) {}
 
 template <int D, std::floating_point R>
 bool FrameWriter<D, R>::write_due(const Simulation<D, R>& sim, bool last) {
@@ -68,7 +71,8 @@ bool FrameWriter<D, R>::write_due(const Simulation<D, R>& sim, bool last) {
 template <int D, std::floating_point R>
 void FrameWriter<D, R>::write(const Simulation<D, R>& sim) {
   const std::size_t index = times_.size();
-  for (FrameFormat f : output_.formats) write_frame(f, dir_ / frame_name(index, f), sim.particles(), sim.time(), fields_);
+  for (FrameFormat f : output_.formats)
+    write_frame(f, dir_ / frame_name(index, f), sim.particles(), sim.time(), fields_);
   times_.push_back(sim.time());
   schedule_.written(sim.time());
   last_off_schedule_ = false;

@@ -42,8 +42,7 @@ char* put_value(char* p, std::uint64_t id) { return put_le(p, static_cast<std::u
 }  // namespace
 
 template <int D, std::floating_point R>
-void write_ply(const std::filesystem::path& path, const ParticleSet<D, R>& ps, double time,
-               const FrameFields& fields) {
+void write_ply(const std::filesystem::path& path, const ParticleSet<D, R>& ps, double time, const FrameFields& fields) {
   const std::size_t n = ps.size();
   std::string header = fmt::format(
       "ply\nformat binary_little_endian 1.0\ncomment sph frame\ncomment time {}\nelement vertex {}\n"

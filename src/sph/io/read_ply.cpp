@@ -139,7 +139,8 @@ FrameData read_ply(const Source& src) {
       p += num_size(props[k].type);
     }
   b.data.position = std::move(groups[0].values);
-  for (std::size_t g = 1; g < groups.size(); ++g) b.add(groups[g].name, groups[g].components, std::move(groups[g].values));
+  for (std::size_t g = 1; g < groups.size(); ++g)
+    b.add(groups[g].name, groups[g].components, std::move(groups[g].values));
   return b.finish(true);
 }
 

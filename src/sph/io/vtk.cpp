@@ -79,7 +79,8 @@ std::string active_arrays(const ParticleSet<D, R>& ps, const FrameFields& fields
     std::string& attr = f.kind == FieldKind::Vector ? vectors : scalars;
     if (attr.empty()) attr = std::string(f.name);
   });
-  return (scalars.empty() ? "" : " Scalars=\"" + scalars + "\"") + (vectors.empty() ? "" : " Vectors=\"" + vectors + "\"");
+  return (scalars.empty() ? "" : " Scalars=\"" + scalars + "\"") +
+         (vectors.empty() ? "" : " Vectors=\"" + vectors + "\"");
 }
 
 /// Appends `values` to `out` in big-endian byte order (the legacy VTK format's only one).

@@ -15,8 +15,8 @@ namespace sph {
 /// Writes the particles to a .vtu file (atomically). Points are the positions (z = 0 in 2D);
 /// point fields: those in `fields`, in the set's field order (velocity, density, pressure,
 /// id (UInt64), initial_position, then added fields), vectors with 3 components. Floating-point
-/// fields are Float32 for float runs and Float64 for double runs. The grid's FieldData holds TimeValue (Float64, one value): `time`, which
-/// ParaView shows as the frame's time.
+/// fields are Float32 for float runs and Float64 for double runs. The grid's FieldData holds TimeValue (Float64, one
+/// value): `time`, which ParaView shows as the frame's time.
 template <int D, std::floating_point R>
 void write_vtu(const std::filesystem::path& path, const ParticleSet<D, R>& particles, double time = 0,
                const FrameFields& fields = {});

@@ -97,11 +97,11 @@ class UniformGrid {
   V origin_{};
   R inv_cell_ = 0;
   std::array<std::int64_t, D> dims_{};
-  std::vector<std::uint32_t> cell_start_;  // size cells + 1
-  std::vector<std::uint32_t> sorted_;      // point indices sorted by cell (stable), + kPad
-  std::vector<std::uint32_t> cell_of_;     // cell of each point
+  std::vector<std::uint32_t> cell_start_;    // size cells + 1
+  std::vector<std::uint32_t> sorted_;        // point indices sorted by cell (stable), + kPad
+  std::vector<std::uint32_t> cell_of_;       // cell of each point
   std::vector<std::uint32_t> block_cursor_;  // parallel counting sort: per block and cell
-  std::array<std::vector<R>, D> coords_;   // coordinates in sorted order, + kPad
+  std::array<std::vector<R>, D> coords_;     // coordinates in sorted order, + kPad
 };
 
 extern template class UniformGrid<2, float>;

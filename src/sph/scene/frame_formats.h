@@ -16,15 +16,16 @@ enum class FrameFormat { Vtu, Vtk, Ply };
 
 struct FrameFormatDesc {
   FrameFormat format;
-  std::string_view name;    ///< in scenes and flags; also the file extension
-  std::string_view what;    ///< a few words for --help: what it is or what reads it
-  std::string_view look_at; ///< what a finished run points the user to, in its directory
-  std::string_view hint;    ///< ... and how to open it
+  std::string_view name;     ///< in scenes and flags; also the file extension
+  std::string_view what;     ///< a few words for --help: what it is or what reads it
+  std::string_view look_at;  ///< what a finished run points the user to, in its directory
+  std::string_view hint;     ///< ... and how to open it
 };
 
 /// Every format, in the order frames are looked for in a run directory (vtu, vtk, ply).
 inline constexpr FrameFormatDesc kFrameFormats[] = {
-    {FrameFormat::Vtu, "vtu", "ParaView", "frames.pvd  ", "open in ParaView (Filters > Point Gaussian to see particles)"},
+    {FrameFormat::Vtu, "vtu", "ParaView", "frames.pvd  ",
+     "open in ParaView (Filters > Point Gaussian to see particles)"},
     {FrameFormat::Vtk, "vtk", "legacy VTK", "frames/*.vtk", "legacy VTK frames (ParaView, VisIt, meshio)"},
     {FrameFormat::Ply, "ply", "Blender, Houdini", "frames/*.ply",
      "point clouds (Blender: File > Import > Stanford PLY; Houdini: File node)"},

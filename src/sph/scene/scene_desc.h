@@ -24,7 +24,8 @@ struct OutputDesc {
   /// whose time reaches k / fps.
   double fps = 0;
   std::vector<FrameFormat> formats{FrameFormat::Vtu};  ///< each frame in each of these formats
-  std::vector<std::string> fields{std::begin(kFrameFieldNames), std::end(kFrameFieldNames)};  ///< in kFrameFieldNames order
+  std::vector<std::string> fields{std::begin(kFrameFieldNames),
+                                  std::end(kFrameFieldNames)};  ///< in kFrameFieldNames order
 
   friend bool operator==(const OutputDesc&, const OutputDesc&) = default;
 };
@@ -53,15 +54,15 @@ struct SceneBody {
 /// SceneDesc.
 struct SceneDesc {
   int version = 1;
-  std::string name;         ///< short name, used for the default output directory
+  std::string name;  ///< short name, used for the default output directory
   std::string description;
-  std::string source;       ///< file the scene was read from (or "<string>")
+  std::string source;  ///< file the scene was read from (or "<string>")
   /// 2 or 3: the dimension of the body; set together with it by set_body().
   int dimension = 3;
   Precision precision = Precision::Double;
-  std::int64_t steps = 0;               ///< number of time steps to run
-  OutputDesc output;                    ///< frame formats, fields and schedule
-  std::vector<std::string> warnings;    ///< non-fatal problems found while reading (e.g. dt close to a limit)
+  std::int64_t steps = 0;             ///< number of time steps to run
+  OutputDesc output;                  ///< frame formats, fields and schedule
+  std::vector<std::string> warnings;  ///< non-fatal problems found while reading (e.g. dt close to a limit)
 
   /// The body; SPH_CHECK: D is the scene's dimension.
   template <int D>

@@ -11,12 +11,12 @@
 #include <nlohmann/json.hpp>
 
 #include <sph/core/error.h>
+#include <sph/neighbors/neighbor_mode.h>
 #include <sph/scene/direction.h>
 #include <sph/scene/json_source.h>
 #include <sph/scene/object_reader.h>
 #include <sph/scene/overrides.h>
 #include <sph/scene/scene_keys.h>
-#include <sph/neighbors/neighbor_mode.h>
 #include <sph/solver/time_step.h>
 #include <sph/solver/wcsph.h>
 
@@ -118,13 +118,12 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
                              sim.kernel_radius, kMaxKernelSpacings, 2 * sim.particle_radius,
                              kMaxKernelSpacings * 2.0 * sim.particle_radius));
   sim.gravity = c.vec<D>("gravitation", "the gravity acceleration in m/s^2", default_g);
-  sim.neighbors = parse_neighbor_mode(
-      c.choice("neighbors", neighbor_mode_names(), "standard"), c.child("neighbors"));
+  sim.neighbors = parse_neighbor_mode(c.choice("neighbors", neighbor_mode_names(), "standard"), c.child("neighbors"));
   sim.full_rebuild_period = static_cast<int>(
       c.integer("fullRebuildPeriod", "a full-rebuild period of at least 1 step", 1, 1'000'000'000, 200));
-  sim.reorder_period = static_cast<int>(c.integer("reorderPeriod",
-                                                  "a whole number of steps, 0 or more (0: never reorder particles in memory)",
-                                                  0, 1'000'000'000, sim.full_rebuild_period));
+  sim.reorder_period = static_cast<int>(
+      c.integer("reorderPeriod", "a whole number of steps, 0 or more (0: never reorder particles in memory)", 0,
+                1'000'000'000, sim.full_rebuild_period));
   sim.verlet_skin = c.positive("verletSkin", "a positive verlet skin in metres (default 0.1 h)",
                                kDefaultSkinFraction * sim.kernel_radius);
   if (sim.verlet_skin > 2.0 * sim.kernel_radius)
@@ -188,9 +187,9 @@ double read_blocks(ObjectReader& root, SceneBody<D>& body) {
     blk.box = read_box<D>(b, "fluid block");
     blk.velocity = b.vec<D>("velocity", "the initial velocity in m/s", Vec<D, double>{});
     if (!inside<D>(blk.box.lo, sim.container) || !inside<D>(blk.box.hi, sim.container))
-      b.ctx().fail(b.child("start"), fmt::format("the block {} .. {} is not inside the container {} .. {}",
-                                                 vec_text<D>(blk.box.lo), vec_text<D>(blk.box.hi),
-                                                 vec_text<D>(sim.container.lo), vec_text<D>(sim.container.hi)));
+      b.ctx().fail(b.child("start"),
+                   fmt::format("the block {} .. {} is not inside the container {} .. {}", vec_text<D>(blk.box.lo),
+                               vec_text<D>(blk.box.hi), vec_text<D>(sim.container.lo), vec_text<D>(sim.container.hi)));
     // Each axis on its own: a product taken first could be inf * 0 = NaN, which no comparison
     // refuses (a block far longer than 2e9 spacings one way and thinner than one the other).
     double count = 1;
@@ -219,11 +218,10 @@ EmitterParams<D> read_emitter(ObjectReader& e, const SimulationParams<D>& sim) {
   em.direction = *unit;
   em.speed = e.positive("velocity", "a positive emission speed in m/s");
   em.width = static_cast<int>(e.integer("width", "a nozzle width of 1 to 10000 particles", 1, 10000));
-  em.height =
-      D == 3 ? static_cast<int>(e.integer("height", "a nozzle height of 1 to 10000 particles", 1, 10000)) : 1;
+  em.height = D == 3 ? static_cast<int>(e.integer("height", "a nozzle height of 1 to 10000 particles", 1, 10000)) : 1;
   em.spacing = dx;
-  em.every_steps = static_cast<int>(
-      e.integer("emitEveryNSteps", "an emission interval of at least 1 step", 1, 1'000'000'000, 16));
+  em.every_steps =
+      static_cast<int>(e.integer("emitEveryNSteps", "an emission interval of at least 1 step", 1, 1'000'000'000, 16));
   em.max_particles = e.integer("maxParticles", "a positive particle budget", 1, 4'000'000'000LL);
   em.start_time = e.positive("emitStartTime", "a start time >= 0 in s", 0.0, true);
   em.end_time = e.positive("emitEndTime", "an end time > 0 in s", std::numeric_limits<double>::infinity());
@@ -256,9 +254,11 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
     total += static_cast<double>(sim.emitters.back().max_particles);
   });
 
-  if (total < 1) root.ctx().fail("FluidBlocks", "the scene has no particles: add a FluidBlocks entry or an Emitters entry");
+  if (total < 1)
+    root.ctx().fail("FluidBlocks", "the scene has no particles: add a FluidBlocks entry or an Emitters entry");
   if (total > 2e9)
-    root.ctx().fail("FluidBlocks", fmt::format("the scene would hold {:.3g} particles; at most 2e9 are supported", total));
+    root.ctx().fail("FluidBlocks",
+                    fmt::format("the scene would hold {:.3g} particles; at most 2e9 are supported", total));
 
   try {
     for (const std::string& w : check_time_step<D>(sim)) desc.warnings.push_back(w);
@@ -279,7 +279,8 @@ SceneDesc parse_scene(const std::string& text, const std::string& source, const 
   ObjectReader root(doc, "", ctx, detail::kRootKeys);
   desc.version = static_cast<int>(root.integer("version", "the scene format version 1", 1, 1));
   desc.name = root.string("name", "a scene name (letters, digits, - and _)", "scene");
-  if (desc.name.empty() || desc.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_") != std::string::npos)
+  if (desc.name.empty() || desc.name.find_first_not_of(
+                               "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_") != std::string::npos)
     ctx.fail("name", "expected a non-empty name of letters, digits, - and _, got \"" + desc.name + "\"");
   desc.description = root.string("description", "a description", "");
   root.string("units", "\"SI\"", "SI");

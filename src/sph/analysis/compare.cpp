@@ -34,29 +34,30 @@ std::vector<std::int64_t> image_steps(std::int64_t steps, int frames) {
 
 template <int D, std::floating_point R>
 Snapshot snapshot(const Simulation<D, R>& sim, bool with_velocity) {
-  const ParticleSet<D, R>& ps = sim.particles();
+  const FrameData f =
+      frame_data_of(sim.particles(), sim.time(),
+                    FrameFields::only(with_velocity ? std::vector<std::string>{"velocity", "id", "initial_position"}
+                                                    : std::vector<std::string>{"id"}));
   Snapshot s;
   s.step = sim.steps_done();
   s.time = sim.time();
-  const std::size_t ids = static_cast<std::size_t>(ps.next_id());
+  const std::size_t ids = static_cast<std::size_t>(sim.particles().next_id());
   const std::array<double, 3> none{kNaN, kNaN, kNaN};
   s.position.assign(ids, none);
   if (with_velocity) {
     s.velocity.assign(ids, none);
     s.initial.assign(ids, none);
   }
-  for (std::size_t i = 0; i < ps.size(); ++i) {
-    const std::size_t id = static_cast<std::size_t>(ps.id[i]);
-    std::array<double, 3> x{0, 0, 0}, v{0, 0, 0}, x0{0, 0, 0};
-    for (int d = 0; d < D; ++d) {
-      x[d] = static_cast<double>(ps.position[i][d]);
-      v[d] = static_cast<double>(ps.velocity[i][d]);
-      x0[d] = static_cast<double>(ps.initial_position[i][d]);
-    }
-    s.position[id] = x;
+  const auto at = [](const std::vector<double>& v, std::size_t i) {
+    return std::array<double, 3>{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+  };
+  const std::vector<double>& id = f.field("id")->values;
+  for (std::size_t i = 0; i < f.size; ++i) {
+    const auto k = static_cast<std::size_t>(id[i]);  // ids < 2^53: exact as doubles
+    s.position[k] = at(f.position, i);
     if (with_velocity) {
-      s.velocity[id] = v;
-      s.initial[id] = x0;
+      s.velocity[k] = at(f.field("velocity")->values, i);
+      s.initial[k] = at(f.field("initial_position")->values, i);
     }
   }
   return s;

@@ -43,7 +43,8 @@ struct StepRecord {
   double max_missed_penetration = 0;
 };
 
-/// Particle state at one sampled step, indexed by stable id.
+/// Particle state at one sampled step, indexed by stable id (made from the frame view,
+/// frame_data_of: the one conversion of a particle set to doubles).
 struct Snapshot {
   std::int64_t step = 0;  ///< steps done (0: the initial state)
   double time = 0;

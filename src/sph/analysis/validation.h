@@ -71,7 +71,8 @@ FrontError front_error(std::span<const double> T, std::span<const double> Z, std
 
 // ---- Fluid states and energies ---------------------------------------------------------------
 
-/// A fluid's state in doubles (positions and velocities padded with zeros to 3 components).
+/// A fluid's state in doubles (positions and velocities padded with zeros to 3 components), made
+/// from the frame view (frame_data_of) for the measures below.
 struct FluidState {
   int dimension = 2;
   double time = 0;

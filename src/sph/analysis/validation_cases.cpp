@@ -13,6 +13,7 @@
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 #include <sph/core/timer.h>
+#include <sph/io/frames.h>
 #include <sph/run/driver.h>
 #include <sph/scene/dispatch.h>
 #include <sph/scene/scene_reader.h>
@@ -26,24 +27,21 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 template <int D, std::floating_point R>
 FluidState state_of(const Simulation<D, R>& sim) {
-  const ParticleSet<D, R>& ps = sim.particles();
+  const FrameData f =
+      frame_data_of(sim.particles(), sim.time(), FrameFields::only({"velocity", "density", "pressure"}));
   FluidState s;
   s.dimension = D;
-  s.time = sim.time();
+  s.time = f.time;
   s.particle_mass = sim.params().particle_mass;
-  const std::size_t n = ps.size();
-  s.position.assign(n, {0, 0, 0});
-  s.velocity.assign(n, {0, 0, 0});
-  s.density.resize(n);
-  s.pressure.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    for (int d = 0; d < D; ++d) {
-      s.position[i][d] = static_cast<double>(ps.position[i][d]);
-      s.velocity[i][d] = static_cast<double>(ps.velocity[i][d]);
-    }
-    s.density[i] = static_cast<double>(ps.density[i]);
-    s.pressure[i] = static_cast<double>(ps.pressure[i]);
+  const std::vector<double>& v = f.field("velocity")->values;
+  s.position.resize(f.size);
+  s.velocity.resize(f.size);
+  for (std::size_t i = 0; i < f.size; ++i) {
+    s.position[i] = {f.position[3 * i], f.position[3 * i + 1], f.position[3 * i + 2]};
+    s.velocity[i] = {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
   }
+  s.density = f.field("density")->values;
+  s.pressure = f.field("pressure")->values;
   return s;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -268,7 +269,11 @@ EncodedRun encode_run(const RunDirectory& run, const std::vector<std::size_t>& p
   bool ids_dense = true;
   std::vector<std::uint8_t> rgb_by_id;
   for (std::size_t k = 0; k < picks.size(); ++k) {
-    const FrameData frame = k == 0 ? std::move(first) : read_frame(run.frames[picks[k]]);
+    FrameData frame;
+    if (k == 0)
+      std::swap(frame, first);  // (read already)
+    else
+      frame = read_frame(run.frames[picks[k]]);
     EncodedFrame ef = encode_frame(frame, run, qb, q, stride, samples, ids_dense);
     if (ef.rgb.size() > rgb_by_id.size()) rgb_by_id = ef.rgb;
     max_particles = std::max(max_particles, frame.size);

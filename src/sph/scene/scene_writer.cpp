@@ -12,7 +12,7 @@ namespace sph {
 
 namespace {
 
-using ojson = nlohmann::ordered_json;
+using OrderedJson = nlohmann::ordered_json;
 
 /// Builds one object of the scene from the keys declared for it (scene_keys.h), which the
 /// reader also goes through: a key the reader would refuse is a bug found here.
@@ -27,24 +27,24 @@ class ObjectWriter {
     j_[key] = std::forward<T>(value);
     return *this;
   }
-  ojson take() { return std::move(j_); }
+  OrderedJson take() { return std::move(j_); }
 
  private:
   const std::vector<std::string>& keys_;
-  ojson j_ = ojson::object();
+  OrderedJson j_ = OrderedJson::object();
 };
 
 template <int D>
-ojson vec_json(const Vec<D, double>& v) {
-  ojson a = ojson::array();
+OrderedJson vec_json(const Vec<D, double>& v) {
+  OrderedJson a = OrderedJson::array();
   for (int d = 0; d < D; ++d) a.push_back(v[d]);
   return a;
 }
 
 template <int D>
-ojson configuration_json(const SceneDesc& desc, const SimulationParams<D>& sim) {
+OrderedJson configuration_json(const SceneDesc& desc, const SimulationParams<D>& sim) {
   const OutputDesc& out = desc.output;
-  ojson formats = ojson::array();
+  OrderedJson formats = OrderedJson::array();
   for (FrameFormat f : out.formats) formats.push_back(frame_format_name(f));
   ObjectWriter w(detail::kConfigurationKeys);
   w.put("precision", detail::name_of(detail::kPrecisionNames, desc.precision))
@@ -65,7 +65,7 @@ ojson configuration_json(const SceneDesc& desc, const SimulationParams<D>& sim) 
 }
 
 template <int D>
-ojson fluid_json(const SimulationParams<D>& sim) {
+OrderedJson fluid_json(const SimulationParams<D>& sim) {
   const FluidParams& f = sim.fluid;
   ObjectWriter w(detail::kFluidKeys);
   w.put("density0", f.rest_density)
@@ -79,7 +79,7 @@ ojson fluid_json(const SimulationParams<D>& sim) {
 }
 
 template <int D>
-ojson emitter_json(const EmitterParams<D>& e) {
+OrderedJson emitter_json(const EmitterParams<D>& e) {
   const std::vector<std::string> keys = detail::emitter_keys(D);
   ObjectWriter w(keys);
   w.put("translation", vec_json<D>(e.origin))
@@ -95,7 +95,7 @@ ojson emitter_json(const EmitterParams<D>& e) {
 template <int D>
 void write_body(const SceneDesc& desc, const SceneBody<D>& body, ObjectWriter& root) {
   const SimulationParams<D>& sim = body.sim;
-  ojson blocks = ojson::array(), obstacles = ojson::array(), emitters = ojson::array();
+  OrderedJson blocks = OrderedJson::array(), obstacles = OrderedJson::array(), emitters = OrderedJson::array();
   for (const FluidBlockDesc<D>& b : body.blocks)
     blocks.push_back(ObjectWriter(detail::kFluidBlockKeys)
                          .put("start", vec_json<D>(b.box.lo))
@@ -121,7 +121,7 @@ void write_body(const SceneDesc& desc, const SceneBody<D>& body, ObjectWriter& r
 
 }  // namespace
 
-ojson scene_to_json(const SceneDesc& desc) {
+OrderedJson scene_to_json(const SceneDesc& desc) {
   ObjectWriter root(detail::kRootKeys);
   root.put("version", desc.version)
       .put("name", desc.name)

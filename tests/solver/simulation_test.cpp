@@ -225,7 +225,7 @@ TEST(Determinism, EveryModeIsBitwiseIdenticalFor1To4ThreadsFloat) {
 
 // 8,000 particles: 8 chunks, shared unevenly by 3 threads; 40 steps cross a Morton reorder
 // (every 25). (The grid's parallel block sort is checked for thread independence in
-// tests/neighbors/fast_lists_test.cpp.)
+// tests/neighbors/list_builder_test.cpp.)
 TEST(Determinism, EveryModeIsBitwiseIdenticalFor1And3ThreadsOn8Chunks) {
   for (NeighborMode m : {NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet}) {
     SCOPED_TRACE(std::string(to_string(m)));

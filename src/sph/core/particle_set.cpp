@@ -17,10 +17,7 @@ std::size_t ParticleSet<D, R>::add_field(FieldSpec spec) {
     throw Error("a particle field named \"" + spec.name + "\" exists already", "particle field");
   if (spec.kind == FieldKind::Id) throw Error("added particle fields hold reals or vectors, not ids", spec.name);
   AddedField a;
-  if (spec.kind == FieldKind::Vector)
-    a.ply = {spec.name + "_x", spec.name + "_y", spec.name + "_z"};
-  else
-    a.ply = {spec.name, "", ""};
+  a.ply = added_field_ply_names(spec);
   a.spec = std::move(spec);
   if (a.spec.kind == FieldKind::Vector)
     a.vectors.assign(size(), V{});

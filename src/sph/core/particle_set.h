@@ -23,6 +23,13 @@ struct FieldSpec {
   std::string what;                  ///< one line for documentation
 };
 
+/// The PLY vertex property names of an added field: NAME for a real, NAME_x, NAME_y, NAME_z for
+/// a vector (the writer and the reader both go through this).
+inline std::array<std::string, 3> added_field_ply_names(const FieldSpec& spec) {
+  if (spec.kind == FieldKind::Vector) return {spec.name + "_x", spec.name + "_y", spec.name + "_z"};
+  return {spec.name, "", ""};
+}
+
 /// Structure of arrays holding all per-particle state. This is the only place that resizes,
 /// appends and permutes particle data: every operation goes through for_each_field, so a field
 /// added to the list there (with its descriptor in kParticleFields) or at run time (add_field)

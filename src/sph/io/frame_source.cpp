@@ -142,7 +142,8 @@ FrameData FrameBuilder::finish(bool have_position) {
   const auto order = [&](const FrameField& f) {
     const FieldDesc* d = find_particle_field(f.name);
     if (d) return d - std::begin(kParticleFields);
-    return std::ssize(kParticleFields) + (find_added(src_.added, f.name) - src_.added.data());
+    const FieldSpec* a = find_added(src_.added, f.name);  // (add() accepted only those two kinds)
+    return std::ssize(kParticleFields) + (a ? a - src_.added.data() : std::ssize(src_.added));
   };
   std::stable_sort(data.fields.begin(), data.fields.end(),
                    [&](const FrameField& a, const FrameField& b) { return order(a) < order(b); });

@@ -112,9 +112,10 @@ FrameData read_ply(const Source& src) {
         if (prop == fd.ply[static_cast<std::size_t>(c)]) return {group(fd.name, fd.components()), c};
     for (const FieldSpec& a : src.added) {
       if (find_particle_field(a.name)) continue;
-      if (a.kind == FieldKind::Real && prop == a.name) return {group(a.name, 1), 0};
-      for (int c = 0; a.kind == FieldKind::Vector && c < 3; ++c)
-        if (prop == a.name + "_" + "xyz"[c]) return {group(a.name, 3), c};
+      const std::array<std::string, 3> names = added_field_ply_names(a);
+      const int components = a.kind == FieldKind::Vector ? 3 : 1;
+      for (int c = 0; c < components; ++c)
+        if (prop == names[static_cast<std::size_t>(c)]) return {group(a.name, components), c};
     }
     src.fail("has the vertex property \"" + prop + "\", which sph does not write");
   };

@@ -1,7 +1,6 @@
 #include <sph/io/run_directory.h>
 
 #include <algorithm>
-#include <charconv>
 #include <fstream>
 #include <map>
 
@@ -9,6 +8,7 @@
 
 #include <sph/core/error.h>
 #include <sph/io/atomic_file.h>
+#include <sph/io/frame_source.h>
 #include <sph/neighbors/strategy.h>
 #include <sph/scene/scene_reader.h>
 
@@ -18,14 +18,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// A whole unsigned decimal number, or nullopt.
-std::optional<std::uint64_t> parse_count(std::string_view s) {
-  std::uint64_t v = 0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc() || end != s.data() + s.size() || s.empty()) return std::nullopt;
-  return v;
-}
-
 /// "frame_NNNNNN.EXT" -> NNNNNN (6 digits or more), or nullopt.
 std::optional<std::uint64_t> frame_number(const std::string& name, const std::string& ext) {
   if (name.rfind("frame_", 0) != 0 || name.size() < 6 + 6 + 1 + ext.size()) return std::nullopt;
@@ -33,7 +25,7 @@ std::optional<std::uint64_t> frame_number(const std::string& name, const std::st
   if (name.compare(name.size() - tail.size(), tail.size(), tail) != 0) return std::nullopt;
   const std::string digits = name.substr(6, name.size() - 6 - tail.size());
   if (digits.size() < 6 || digits.size() > 12) return std::nullopt;
-  return parse_count(digits);
+  return detail::parse_count(digits);
 }
 
 }  // namespace

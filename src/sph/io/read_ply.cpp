@@ -93,7 +93,7 @@ FrameData read_ply(const Source& src) {
     std::array<bool, 3> seen{};
     std::vector<double> values;
   };
-  std::vector<Group> groups{{"", 3}};
+  std::vector<Group> groups{{"", 3, {}, {}}};
   struct Target {
     std::size_t group;
     int component;

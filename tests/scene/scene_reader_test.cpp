@@ -168,11 +168,14 @@ TEST(SceneReader, WrongTypeObjectExpected) {
   EXPECT_CONTAINS(m, "Configuration: expected an object");
 }
 
-TEST(SceneReader, MissingRequiredTimeStep) {
+// timeStepSize became optional (absent is "auto", tests/scene/scene_defaults_test.cpp); the
+// run's length is the required key of Configuration besides particleRadius.
+TEST(SceneReader, MissingRequiredRunLength) {
   json j = valid_scene();
-  j["Configuration"].erase("timeStepSize");
+  j["Configuration"].erase("numberOfSteps");
   const std::string m = error_of(j);
-  EXPECT_CONTAINS(m, "Configuration.timeStepSize: missing required key");
+  EXPECT_CONTAINS(m, "Configuration.numberOfSteps: missing required key");
+  EXPECT_CONTAINS(m, "stopAt");
 }
 
 TEST(SceneReader, MissingContainer) {

@@ -18,19 +18,23 @@
 namespace sph::detail {
 
 /// The keys of each object of a scene, in the order the writer writes them. The reader refuses
-/// any other key; the writer writes every one (emitEndTime only when an emitter stops).
+/// any other key; the writer writes every one (emitEndTime only when an emitter stops), except
+/// Configuration.stopAt, the alternative to numberOfSteps: the writer writes the numberOfSteps it
+/// gave (kWriterResolvedKeys).
 inline const std::vector<std::string> kRootKeys{"version",     "name",          "description", "units",
                                                 "dimension",   "Configuration", "Fluid",       "Container",
                                                 "FluidBlocks", "Obstacles",     "Emitters"};
 inline const std::vector<std::string> kConfigurationKeys{
-    "precision",         "timeStepSize", "numberOfSteps",     "particleRadius", "kernelRadius",
-    "gravitation",       "neighbors",    "fullRebuildPeriod", "verletSkin",     "reorderPeriod",
-    "outputEveryNSteps", "outputFps",    "outputFormats",     "outputFields"};
+    "precision",     "timeStepSize",      "numberOfSteps",     "stopAt",    "particleRadius",
+    "kernelRadius",  "gravitation",       "neighbors",         "fullRebuildPeriod", "verletSkin",
+    "reorderPeriod", "outputEveryNSteps", "outputFps",         "outputFormats",     "outputFields"};
 inline const std::vector<std::string> kFluidKeys{
     "density0", "stiffness", "viscosity", "negativePressure", "pressureForce", "gradientCorrection", "particleMass"};
 inline const std::vector<std::string> kContainerKeys{"start", "end", "wallStiffness", "wallDamping"};
 inline const std::vector<std::string> kFluidBlockKeys{"start", "end", "velocity"};
 inline const std::vector<std::string> kObstacleKeys{"start", "end"};
+/// The keys the writer never writes because the reader resolves them into another key's value.
+inline const std::vector<std::string> kWriterResolvedKeys{"stopAt"};
 /// An emitter's keys in D dimensions: a 2D nozzle is a line of `width` particles (no height).
 inline std::vector<std::string> emitter_keys(int dimension) {
   std::vector<std::string> keys{"translation",     "direction",    "velocity",      "width",      "height",

@@ -16,6 +16,7 @@
 #include <sph/scene/json_source.h>
 #include <sph/scene/object_reader.h>
 #include <sph/scene/overrides.h>
+#include <sph/scene/scales.h>
 #include <sph/scene/scene_keys.h>
 #include <sph/solver/time_step.h>
 #include <sph/solver/wcsph.h>
@@ -26,6 +27,16 @@ namespace {
 
 using json = nlohmann::json;
 using detail::ObjectReader;
+
+/// The keys a scene left out (or set to "auto") whose values come from its scales (scales.h),
+/// filled in by resolve_defaults once the whole body is read.
+struct Derived {
+  bool time_step = false;  ///< timeStepSize absent or "auto"
+  bool stiffness = false;
+  bool viscosity = false;
+  bool wall_stiffness = false;
+  bool wall_damping = false;
+};
 
 /// The largest kernel support h accepted, in particle spacings (2 * particleRadius).
 constexpr double kMaxKernelSpacings = 10;
@@ -93,13 +104,14 @@ void read_output(ObjectReader& c, SceneDesc& desc) {
 /// The Configuration object: time step, steps, particle and kernel radii, gravity, the neighbor
 /// strategy's settings and the output.
 template <int D>
-void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& sim) {
+void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& sim, Derived& derived) {
   Vec<D, double> default_g{};
   default_g[1] = -9.81;
   desc.precision = detail::value_named(detail::kPrecisionNames,
                                        c.choice("precision", detail::names_of(detail::kPrecisionNames), "double"));
-  sim.time_step = c.positive("timeStepSize", "a positive time step in seconds");
-  desc.steps = c.integer("numberOfSteps", "a number of steps between 1 and 1e12", 1, 1'000'000'000'000LL);
+  const json* dt = c.find("timeStepSize");
+  derived.time_step = !dt || (dt->is_string() && dt->get<std::string>() == "auto");
+  if (!derived.time_step) sim.time_step = c.positive("timeStepSize", "a positive time step in seconds or \"auto\"");
   sim.particle_radius = c.positive("particleRadius", "a positive particle radius in metres");
   sim.kernel_radius =
       c.positive("kernelRadius", "a positive kernel support radius h in metres", 4.0 * sim.particle_radius);
@@ -131,17 +143,42 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
                  fmt::format("a skin of {:g} m is more than twice h = {:g} m: lists would hold over 27 times the "
                              "pairs needed in 3D; expected a skin between 0.05 h and 0.5 h",
                              sim.verlet_skin, sim.kernel_radius));
+}
+
+/// Configuration.numberOfSteps or stopAt (an end time, turned into steps of dt), and the output
+/// (whose default frame interval depends on the steps).
+void read_run_length(ObjectReader& c, SceneDesc& desc, double dt) {
+  constexpr std::int64_t kMaxSteps = 1'000'000'000'000LL;
+  if (!c.find("stopAt")) {
+    desc.steps = c.integer("numberOfSteps", "a number of steps between 1 and 1e12 (or stopAt, an end time in s)", 1,
+                           kMaxSteps);
+  } else {
+    if (c.find("numberOfSteps"))
+      c.ctx().fail(c.child("stopAt"), "numberOfSteps and stopAt both say when the run ends; give one of them");
+    const double stop = c.positive("stopAt", "a positive end time in seconds");
+    // The first step whose end reaches stopAt (an end time that is a whole number of steps,
+    // up to rounding, is that number).
+    const double steps = std::max(1.0, std::ceil(stop / dt * (1 - 1e-12)));
+    if (!(steps <= static_cast<double>(kMaxSteps)))
+      c.ctx().fail(c.child("stopAt"), fmt::format("stopAt = {:g} s is {:.3g} steps of {:.4g} s; at most 1e12 steps are "
+                                                  "supported",
+                                                  stop, steps, dt));
+    desc.steps = static_cast<std::int64_t>(steps);
+  }
   read_output(c, desc);
 }
 
 /// The Fluid object: rest density, equation of state, viscosity, the pressure force's form and
 /// the particle mass.
 template <int D>
-void read_fluid(ObjectReader& f, SimulationParams<D>& sim) {
+void read_fluid(ObjectReader& f, SimulationParams<D>& sim, Derived& derived) {
   using detail::names_of, detail::value_named;
   sim.fluid.rest_density = f.positive("density0", "a positive rest density in kg/m^" + std::to_string(D), 1000.0);
-  sim.fluid.stiffness = f.positive("stiffness", "a positive EOS stiffness k in m^2/s^2 (p = k (rho - rho0))");
-  sim.fluid.viscosity = f.positive("viscosity", "a viscosity >= 0 in Pa s", 0.0, true);
+  derived.stiffness = !f.find("stiffness");
+  if (!derived.stiffness)
+    sim.fluid.stiffness = f.positive("stiffness", "a positive EOS stiffness k in m^2/s^2 (p = k (rho - rho0))");
+  derived.viscosity = !f.find("viscosity");
+  if (!derived.viscosity) sim.fluid.viscosity = f.positive("viscosity", "a viscosity >= 0 in Pa s", 0.0, true);
   sim.fluid.negative_pressure = value_named(
       detail::kNegativePressureNames, f.choice("negativePressure", names_of(detail::kNegativePressureNames), "clamp"));
   sim.fluid.pressure_force = value_named(detail::kPressureForceNames,
@@ -165,12 +202,14 @@ void read_fluid(ObjectReader& f, SimulationParams<D>& sim) {
 
 /// The Container object: the box and its walls' springs.
 template <int D>
-void read_container(ObjectReader& root, SimulationParams<D>& sim) {
+void read_container(ObjectReader& root, SimulationParams<D>& sim, Derived& derived) {
   const json& cj = root.require("Container", "an object with \"start\" and \"end\" corners");
   ObjectReader c(cj, root.child("Container"), root.ctx(), detail::kContainerKeys);
   sim.container = read_box<D>(c, "container");
-  sim.walls.stiffness = c.positive("wallStiffness", "a positive wall spring stiffness in 1/s^2");
-  sim.walls.damping = c.positive("wallDamping", "a wall damping >= 0 in 1/s", 0.0, true);
+  derived.wall_stiffness = !c.find("wallStiffness");
+  if (!derived.wall_stiffness) sim.walls.stiffness = c.positive("wallStiffness", "a positive wall spring stiffness in 1/s^2");
+  derived.wall_damping = !c.find("wallDamping");
+  if (!derived.wall_damping) sim.walls.damping = c.positive("wallDamping", "a wall damping >= 0 in 1/s", 0.0, true);
   for (int d = 0; d < D; ++d)
     if (sim.container.hi[d] - sim.container.lo[d] < 4 * sim.particle_radius)
       c.ctx().fail(c.child("end"), "the container must be at least two particle diameters wide in every direction");
@@ -210,7 +249,6 @@ double read_blocks(ObjectReader& root, SceneBody<D>& body) {
 /// One Emitters entry.
 template <int D>
 EmitterParams<D> read_emitter(ObjectReader& e, const SimulationParams<D>& sim) {
-  const double dx = 2.0 * sim.particle_radius;
   EmitterParams<D> em;
   em.origin = e.vec<D>("translation", "the center of the emitter nozzle in m");
   const auto unit = detail::unit_direction<D>(e.vec<D>("direction", "the emission direction (any non-zero length)"));
@@ -219,7 +257,7 @@ EmitterParams<D> read_emitter(ObjectReader& e, const SimulationParams<D>& sim) {
   em.speed = e.positive("velocity", "a positive emission speed in m/s");
   em.width = static_cast<int>(e.integer("width", "a nozzle width of 1 to 10000 particles", 1, 10000));
   em.height = D == 3 ? static_cast<int>(e.integer("height", "a nozzle height of 1 to 10000 particles", 1, 10000)) : 1;
-  em.spacing = dx;
+  em.spacing = 2.0 * sim.particle_radius;
   em.every_steps =
       static_cast<int>(e.integer("emitEveryNSteps", "an emission interval of at least 1 step", 1, 1'000'000'000, 16));
   em.max_particles = e.integer("maxParticles", "a positive particle budget", 1, 4'000'000'000LL);
@@ -228,24 +266,101 @@ EmitterParams<D> read_emitter(ObjectReader& e, const SimulationParams<D>& sim) {
   if (!inside<D>(em.origin, sim.container))
     e.ctx().fail(e.child("translation"),
                  fmt::format("the nozzle center {} is outside the container", vec_text<D>(em.origin)));
-  // Each batch must have left the nozzle before the next one is placed there.
-  const double travel = em.speed * em.every_steps * sim.time_step;
-  if (travel < dx)
-    e.ctx().fail(e.child("velocity"),
-                 fmt::format("a batch moves {:.3g} m in {} steps, less than the particle spacing {:.3g} m, so "
-                             "batches would overlap; raise velocity to at least {:.3g} m/s or emitEveryNSteps",
-                             travel, em.every_steps, dx, dx / (em.every_steps * sim.time_step)));
   return em;
+}
+
+/// Each emitter's batch must have left the nozzle before the next one is placed there (checked
+/// once the time step is known).
+template <int D>
+void check_emitter_travel(const detail::ReadContext& ctx, const SimulationParams<D>& sim) {
+  const double dx = 2.0 * sim.particle_radius;
+  for (std::size_t i = 0; i < sim.emitters.size(); ++i) {
+    const EmitterParams<D>& em = sim.emitters[i];
+    const double travel = em.speed * em.every_steps * sim.time_step;
+    if (travel < dx)
+      ctx.fail(fmt::format("Emitters[{}].velocity", i),
+               fmt::format("a batch moves {:.3g} m in {} steps, less than the particle spacing {:.3g} m, so "
+                           "batches would overlap; raise velocity to at least {:.3g} m/s or emitEveryNSteps",
+                           travel, em.every_steps, dx, dx / (em.every_steps * sim.time_step)));
+  }
+}
+
+/// A value derived from the scene's scales, checked positive and finite (extreme scenes can
+/// overflow or vanish); the message names the key to give instead.
+void check_derived(const detail::ReadContext& ctx, const std::string& key, double value, const std::string& from) {
+  if (!(std::isfinite(value) && value > 0))
+    ctx.fail(key, fmt::format("the default computed from {} is {:g}; expected a positive finite value: give {} in "
+                              "the scene",
+                              from, value, key));
+}
+
+/// Fills the keys the scene left out from its scales (scales.h, docs/reliability.md "Defaults"),
+/// in dependency order: stiffness, viscosity, wall stiffness, wall damping, then the time step.
+template <int D>
+void resolve_defaults(const detail::ReadContext& ctx, SceneBody<D>& body, const Derived& derived,
+                      const SceneScales& s) {
+  SimulationParams<D>& sim = body.sim;
+  if (derived.stiffness) {
+    if (!(s.max_speed > 0))
+      ctx.fail("Fluid.stiffness",
+               "missing, and no default can be derived: the scene has no gravity and nothing moves initially, so no "
+               "speed sets the sound speed; give stiffness (typical: (10 v)^2 in m^2/s^2 for the largest speed v "
+               "expected)");
+    sim.fluid.stiffness = stiffness_for_speed(s.max_speed);
+    check_derived(ctx, "Fluid.stiffness", sim.fluid.stiffness,
+                  fmt::format("the expected largest speed {:g} m/s", s.max_speed));
+  }
+  const double c0 = std::sqrt(sim.fluid.stiffness);
+  if (derived.viscosity) {
+    sim.fluid.viscosity =
+        viscosity_for_sound_speed(D, kArtificialViscosityAlpha, sim.kernel_radius, c0, sim.fluid.rest_density);
+    check_derived(ctx, "Fluid.viscosity", sim.fluid.viscosity,
+                  fmt::format("h = {:g} m and the sound speed {:g} m/s", sim.kernel_radius, c0));
+  }
+  if (derived.wall_stiffness) {
+    sim.walls.stiffness = default_wall_stiffness(s, sim.particle_radius, sim.fluid.stiffness);
+    check_derived(ctx, "Container.wallStiffness", sim.walls.stiffness,
+                  fmt::format("the head {:g} m, the speed {:g} m/s and particleRadius {:g} m", s.head,
+                              wall_impact_speed(s, sim.fluid.stiffness), sim.particle_radius));
+  }
+  if (derived.wall_damping) sim.walls.damping = critical_wall_damping(sim.walls.stiffness);
+  if (derived.time_step) {
+    sim.time_step = auto_time_step<D>(sim);
+    check_derived(ctx, "Configuration.timeStepSize", sim.time_step, "the stability limits");
+  }
+}
+
+/// Warnings about explicit values the scales show will probably not hold.
+template <int D>
+void warn_from_scales(SceneDesc& desc, const SimulationParams<D>& sim, const Derived& derived, const SceneScales& s) {
+  const double r = sim.particle_radius, k = sim.fluid.stiffness, kw = sim.walls.stiffness;
+  if (!derived.wall_stiffness && kw < least_holding_wall_stiffness(s, r, k)) {
+    const double v = wall_impact_speed(s, k);
+    desc.warnings.push_back(fmt::format(
+        "Container.wallStiffness = {:g} is too low for this scene: the {:.3g} m head of fluid pushes the bottom "
+        "particles {:.2g} particle radii into the walls and a particle arriving at {:.3g} m/s stops only after {:.2g} "
+        "radii (the wall springs act within one radius), so particles may leave the container; wallStiffness = "
+        "{:.3g} would hold them (the default, docs/reliability.md \"Defaults\")",
+        kw, s.head, s.gravity * s.head / (2 * r * kw) / r, v, v / std::sqrt(kw) / r, default_wall_stiffness(s, r, k)));
+  }
+  if (!derived.viscosity && sim.fluid.viscosity == 0)
+    desc.warnings.push_back(fmt::format(
+        "Fluid.viscosity = 0: nothing damps the pressure waves inside the fluid (wall damping acts only at the "
+        "walls), so the run may heat up and blow up; viscosity = {:.3g} (the default: Monaghan's artificial "
+        "viscosity alpha = {:g}, docs/reliability.md \"Defaults\") would damp them",
+        viscosity_for_sound_speed(D, kArtificialViscosityAlpha, sim.kernel_radius, std::sqrt(k), sim.fluid.rest_density),
+        kArtificialViscosityAlpha));
 }
 
 template <int D>
 void read_body(ObjectReader& root, SceneDesc& desc) {
   SceneBody<D>& body = desc.set_body<D>();
   SimulationParams<D>& sim = body.sim;
+  Derived derived;
   root.object("Configuration", detail::kConfigurationKeys,
-              [&](ObjectReader& c) { read_configuration<D>(c, desc, sim); });
-  root.object("Fluid", detail::kFluidKeys, [&](ObjectReader& f) { read_fluid<D>(f, sim); });
-  read_container<D>(root, sim);
+              [&](ObjectReader& c) { read_configuration<D>(c, desc, sim, derived); });
+  root.object("Fluid", detail::kFluidKeys, [&](ObjectReader& f) { read_fluid<D>(f, sim, derived); });
+  read_container<D>(root, sim, derived);
   double total = read_blocks<D>(root, body);
   root.array_of_objects("Obstacles", detail::kObstacleKeys,
                         [&](ObjectReader& o, std::size_t) { sim.obstacles.push_back(read_box<D>(o, "obstacle")); });
@@ -260,6 +375,12 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
     root.ctx().fail("FluidBlocks",
                     fmt::format("the scene would hold {:.3g} particles; at most 2e9 are supported", total));
 
+  const SceneScales scales = scene_scales<D>(body);
+  resolve_defaults<D>(root.ctx(), body, derived, scales);
+  root.object("Configuration", detail::kConfigurationKeys,
+              [&](ObjectReader& c) { read_run_length(c, desc, sim.time_step); });
+  check_emitter_travel<D>(root.ctx(), sim);
+  warn_from_scales<D>(desc, sim, derived, scales);
   try {
     for (const std::string& w : check_time_step<D>(sim)) desc.warnings.push_back(w);
   } catch (const Error& e) {

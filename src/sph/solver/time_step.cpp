@@ -1,5 +1,6 @@
 #include <sph/solver/time_step.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -30,6 +31,14 @@ std::vector<TimeStepLimit> time_step_limits(const SimulationParams<D>& p) {
 }
 
 template <int D>
+double auto_time_step(const SimulationParams<D>& p) {
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const auto& l : time_step_limits(p)) smallest = std::min(smallest, l.dt_warn);
+  SPH_CHECK(std::isfinite(smallest), "auto_time_step: no stability limit applies (stiffness not positive)");
+  return kAutoTimeStepFraction * smallest;
+}
+
+template <int D>
 std::vector<std::string> check_time_step(const SimulationParams<D>& p) {
   std::vector<std::string> warnings;
   for (const auto& l : time_step_limits(p)) {
@@ -48,6 +57,8 @@ std::vector<std::string> check_time_step(const SimulationParams<D>& p) {
 
 template std::vector<TimeStepLimit> time_step_limits<2>(const SimulationParams<2>&);
 template std::vector<TimeStepLimit> time_step_limits<3>(const SimulationParams<3>&);
+template double auto_time_step<2>(const SimulationParams<2>&);
+template double auto_time_step<3>(const SimulationParams<3>&);
 template std::vector<std::string> check_time_step<2>(const SimulationParams<2>&);
 template std::vector<std::string> check_time_step<3>(const SimulationParams<3>&);
 

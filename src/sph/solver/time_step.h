@@ -24,6 +24,16 @@ struct TimeStepLimit {
 template <int D>
 std::vector<TimeStepLimit> time_step_limits(const SimulationParams<D>& p);
 
+/// The fraction of the tightest warning limit that `timeStepSize: "auto"` takes: a margin
+/// below the limits above (the acoustic CFL number of an auto step is 0.8 * 0.4 = 0.32).
+inline constexpr double kAutoTimeStepFraction = 0.8;
+
+/// The time step `timeStepSize: "auto"` gives: kAutoTimeStepFraction times the smallest dt_warn
+/// of time_step_limits(p) (p.time_step is not used); fixed for the run, so that runs stay
+/// deterministic. SPH_CHECK: some limit applies (a positive stiffness always gives one).
+template <int D>
+double auto_time_step(const SimulationParams<D>& p);
+
 /// Returns warning lines for limits exceeded; throws sph::Error naming the criterion, the
 /// largest acceptable dt and the key to change when a hard limit is exceeded.
 template <int D>

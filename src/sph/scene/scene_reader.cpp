@@ -258,8 +258,11 @@ EmitterParams<D> read_emitter(ObjectReader& e, const SimulationParams<D>& sim) {
   em.width = static_cast<int>(e.integer("width", "a nozzle width of 1 to 10000 particles", 1, 10000));
   em.height = D == 3 ? static_cast<int>(e.integer("height", "a nozzle height of 1 to 10000 particles", 1, 10000)) : 1;
   em.spacing = 2.0 * sim.particle_radius;
-  em.every_steps =
-      static_cast<int>(e.integer("emitEveryNSteps", "an emission interval of at least 1 step", 1, 1'000'000'000, 16));
+  // Absent: 16, or the fewest steps a batch needs to clear the nozzle (check_emitter_travel).
+  em.every_steps = e.find("emitEveryNSteps") ? static_cast<int>(e.integer(
+                                                   "emitEveryNSteps", "an emission interval of at least 1 step", 1,
+                                                   1'000'000'000))
+                                             : 0;
   em.max_particles = e.integer("maxParticles", "a positive particle budget", 1, 4'000'000'000LL);
   em.start_time = e.positive("emitStartTime", "a start time >= 0 in s", 0.0, true);
   em.end_time = e.positive("emitEndTime", "an end time > 0 in s", std::numeric_limits<double>::infinity());
@@ -270,12 +273,20 @@ EmitterParams<D> read_emitter(ObjectReader& e, const SimulationParams<D>& sim) {
 }
 
 /// Each emitter's batch must have left the nozzle before the next one is placed there (checked
-/// once the time step is known).
+/// once the time step is known). An emitter without emitEveryNSteps (every_steps 0 here) emits
+/// every 16 steps, or, when the time step is "auto", every as many steps as a batch needs to
+/// move one spacing if 16 are too few.
 template <int D>
-void check_emitter_travel(const detail::ReadContext& ctx, const SimulationParams<D>& sim) {
+void check_emitter_travel(const detail::ReadContext& ctx, SimulationParams<D>& sim, bool auto_time_step) {
   const double dx = 2.0 * sim.particle_radius;
   for (std::size_t i = 0; i < sim.emitters.size(); ++i) {
-    const EmitterParams<D>& em = sim.emitters[i];
+    EmitterParams<D>& em = sim.emitters[i];
+    if (em.every_steps == 0 && !auto_time_step) em.every_steps = 16;
+    if (em.every_steps == 0) {
+      double needed = std::ceil(dx / (em.speed * sim.time_step));
+      if (em.speed * needed * sim.time_step < dx) needed += 1;  // (rounding)
+      em.every_steps = static_cast<int>(std::clamp(needed, 16.0, 1e9));
+    }
     const double travel = em.speed * em.every_steps * sim.time_step;
     if (travel < dx)
       ctx.fail(fmt::format("Emitters[{}].velocity", i),
@@ -379,7 +390,7 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
   resolve_defaults<D>(root.ctx(), body, derived, scales);
   root.object("Configuration", detail::kConfigurationKeys,
               [&](ObjectReader& c) { read_run_length(c, desc, sim.time_step); });
-  check_emitter_travel<D>(root.ctx(), sim);
+  check_emitter_travel<D>(root.ctx(), sim, derived.time_step);
   warn_from_scales<D>(desc, sim, derived, scales);
   try {
     for (const std::string& w : check_time_step<D>(sim)) desc.warnings.push_back(w);

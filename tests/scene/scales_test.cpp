@@ -1,0 +1,234 @@
+// Scene scale estimates (scene/scales.h) and the defaults the reader derives from them, with
+// numbers worked out by hand in the comments.
+
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sph/core/error.h>
+#include <sph/scene/scales.h>
+#include <sph/scene/scene_reader.h>
+#include <sph/scene/scene_writer.h>
+#include <sph/solver/time_step.h>
+
+#include "support/expect.h"
+
+namespace {
+
+using json = nlohmann::json;
+
+/// 0.2 m x 0.2 m of water at rest in a 1 m x 1 m box, particleRadius 0.01, h = 0.04.
+json tank_2d() {
+  return json::parse(R"({ "version": 1, "dimension": 2,
+    "Configuration": { "numberOfSteps": 10, "particleRadius": 0.01 },
+    "Container": { "start": [0, 0], "end": [1, 1] },
+    "FluidBlocks": [ { "start": [0, 0], "end": [0.2, 0.2] } ] })");
+}
+
+sph::SceneDesc parse(const json& j, const std::vector<std::string>& overrides = {}) {
+  return sph::parse_scene(j.dump(), "scales.json", overrides);
+}
+
+std::string error_of(const json& j) {
+  try {
+    parse(j);
+  } catch (const sph::Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no error for " << j.dump();
+  return {};
+}
+
+TEST(SceneScales, TankAtRest2d) {
+  const sph::SceneDesc d = parse(tank_2d());
+  const sph::SceneScales s = sph::scene_scales<2>(d.body<2>());
+  EXPECT_DOUBLE_EQ(s.gravity, 9.81);
+  EXPECT_DOUBLE_EQ(s.fall_height, 0.2);
+  EXPECT_DOUBLE_EQ(s.head, 0.2);                       // the block's top; it fills only 0.04 m of the box
+  EXPECT_DOUBLE_EQ(s.max_speed, std::sqrt(2 * 9.81 * 0.2));  // 1.98 m/s
+  // k = (10 v)^2 = 100 * 2 g H = 392.4.
+  EXPECT_NEAR(sph::stiffness_for_speed(s.max_speed), 392.4, 1e-9);
+  // Head: g H / (dx f r) = 9.81 * 0.2 / (0.02 * 0.5 * 0.01) = 19620; impact (v / r)^2 = 3.924 / 1e-4 = 39240.
+  EXPECT_NEAR(sph::wall_stiffness_for_head(s, 0.01, 0.5), 19620, 1e-6);
+  EXPECT_NEAR(sph::wall_stiffness_for_impact(s.max_speed, 0.01), 39240, 1e-6);
+  EXPECT_NEAR(sph::default_wall_stiffness(s, 0.01, 392.4), 39240, 1e-6);
+  // Cannot hold: the head at penetration r (9810), the impact within 2 r (3.924 / 4e-4 = 9810).
+  EXPECT_NEAR(sph::least_holding_wall_stiffness(s, 0.01, 392.4), 9810, 1e-6);
+  EXPECT_NEAR(sph::critical_wall_damping(39240), 2 * std::sqrt(39240.0), 1e-9);  // 396.2
+  // nu = alpha h c0 / (2 (D + 2)) = 0.1 * 0.04 * 19.809 / 8 = 9.9045e-3 m^2/s; mu = rho0 nu.
+  EXPECT_NEAR(sph::viscosity_for_sound_speed(2, 0.1, 0.04, std::sqrt(392.4), 1000), 9.90454, 1e-5);
+  EXPECT_NEAR(sph::viscosity_for_sound_speed(3, 0.1, 0.04, std::sqrt(392.4), 1000), 7.92363, 1e-5);
+
+  // The reader filled in exactly these.
+  const auto& sim = d.body<2>().sim;
+  EXPECT_NEAR(sim.fluid.stiffness, 392.4, 1e-9);
+  EXPECT_NEAR(sim.fluid.viscosity, 9.90454, 1e-5);
+  EXPECT_NEAR(sim.walls.stiffness, 39240, 1e-6);
+  EXPECT_NEAR(sim.walls.damping, 396.182, 1e-3);
+  // dt: the smallest warning limit is the acoustic CFL 0.4 h / c0 = 0.4 * 0.04 / 19.809 = 8.077e-4
+  // (viscous 0.125 h^2 / nu = 0.0202, wall spring 0.5 / 198.1 = 2.52e-3, damping 0.5 / 396.2 =
+  // 1.26e-3, gravity 0.25 sqrt(h / g) = 0.016); auto takes 0.8 of it: 6.462e-4 s.
+  EXPECT_NEAR(sim.time_step, 0.8 * 0.4 * 0.04 / std::sqrt(392.4), 1e-12);
+  EXPECT_DOUBLE_EQ(sim.time_step, sph::auto_time_step<2>(sim));
+  EXPECT_TRUE(d.warnings.empty()) << d.warnings.front();
+}
+
+TEST(SceneScales, MovingBlockEmitterAndFillDepth3d) {
+  // Gravity along -z; a 0.5 x 0.5 x 0.1 block moving at 3 m/s; an emitter at z = 0.3, 2 m/s.
+  const sph::SceneDesc d = parse(json::parse(R"({ "version": 1, "dimension": 3,
+    "Configuration": { "numberOfSteps": 10, "particleRadius": 0.01, "gravitation": [0, 0, -9.81] },
+    "Container": { "start": [0, 0, 0], "end": [1, 2, 0.5] },
+    "FluidBlocks": [ { "start": [0, 0, 0], "end": [0.5, 0.5, 0.1], "velocity": [3, 0, 0] } ],
+    "Emitters": [ { "translation": [0.8, 1, 0.3], "direction": [-1, 0, 0], "velocity": 2, "width": 2,
+                    "height": 2, "maxParticles": 1000 } ] })"));
+  const sph::SceneScales s = sph::scene_scales<3>(d.body<3>());
+  EXPECT_DOUBLE_EQ(s.fall_height, 0.3);  // the nozzle
+  // Fill depth: (0.025 + 1000 * 0.02^3) m^3 over the 1 x 2 m floor = 0.0165 m, below the block's top 0.1 m.
+  EXPECT_DOUBLE_EQ(s.head, 0.1);
+  // Block: 3^2 + 2 g 0.1 = 10.962; emitter: 2^2 + 2 g 0.3 = 9.886; the larger.
+  EXPECT_NEAR(s.max_speed, std::sqrt(9 + 2 * 9.81 * 0.1), 1e-12);
+  // Without emitEveryNSteps, the emitter waits the fewest steps (more than the usual 16 at the
+  // auto time step) for a batch to move one spacing.
+  const auto& sim = d.body<3>().sim;
+  const auto& e = sim.emitters.at(0);
+  EXPECT_GT(e.every_steps, 16);
+  EXPECT_GE(e.speed * e.every_steps * sim.time_step, 0.02);
+  EXPECT_LT(e.speed * (e.every_steps - 1) * sim.time_step, 0.02);
+}
+
+TEST(SceneScales, EmittersFillingATankSetTheHead) {
+  // 2500 particles of 0.01 m spacing: 0.25 m^2 over a 0.5 m floor fills 0.5 m (the nozzle is at 0.8 m).
+  const sph::SceneDesc d = parse(json::parse(R"({ "version": 1, "dimension": 2,
+    "Configuration": { "numberOfSteps": 10, "particleRadius": 0.005 },
+    "Container": { "start": [0, 0], "end": [0.5, 1] },
+    "Emitters": [ { "translation": [0.1, 0.8], "direction": [1, 0], "velocity": 2, "width": 4,
+                    "maxParticles": 2500 } ] })"));
+  const sph::SceneScales s = sph::scene_scales<2>(d.body<2>());
+  EXPECT_DOUBLE_EQ(s.fall_height, 0.8);
+  EXPECT_NEAR(s.head, 0.5, 1e-12);
+  EXPECT_NEAR(s.max_speed, std::sqrt(4 + 2 * 9.81 * 0.8), 1e-12);
+}
+
+TEST(SceneScales, TiltedGravity) {
+  // g = (-3, -4), |g| = 5, down = (-0.6, -0.8): the floor is the corner (0, 0), the block's top
+  // the corner (0.5, 0.5), 0.6 * 0.5 + 0.8 * 0.5 = 0.7 m above it.
+  json j = tank_2d();
+  j["Configuration"]["gravitation"] = {-3, -4};
+  j["FluidBlocks"][0]["end"] = {0.5, 0.5};
+  const sph::SceneScales s = sph::scene_scales<2>(parse(j).body<2>());
+  EXPECT_DOUBLE_EQ(s.gravity, 5);
+  EXPECT_NEAR(s.fall_height, 0.7, 1e-12);
+  EXPECT_NEAR(s.max_speed, std::sqrt(2 * 5 * 0.7), 1e-12);
+}
+
+TEST(SceneScales, WithoutGravityOnlyMotionSetsTheSpeed) {
+  json j = tank_2d();
+  j["Configuration"]["gravitation"] = {0, 0};
+  j["FluidBlocks"][0]["velocity"] = {0.3, 0.4};
+  const sph::SceneDesc d = parse(j);
+  const sph::SceneScales s = sph::scene_scales<2>(d.body<2>());
+  EXPECT_EQ(s.head, 0);
+  EXPECT_DOUBLE_EQ(s.max_speed, 0.5);
+  EXPECT_NEAR(d.body<2>().sim.fluid.stiffness, 25, 1e-12);  // (10 * 0.5)^2
+  // Still: no speed to derive a stiffness from; with one given, the walls stop c0 / 10.
+  j["FluidBlocks"][0].erase("velocity");
+  const std::string m = error_of(j);
+  EXPECT_CONTAINS(m, "Fluid.stiffness");
+  EXPECT_CONTAINS(m, "no gravity and nothing moves");
+  j["Fluid"]["stiffness"] = 400;
+  EXPECT_NEAR(parse(j).body<2>().sim.walls.stiffness, 4e4, 1e-6);  // (2 m/s / 0.01 m)^2
+}
+
+TEST(SceneDefaults, ExplicitValuesAreKept) {
+  json j = tank_2d();
+  j["Fluid"] = {{"stiffness", 1000}, {"viscosity", 0.5}};
+  j["Container"]["wallStiffness"] = 1e5;
+  j["Container"]["wallDamping"] = 0;
+  j["Configuration"]["timeStepSize"] = 1e-4;
+  const auto& sim = parse(j).body<2>().sim;
+  EXPECT_EQ(sim.fluid.stiffness, 1000);
+  EXPECT_EQ(sim.fluid.viscosity, 0.5);
+  EXPECT_EQ(sim.walls.stiffness, 1e5);
+  EXPECT_EQ(sim.walls.damping, 0);
+  EXPECT_EQ(sim.time_step, 1e-4);
+}
+
+TEST(SceneDefaults, AutoTimeStepFollowsTheGivenValues) {
+  json j = tank_2d();
+  j["Configuration"]["timeStepSize"] = "auto";
+  j["Fluid"]["stiffness"] = 1e4;  // c0 = 100: acoustic 0.4 * 0.04 / 100 = 1.6e-4
+  const auto& sim = parse(j).body<2>().sim;
+  EXPECT_NEAR(sim.time_step, 0.8 * 1.6e-4, 1e-15);
+  // --set gives "auto" too (a plain string).
+  json k = tank_2d();
+  k["Configuration"]["timeStepSize"] = 1e-5;
+  EXPECT_DOUBLE_EQ(parse(k, {"Configuration.timeStepSize=auto"}).body<2>().sim.time_step,
+                   parse(tank_2d()).body<2>().sim.time_step);
+}
+
+TEST(SceneDefaults, StopAtGivesTheSteps) {
+  json j = tank_2d();
+  j["Configuration"].erase("numberOfSteps");
+  j["Configuration"]["timeStepSize"] = 1e-4;
+  j["Configuration"]["stopAt"] = 0.5;
+  EXPECT_EQ(parse(j).steps, 5000);  // a whole number of steps (0.5 / 1e-4 rounds to 5000.000000000001)
+  j["Configuration"]["stopAt"] = 0.50001;
+  EXPECT_EQ(parse(j).steps, 5001);  // the first step reaching it
+  j["Configuration"]["stopAt"] = 1e-9;
+  EXPECT_EQ(parse(j).steps, 1);
+  j["Configuration"]["stopAt"] = 1e9;
+  EXPECT_CONTAINS(error_of(j), "at most 1e12 steps");
+  j["Configuration"]["stopAt"] = 0.5;
+  j["Configuration"]["numberOfSteps"] = 10;
+  EXPECT_CONTAINS(error_of(j), "Configuration.stopAt: numberOfSteps and stopAt both say when the run ends");
+}
+
+TEST(SceneDefaults, TheEffectiveSceneGivesTheComputedValuesAndReadsBackEqual) {
+  json j = tank_2d();
+  j["Configuration"].erase("numberOfSteps");
+  j["Configuration"]["stopAt"] = 0.05;
+  const sph::SceneDesc d = parse(j);
+  const json w = json::parse(sph::scene_text(d));
+  const auto& sim = d.body<2>().sim;
+  EXPECT_EQ(w["Configuration"]["timeStepSize"], sim.time_step);
+  EXPECT_EQ(w["Configuration"]["numberOfSteps"], d.steps);
+  EXPECT_FALSE(w["Configuration"].contains("stopAt"));
+  EXPECT_EQ(w["Fluid"]["stiffness"], sim.fluid.stiffness);
+  EXPECT_EQ(w["Fluid"]["viscosity"], sim.fluid.viscosity);
+  EXPECT_EQ(w["Container"]["wallStiffness"], sim.walls.stiffness);
+  EXPECT_EQ(w["Container"]["wallDamping"], sim.walls.damping);
+  const sph::SceneDesc again = sph::parse_scene(w.dump(), "scales.json");
+  EXPECT_TRUE(again == d);
+  EXPECT_EQ(d.steps, static_cast<std::int64_t>(std::ceil(0.05 / sim.time_step)));
+}
+
+TEST(SceneDefaults, WarnsAboutAWallTooSoftForTheHeadOrTheImpact) {
+  json j = tank_2d();
+  j["Container"]["wallStiffness"] = 9000;  // below 9810 (see TankAtRest2d)
+  const sph::SceneDesc d = parse(j);
+  ASSERT_EQ(d.warnings.size(), 1u);
+  EXPECT_CONTAINS(d.warnings[0], "Container.wallStiffness = 9000 is too low");
+  EXPECT_CONTAINS(d.warnings[0], "wallStiffness = 3.92e+04 would hold");
+  j["Container"]["wallStiffness"] = 9900;
+  EXPECT_TRUE(parse(j).warnings.empty());
+  // A fast block needs a stiffer wall: 10 m/s within 2 radii is (10 / 0.02)^2 = 2.5e5.
+  j["FluidBlocks"][0]["velocity"] = {10, 0};
+  j["Fluid"]["stiffness"] = 1e4;
+  j["Configuration"]["timeStepSize"] = 1e-4;
+  j["Container"]["wallStiffness"] = 2e5;
+  ASSERT_EQ(parse(j).warnings.size(), 1u);
+  EXPECT_CONTAINS(parse(j).warnings[0], "a particle arriving at 10.2 m/s");
+}
+
+TEST(SceneDefaults, WarnsAboutAnExplicitZeroViscosity) {
+  json j = tank_2d();
+  j["Fluid"]["viscosity"] = 0;
+  const sph::SceneDesc d = parse(j);
+  ASSERT_EQ(d.warnings.size(), 1u);
+  EXPECT_CONTAINS(d.warnings[0], "Fluid.viscosity = 0: nothing damps");
+  EXPECT_CONTAINS(d.warnings[0], "viscosity = 9.9 ");
+}
+
+}  // namespace

@@ -232,3 +232,24 @@ TEST(SceneDefaults, WarnsAboutAnExplicitZeroViscosity) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(SceneDefaults, AFlagGivingTheStepsOverridesStopAt) {
+  json j = tank_2d();
+  j["Configuration"].erase("numberOfSteps");
+  j["Configuration"]["timeStepSize"] = 1e-4;
+  j["Configuration"]["stopAt"] = 0.5;
+  // `sph run --steps 7` is --set Configuration.numberOfSteps=7.
+  EXPECT_EQ(parse(j, {"Configuration.numberOfSteps=7"}).steps, 7);
+  // The stopAt it overrides is still checked.
+  j["Configuration"]["stopAt"] = -1;
+  EXPECT_THROW(parse(j, {"Configuration.numberOfSteps=7"}), sph::Error);
+  // And the other way round.
+  json k = tank_2d();
+  k["Configuration"]["timeStepSize"] = 1e-4;
+  EXPECT_EQ(parse(k, {"Configuration.stopAt=0.01"}).steps, 100);
+  EXPECT_THROW(parse(k, {"Configuration.stopAt=0.01", "Configuration.numberOfSteps=5"}), sph::Error);
+}
+
+}  // namespace

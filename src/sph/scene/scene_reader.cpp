@@ -149,13 +149,24 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
 /// (whose default frame interval depends on the steps).
 void read_run_length(ObjectReader& c, SceneDesc& desc, double dt) {
   constexpr std::int64_t kMaxSteps = 1'000'000'000'000LL;
-  if (!c.find("stopAt")) {
-    desc.steps = c.integer("numberOfSteps", "a number of steps between 1 and 1e12 (or stopAt, an end time in s)", 1,
-                           kMaxSteps);
-  } else {
-    if (c.find("numberOfSteps"))
+  const char* what_steps = "a number of steps between 1 and 1e12 (or stopAt, an end time in s)";
+  const char* what_stop = "a positive end time in seconds";
+  // Both given: one from a flag (--steps, --set) overrides the other from the file, which is
+  // still validated; both from the same place contradict each other.
+  bool by_time = c.find("stopAt") != nullptr;
+  if (by_time && c.find("numberOfSteps")) {
+    const auto& set = c.ctx().overridden;
+    const bool steps_set = set.count(c.child("numberOfSteps")) > 0, stop_set = set.count(c.child("stopAt")) > 0;
+    if (steps_set == stop_set)
       c.ctx().fail(c.child("stopAt"), "numberOfSteps and stopAt both say when the run ends; give one of them");
-    const double stop = c.positive("stopAt", "a positive end time in seconds");
+    if (steps_set) c.positive("stopAt", what_stop);
+    if (stop_set) c.integer("numberOfSteps", what_steps, 1, kMaxSteps);
+    by_time = stop_set;
+  }
+  if (!by_time) {
+    desc.steps = c.integer("numberOfSteps", what_steps, 1, kMaxSteps);
+  } else {
+    const double stop = c.positive("stopAt", what_stop);
     // The first step whose end reaches stopAt (an end time that is a whole number of steps,
     // up to rounding, is that number).
     const double steps = std::max(1.0, std::ceil(stop / dt * (1 - 1e-12)));

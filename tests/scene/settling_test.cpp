@@ -136,11 +136,15 @@ TEST(Settling, DamBreak2d) {
 }
 
 TEST(Settling, TankAtRest3d) {
-  const std::string scene = R"({ "version": 1, "dimension": 3,
-    "Configuration": { "particleRadius": 0.01, "stopAt": 2.0 },
-    "Container": { "start": [0, 0, 0], "end": [0.12, 0.15, 0.12] },
-    "FluidBlocks": [ { "start": [0, 0, 0], "end": [0.12, 0.1, 0.12] } ] })";
-  expect_settled_at_rest(run_scene<3>(scene));
+  for (double r : {0.01, 0.0075}) {
+    SCOPED_TRACE(fmt::format("particleRadius {}", r));
+    const std::string scene = fmt::format(R"({{ "version": 1, "dimension": 3,
+      "Configuration": {{ "particleRadius": {}, "stopAt": 2.0 }},
+      "Container": {{ "start": [0, 0, 0], "end": [0.12, 0.15, 0.12] }},
+      "FluidBlocks": [ {{ "start": [0, 0, 0], "end": [0.12, 0.09, 0.12] }} ] }})",
+                                          r);
+    expect_settled_at_rest(run_scene<3>(scene));
+  }
 }
 
 TEST(Settling, DamBreak3d) {

@@ -86,7 +86,7 @@ double wall_stiffness_for_impact(double speed, double distance) { return (speed 
 
 double default_wall_stiffness(const SceneScales& s, double particle_radius, double stiffness) {
   return std::max(wall_stiffness_for_head(s, particle_radius, kHeadPenetrationFraction),
-                  wall_stiffness_for_impact(wall_impact_speed(s, stiffness), particle_radius));
+                  wall_stiffness_for_impact(kWallSpeedFactor * wall_impact_speed(s, stiffness), particle_radius));
 }
 
 double least_holding_wall_stiffness(const SceneScales& s, double particle_radius, double stiffness) {

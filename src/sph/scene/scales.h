@@ -14,6 +14,10 @@ inline constexpr double kSoundSpeedPerSpeed = 10;
 /// The largest penetration into a wall a resting bottom particle may need to carry the
 /// hydrostatic head, as a fraction of the particle radius (the springs act within one radius).
 inline constexpr double kHeadPenetrationFraction = 0.5;
+/// The speed the default wall stiffness stops within one radius, in units of the expected largest
+/// speed: splashes and jets off an impact (and a dam break's surge front, 2 sqrt(g H) by Ritter's
+/// solution) run faster than the free fall that starts them.
+inline constexpr double kWallSpeedFactor = 1.5;
 /// Monaghan's artificial viscosity coefficient alpha the default viscosity is equivalent to.
 inline constexpr double kArtificialViscosityAlpha = 0.1;
 
@@ -49,7 +53,7 @@ double wall_stiffness_for_head(const SceneScales& s, double particle_radius, dou
 /// k_w = (v / distance)^2.
 double wall_stiffness_for_impact(double speed, double distance);
 /// The default wall stiffness: the larger of the head at kHeadPenetrationFraction of the radius
-/// and the impact speed stopped within one radius.
+/// and kWallSpeedFactor times the impact speed stopped within one radius.
 double default_wall_stiffness(const SceneScales& s, double particle_radius, double stiffness);
 /// The stiffness below which an explicit wall cannot hold (a read-time warning): the head with
 /// the bottom particles' centres reaching the wall (penetration r), or the impact speed not

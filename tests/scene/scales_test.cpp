@@ -50,13 +50,14 @@ TEST(SceneScales, TankAtRest2d) {
   EXPECT_DOUBLE_EQ(s.max_speed, std::sqrt(2 * 9.81 * 0.2));  // 1.98 m/s
   // k = (10 v)^2 = 100 * 2 g H = 392.4.
   EXPECT_NEAR(sph::stiffness_for_speed(s.max_speed), 392.4, 1e-9);
-  // Head: g H / (dx f r) = 9.81 * 0.2 / (0.02 * 0.5 * 0.01) = 19620; impact (v / r)^2 = 3.924 / 1e-4 = 39240.
+  // Head: g H / (dx f r) = 9.81 * 0.2 / (0.02 * 0.5 * 0.01) = 19620; impact (v / r)^2 = 3.924 / 1e-4 = 39240,
+  // and for the default 1.5 v: 2.25 * 39240 = 88290.
   EXPECT_NEAR(sph::wall_stiffness_for_head(s, 0.01, 0.5), 19620, 1e-6);
   EXPECT_NEAR(sph::wall_stiffness_for_impact(s.max_speed, 0.01), 39240, 1e-6);
-  EXPECT_NEAR(sph::default_wall_stiffness(s, 0.01, 392.4), 39240, 1e-6);
+  EXPECT_NEAR(sph::default_wall_stiffness(s, 0.01, 392.4), 88290, 1e-6);
   // Cannot hold: the head at penetration r (9810), the impact within 2 r (3.924 / 4e-4 = 9810).
   EXPECT_NEAR(sph::least_holding_wall_stiffness(s, 0.01, 392.4), 9810, 1e-6);
-  EXPECT_NEAR(sph::critical_wall_damping(39240), 2 * std::sqrt(39240.0), 1e-9);  // 396.2
+  EXPECT_NEAR(sph::critical_wall_damping(88290), 2 * std::sqrt(88290.0), 1e-9);  // 594.3
   // nu = alpha h c0 / (2 (D + 2)) = 0.1 * 0.04 * 19.809 / 8 = 9.9045e-3 m^2/s; mu = rho0 nu.
   EXPECT_NEAR(sph::viscosity_for_sound_speed(2, 0.1, 0.04, std::sqrt(392.4), 1000), 9.90454, 1e-5);
   EXPECT_NEAR(sph::viscosity_for_sound_speed(3, 0.1, 0.04, std::sqrt(392.4), 1000), 7.92363, 1e-5);
@@ -65,11 +66,11 @@ TEST(SceneScales, TankAtRest2d) {
   const auto& sim = d.body<2>().sim;
   EXPECT_NEAR(sim.fluid.stiffness, 392.4, 1e-9);
   EXPECT_NEAR(sim.fluid.viscosity, 9.90454, 1e-5);
-  EXPECT_NEAR(sim.walls.stiffness, 39240, 1e-6);
-  EXPECT_NEAR(sim.walls.damping, 396.182, 1e-3);
+  EXPECT_NEAR(sim.walls.stiffness, 88290, 1e-6);
+  EXPECT_NEAR(sim.walls.damping, 594.273, 1e-3);
   // dt: the smallest warning limit is the acoustic CFL 0.4 h / c0 = 0.4 * 0.04 / 19.809 = 8.077e-4
-  // (viscous 0.125 h^2 / nu = 0.0202, wall spring 0.5 / 198.1 = 2.52e-3, damping 0.5 / 396.2 =
-  // 1.26e-3, gravity 0.25 sqrt(h / g) = 0.016); auto takes 0.8 of it: 6.462e-4 s.
+  // (viscous 0.125 h^2 / nu = 0.0202, wall spring 0.5 / 297.1 = 1.68e-3, damping 0.5 / 594.3 =
+  // 8.41e-4, gravity 0.25 sqrt(h / g) = 0.016); auto takes 0.8 of it: 6.462e-4 s.
   EXPECT_NEAR(sim.time_step, 0.8 * 0.4 * 0.04 / std::sqrt(392.4), 1e-12);
   EXPECT_DOUBLE_EQ(sim.time_step, sph::auto_time_step<2>(sim));
   EXPECT_TRUE(d.warnings.empty()) << d.warnings.front();
@@ -138,7 +139,7 @@ TEST(SceneScales, WithoutGravityOnlyMotionSetsTheSpeed) {
   EXPECT_CONTAINS(m, "Fluid.stiffness");
   EXPECT_CONTAINS(m, "no gravity and nothing moves");
   j["Fluid"]["stiffness"] = 400;
-  EXPECT_NEAR(parse(j).body<2>().sim.walls.stiffness, 4e4, 1e-6);  // (2 m/s / 0.01 m)^2
+  EXPECT_NEAR(parse(j).body<2>().sim.walls.stiffness, 9e4, 1e-6);  // (1.5 * 2 m/s / 0.01 m)^2
 }
 
 TEST(SceneDefaults, ExplicitValuesAreKept) {
@@ -210,7 +211,7 @@ TEST(SceneDefaults, WarnsAboutAWallTooSoftForTheHeadOrTheImpact) {
   const sph::SceneDesc d = parse(j);
   ASSERT_EQ(d.warnings.size(), 1u);
   EXPECT_CONTAINS(d.warnings[0], "Container.wallStiffness = 9000 is too low");
-  EXPECT_CONTAINS(d.warnings[0], "wallStiffness = 3.92e+04 would hold");
+  EXPECT_CONTAINS(d.warnings[0], "wallStiffness = 8.83e+04 would hold");
   j["Container"]["wallStiffness"] = 9900;
   EXPECT_TRUE(parse(j).warnings.empty());
   // A fast block needs a stiffer wall: 10 m/s within 2 radii is (10 / 0.02)^2 = 2.5e5.

@@ -46,7 +46,7 @@ TEST(SceneScales, TankAtRest2d) {
   const sph::SceneScales s = sph::scene_scales<2>(d.body<2>());
   EXPECT_DOUBLE_EQ(s.gravity, 9.81);
   EXPECT_DOUBLE_EQ(s.fall_height, 0.2);
-  EXPECT_DOUBLE_EQ(s.head, 0.2);                       // the block's top; it fills only 0.04 m of the box
+  EXPECT_DOUBLE_EQ(s.head, 0.2);                             // the block's top; it fills only 0.04 m of the box
   EXPECT_DOUBLE_EQ(s.max_speed, std::sqrt(2 * 9.81 * 0.2));  // 1.98 m/s
   // k = (10 v)^2 = 100 * 2 g H = 392.4.
   EXPECT_NEAR(sph::stiffness_for_speed(s.max_speed), 392.4, 1e-9);
@@ -148,7 +148,8 @@ TEST(SceneDefaults, ExplicitValuesAreKept) {
   j["Container"]["wallStiffness"] = 1e5;
   j["Container"]["wallDamping"] = 0;
   j["Configuration"]["timeStepSize"] = 1e-4;
-  const auto& sim = parse(j).body<2>().sim;
+  const sph::SceneDesc d = parse(j);
+  const auto& sim = d.body<2>().sim;
   EXPECT_EQ(sim.fluid.stiffness, 1000);
   EXPECT_EQ(sim.fluid.viscosity, 0.5);
   EXPECT_EQ(sim.walls.stiffness, 1e5);
@@ -160,7 +161,8 @@ TEST(SceneDefaults, AutoTimeStepFollowsTheGivenValues) {
   json j = tank_2d();
   j["Configuration"]["timeStepSize"] = "auto";
   j["Fluid"]["stiffness"] = 1e4;  // c0 = 100: acoustic 0.4 * 0.04 / 100 = 1.6e-4
-  const auto& sim = parse(j).body<2>().sim;
+  const sph::SceneDesc d = parse(j);
+  const auto& sim = d.body<2>().sim;
   EXPECT_NEAR(sim.time_step, 0.8 * 1.6e-4, 1e-15);
   // --set gives "auto" too (a plain string).
   json k = tank_2d();

@@ -81,8 +81,8 @@ Settling run_scene(const std::string& json) {
   std::printf(
       "  %lld steps of %.3g s, %zu particles: outside %zu, peak Mach %.3f, speed peak %.3g end %.3g (free fall "
       "%.3g, 95 %% end %.3g) m/s, kinetic peak %.3g end %.3g, density end max %.4f mean %.4f\n",
-      static_cast<long long>(s.steps), p.time_step, s.particles, s.most_outside, s.peak_mach, s.peak_speed,
-      s.end_speed, s.free_fall, s.end_bulk_speed, s.peak_kinetic, s.end_kinetic, s.end_max_density, s.end_mean_density);
+      static_cast<long long>(s.steps), p.time_step, s.particles, s.most_outside, s.peak_mach, s.peak_speed, s.end_speed,
+      s.free_fall, s.end_bulk_speed, s.peak_kinetic, s.end_kinetic, s.end_max_density, s.end_mean_density);
   return s;
 }
 

@@ -25,9 +25,9 @@ inline const std::vector<std::string> kRootKeys{"version",     "name",          
                                                 "dimension",   "Configuration", "Fluid",       "Container",
                                                 "FluidBlocks", "Obstacles",     "Emitters"};
 inline const std::vector<std::string> kConfigurationKeys{
-    "precision",     "timeStepSize",      "numberOfSteps",     "stopAt",    "particleRadius",
-    "kernelRadius",  "gravitation",       "neighbors",         "fullRebuildPeriod", "verletSkin",
-    "reorderPeriod", "outputEveryNSteps", "outputFps",         "outputFormats",     "outputFields"};
+    "precision",   "timeStepSize",  "numberOfSteps",     "stopAt",     "particleRadius", "kernelRadius",
+    "gravitation", "neighbors",     "fullRebuildPeriod", "verletSkin", "reorderPeriod",  "outputEveryNSteps",
+    "outputFps",   "outputFormats", "outputFields"};
 inline const std::vector<std::string> kFluidKeys{
     "density0", "stiffness", "viscosity", "negativePressure", "pressureForce", "gradientCorrection", "particleMass"};
 inline const std::vector<std::string> kContainerKeys{"start", "end", "wallStiffness", "wallDamping"};

@@ -218,7 +218,8 @@ void read_container(ObjectReader& root, SimulationParams<D>& sim, Derived& deriv
   ObjectReader c(cj, root.child("Container"), root.ctx(), detail::kContainerKeys);
   sim.container = read_box<D>(c, "container");
   derived.wall_stiffness = !c.find("wallStiffness");
-  if (!derived.wall_stiffness) sim.walls.stiffness = c.positive("wallStiffness", "a positive wall spring stiffness in 1/s^2");
+  if (!derived.wall_stiffness)
+    sim.walls.stiffness = c.positive("wallStiffness", "a positive wall spring stiffness in 1/s^2");
   derived.wall_damping = !c.find("wallDamping");
   if (!derived.wall_damping) sim.walls.damping = c.positive("wallDamping", "a wall damping >= 0 in 1/s", 0.0, true);
   for (int d = 0; d < D; ++d)
@@ -270,10 +271,10 @@ EmitterParams<D> read_emitter(ObjectReader& e, const SimulationParams<D>& sim) {
   em.height = D == 3 ? static_cast<int>(e.integer("height", "a nozzle height of 1 to 10000 particles", 1, 10000)) : 1;
   em.spacing = 2.0 * sim.particle_radius;
   // Absent: 16, or the fewest steps a batch needs to clear the nozzle (check_emitter_travel).
-  em.every_steps = e.find("emitEveryNSteps") ? static_cast<int>(e.integer(
-                                                   "emitEveryNSteps", "an emission interval of at least 1 step", 1,
-                                                   1'000'000'000))
-                                             : 0;
+  em.every_steps =
+      e.find("emitEveryNSteps")
+          ? static_cast<int>(e.integer("emitEveryNSteps", "an emission interval of at least 1 step", 1, 1'000'000'000))
+          : 0;
   em.max_particles = e.integer("maxParticles", "a positive particle budget", 1, 4'000'000'000LL);
   em.start_time = e.positive("emitStartTime", "a start time >= 0 in s", 0.0, true);
   em.end_time = e.positive("emitEndTime", "an end time > 0 in s", std::numeric_limits<double>::infinity());
@@ -370,7 +371,8 @@ void warn_from_scales(SceneDesc& desc, const SimulationParams<D>& sim, const Der
         "Fluid.viscosity = 0: nothing damps the pressure waves inside the fluid (wall damping acts only at the "
         "walls), so the run may heat up and blow up; viscosity = {:.3g} (the default: Monaghan's artificial "
         "viscosity alpha = {:g}, docs/reliability.md \"Defaults\") would damp them",
-        viscosity_for_sound_speed(D, kArtificialViscosityAlpha, sim.kernel_radius, std::sqrt(k), sim.fluid.rest_density),
+        viscosity_for_sound_speed(D, kArtificialViscosityAlpha, sim.kernel_radius, std::sqrt(k),
+                                  sim.fluid.rest_density),
         kArtificialViscosityAlpha));
 }
 

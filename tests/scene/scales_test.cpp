@@ -48,30 +48,32 @@ TEST(SceneScales, TankAtRest2d) {
   EXPECT_DOUBLE_EQ(s.fall_height, 0.2);
   EXPECT_DOUBLE_EQ(s.head, 0.2);                             // the block's top; it fills only 0.04 m of the box
   EXPECT_DOUBLE_EQ(s.max_speed, std::sqrt(2 * 9.81 * 0.2));  // 1.98 m/s
-  // k = (10 v)^2 = 100 * 2 g H = 392.4.
+  // k = (10 v)^2 = 100 * 2 g H = 392.4; the default designs for 1.5 v: 2.25 * 392.4 = 882.9.
   EXPECT_NEAR(sph::stiffness_for_speed(s.max_speed), 392.4, 1e-9);
+  EXPECT_NEAR(sph::default_stiffness(s), 882.9, 1e-9);
   // Head: g H / (dx f r) = 9.81 * 0.2 / (0.02 * 0.5 * 0.01) = 19620; impact (v / r)^2 = 3.924 / 1e-4 = 39240,
   // and for the default 1.5 v: 2.25 * 39240 = 88290.
   EXPECT_NEAR(sph::wall_stiffness_for_head(s, 0.01, 0.5), 19620, 1e-6);
   EXPECT_NEAR(sph::wall_stiffness_for_impact(s.max_speed, 0.01), 39240, 1e-6);
-  EXPECT_NEAR(sph::default_wall_stiffness(s, 0.01, 392.4), 88290, 1e-6);
+  EXPECT_NEAR(sph::default_wall_stiffness(s, 0.01, 882.9), 88290, 1e-6);
   // Cannot hold: the head at penetration r (9810), the impact within 2 r (3.924 / 4e-4 = 9810).
-  EXPECT_NEAR(sph::least_holding_wall_stiffness(s, 0.01, 392.4), 9810, 1e-6);
+  EXPECT_NEAR(sph::least_holding_wall_stiffness(s, 0.01, 882.9), 9810, 1e-6);
   EXPECT_NEAR(sph::critical_wall_damping(88290), 2 * std::sqrt(88290.0), 1e-9);  // 594.3
-  // nu = alpha h c0 / (2 (D + 2)) = 0.1 * 0.04 * 19.809 / 8 = 9.9045e-3 m^2/s; mu = rho0 nu.
+  // nu = alpha h c0 / (2 (D + 2)) = 0.1 * 0.04 * 19.809 / 8 = 9.9045e-3 m^2/s; mu = rho0 nu (and
+  // for the default c0 = sqrt(882.9) = 29.714: 14.857).
   EXPECT_NEAR(sph::viscosity_for_sound_speed(2, 0.1, 0.04, std::sqrt(392.4), 1000), 9.90454, 1e-5);
   EXPECT_NEAR(sph::viscosity_for_sound_speed(3, 0.1, 0.04, std::sqrt(392.4), 1000), 7.92363, 1e-5);
 
   // The reader filled in exactly these.
   const auto& sim = d.body<2>().sim;
-  EXPECT_NEAR(sim.fluid.stiffness, 392.4, 1e-9);
-  EXPECT_NEAR(sim.fluid.viscosity, 9.90454, 1e-5);
+  EXPECT_NEAR(sim.fluid.stiffness, 882.9, 1e-9);
+  EXPECT_NEAR(sim.fluid.viscosity, 14.8568, 1e-4);
   EXPECT_NEAR(sim.walls.stiffness, 88290, 1e-6);
   EXPECT_NEAR(sim.walls.damping, 594.273, 1e-3);
-  // dt: the smallest warning limit is the acoustic CFL 0.4 h / c0 = 0.4 * 0.04 / 19.809 = 8.077e-4
-  // (viscous 0.125 h^2 / nu = 0.0202, wall spring 0.5 / 297.1 = 1.68e-3, damping 0.5 / 594.3 =
-  // 8.41e-4, gravity 0.25 sqrt(h / g) = 0.016); auto takes 0.8 of it: 6.462e-4 s.
-  EXPECT_NEAR(sim.time_step, 0.8 * 0.4 * 0.04 / std::sqrt(392.4), 1e-12);
+  // dt: the smallest warning limit is the acoustic CFL 0.4 h / c0 = 0.4 * 0.04 / 29.714 = 5.385e-4
+  // (viscous 0.125 h^2 / nu = 0.0135, wall spring 0.5 / 297.1 = 1.68e-3, damping 0.5 / 594.3 =
+  // 8.41e-4, gravity 0.25 sqrt(h / g) = 0.016); auto takes 0.8 of it: 4.308e-4 s.
+  EXPECT_NEAR(sim.time_step, 0.8 * 0.4 * 0.04 / std::sqrt(882.9), 1e-12);
   EXPECT_DOUBLE_EQ(sim.time_step, sph::auto_time_step<2>(sim));
   EXPECT_TRUE(d.warnings.empty()) << d.warnings.front();
 }
@@ -132,7 +134,7 @@ TEST(SceneScales, WithoutGravityOnlyMotionSetsTheSpeed) {
   const sph::SceneScales s = sph::scene_scales<2>(d.body<2>());
   EXPECT_EQ(s.head, 0);
   EXPECT_DOUBLE_EQ(s.max_speed, 0.5);
-  EXPECT_NEAR(d.body<2>().sim.fluid.stiffness, 25, 1e-12);  // (10 * 0.5)^2
+  EXPECT_NEAR(d.body<2>().sim.fluid.stiffness, 56.25, 1e-12);  // (10 * 1.5 * 0.5)^2
   // Still: no speed to derive a stiffness from; with one given, the walls stop c0 / 10.
   j["FluidBlocks"][0].erase("velocity");
   const std::string m = error_of(j);
@@ -231,7 +233,7 @@ TEST(SceneDefaults, WarnsAboutAnExplicitZeroViscosity) {
   const sph::SceneDesc d = parse(j);
   ASSERT_EQ(d.warnings.size(), 1u);
   EXPECT_CONTAINS(d.warnings[0], "Fluid.viscosity = 0: nothing damps");
-  EXPECT_CONTAINS(d.warnings[0], "viscosity = 9.9 ");
+  EXPECT_CONTAINS(d.warnings[0], "viscosity = 14.9 ");
 }
 
 }  // namespace

@@ -30,6 +30,7 @@ struct Settling {
   double end_bulk_speed = 0;     ///< the largest 95th-percentile speed over the last tenth, m/s
   double free_fall = 0;          ///< sqrt(2 g H) of the scene's scales, m/s
   double peak_kinetic = 0;
+  double peak_density = 0;  ///< the largest rho / rho0 of any particle in any step
   double end_kinetic = 0;       ///< at the last step
   double end_max_density = 0;   ///< the largest rho / rho0 at the end
   double end_mean_density = 0;  ///< the mean rho / rho0 at the end
@@ -49,6 +50,7 @@ Settling run_scene(const std::string& json) {
     sim.step();
     const auto& ps = sim.particles();
     std::size_t outside = 0;
+    for (std::size_t i = 0; i < ps.size(); ++i) s.peak_density = std::max(s.peak_density, ps.density[i] / rho0);
     for (std::size_t i = 0; i < ps.size(); ++i)
       for (int d = 0; d < D; ++d)
         if (ps.position[i][d] < p.container.lo[d] || ps.position[i][d] > p.container.hi[d]) {
@@ -80,9 +82,9 @@ Settling run_scene(const std::string& json) {
   s.end_mean_density = sum / static_cast<double>(ps.size());
   std::printf(
       "  %lld steps of %.3g s, %zu particles: outside %zu, peak Mach %.3f, speed peak %.3g end %.3g (free fall "
-      "%.3g, 95 %% end %.3g) m/s, kinetic peak %.3g end %.3g, density end max %.4f mean %.4f\n",
+      "%.3g, 95 %% end %.3g) m/s, kinetic peak %.3g end %.3g, density peak %.4f end max %.4f mean %.4f\n",
       static_cast<long long>(s.steps), p.time_step, s.particles, s.most_outside, s.peak_mach, s.peak_speed, s.end_speed,
-      s.free_fall, s.end_bulk_speed, s.peak_kinetic, s.end_kinetic, s.end_max_density, s.end_mean_density);
+      s.free_fall, s.end_bulk_speed, s.peak_kinetic, s.end_kinetic, s.peak_density, s.end_max_density, s.end_mean_density);
   return s;
 }
 

@@ -69,10 +69,12 @@ SceneScales scene_scales(const SceneBody<D>& body) {
   return s;
 }
 
-double stiffness_for_speed(double max_speed) {
-  const double c0 = kSoundSpeedPerSpeed * max_speed;
+double stiffness_for_speed(double speed) {
+  const double c0 = kSoundSpeedPerSpeed * speed;
   return c0 * c0;
 }
+
+double default_stiffness(const SceneScales& s) { return stiffness_for_speed(kDesignSpeedFactor * s.max_speed); }
 
 double wall_impact_speed(const SceneScales& s, double stiffness) {
   return s.max_speed > 0 ? s.max_speed : std::sqrt(stiffness) / kSoundSpeedPerSpeed;
@@ -86,7 +88,7 @@ double wall_stiffness_for_impact(double speed, double distance) { return (speed 
 
 double default_wall_stiffness(const SceneScales& s, double particle_radius, double stiffness) {
   return std::max(wall_stiffness_for_head(s, particle_radius, kHeadPenetrationFraction),
-                  wall_stiffness_for_impact(kWallSpeedFactor * wall_impact_speed(s, stiffness), particle_radius));
+                  wall_stiffness_for_impact(kDesignSpeedFactor * wall_impact_speed(s, stiffness), particle_radius));
 }
 
 double least_holding_wall_stiffness(const SceneScales& s, double particle_radius, double stiffness) {

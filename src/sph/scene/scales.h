@@ -14,10 +14,11 @@ inline constexpr double kSoundSpeedPerSpeed = 10;
 /// The largest penetration into a wall a resting bottom particle may need to carry the
 /// hydrostatic head, as a fraction of the particle radius (the springs act within one radius).
 inline constexpr double kHeadPenetrationFraction = 0.5;
-/// The speed the default wall stiffness stops within one radius, in units of the expected largest
-/// speed: splashes and jets off an impact (and a dam break's surge front, 2 sqrt(g H) by Ritter's
-/// solution) run faster than the free fall that starts them.
-inline constexpr double kWallSpeedFactor = 1.5;
+/// The speed the defaults are designed for (the sound speed 10 times it, the walls stopping it
+/// within one radius), in units of the expected largest speed: splashes and jets off an impact
+/// (and a dam break's surge front, 2 sqrt(g H) by Ritter's solution) run faster than the free
+/// fall that starts them.
+inline constexpr double kDesignSpeedFactor = 1.5;
 /// Monaghan's artificial viscosity coefficient alpha the default viscosity is equivalent to.
 inline constexpr double kArtificialViscosityAlpha = 0.1;
 
@@ -37,8 +38,10 @@ struct SceneScales {
 template <int D>
 SceneScales scene_scales(const SceneBody<D>& body);
 
-/// The EOS stiffness giving a sound speed kSoundSpeedPerSpeed times `max_speed`: k = (10 v)^2, m^2/s^2.
-double stiffness_for_speed(double max_speed);
+/// The EOS stiffness giving a sound speed kSoundSpeedPerSpeed times `speed`: k = (10 v)^2, m^2/s^2.
+double stiffness_for_speed(double speed);
+/// The default stiffness: stiffness_for_speed(kDesignSpeedFactor * s.max_speed).
+double default_stiffness(const SceneScales& s);
 
 /// The speed a wall must stop: the expected largest speed, or, when the scene has neither
 /// gravity nor initial motion, a tenth of the sound speed sqrt(stiffness) (the weakly
@@ -53,7 +56,7 @@ double wall_stiffness_for_head(const SceneScales& s, double particle_radius, dou
 /// k_w = (v / distance)^2.
 double wall_stiffness_for_impact(double speed, double distance);
 /// The default wall stiffness: the larger of the head at kHeadPenetrationFraction of the radius
-/// and kWallSpeedFactor times the impact speed stopped within one radius.
+/// and kDesignSpeedFactor times the impact speed stopped within one radius.
 double default_wall_stiffness(const SceneScales& s, double particle_radius, double stiffness);
 /// The stiffness below which an explicit wall cannot hold (a read-time warning): the head with
 /// the bottom particles' centres reaching the wall (penetration r), or the impact speed not

@@ -329,7 +329,7 @@ void resolve_defaults(const detail::ReadContext& ctx, SceneBody<D>& body, const 
                "missing, and no default can be derived: the scene has no gravity and nothing moves initially, so no "
                "speed sets the sound speed; give stiffness (typical: (10 v)^2 in m^2/s^2 for the largest speed v "
                "expected)");
-    sim.fluid.stiffness = stiffness_for_speed(s.max_speed);
+    sim.fluid.stiffness = default_stiffness(s);
     check_derived(ctx, "Fluid.stiffness", sim.fluid.stiffness,
                   fmt::format("the expected largest speed {:g} m/s", s.max_speed));
   }

@@ -17,10 +17,9 @@ namespace sph {
 namespace {
 
 using detail::box_text;
+using detail::kAxisNames;
 using detail::point_text;
 using detail::ReadContext;
-
-constexpr const char* kAxisNames[3] = {"x", "y", "z"};
 
 /// Whether a particle of the block filling box b at spacing dx lies strictly inside box o (as
 /// build_particles tests it): on each axis on its own, as the lattice is a product of axes.

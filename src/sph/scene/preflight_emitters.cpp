@@ -115,9 +115,9 @@ void check_inside(const ReadContext& ctx, const Nozzle<D>& n, const SimulationPa
   std::string advice;
   for (int d = 0; d < D && advice.empty(); ++d) {
     if (span.hi[d] - span.lo[d] > room.hi[d] - room.lo[d])
-      advice = fmt::format("the nozzle spans {:.4g} m along axis {}, more than the {:.4g} m the container leaves "
-                           "there: make it narrower",
-                           span.hi[d] - span.lo[d], d, room.hi[d] - room.lo[d]);
+      advice = fmt::format("the nozzle spans {:.4g} m along {}, more than the {:.4g} m the container leaves there: "
+                           "make it narrower",
+                           span.hi[d] - span.lo[d], kAxisNames[d], room.hi[d] - room.lo[d]);
     else if (span.lo[d] < room.lo[d])
       shift[d] = room.lo[d] - span.lo[d];
     else if (span.hi[d] > room.hi[d])

@@ -15,6 +15,8 @@
 
 namespace sph::detail {
 
+inline constexpr const char* kAxisNames[3] = {"x", "y", "z"};
+
 template <int D>
 std::string point_text(const Vec<D, double>& v) {
   std::string s = "[";

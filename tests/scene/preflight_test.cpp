@@ -233,22 +233,39 @@ TEST(Preflight, AnEmitterStartingAfterTheRunIsAWarningWithTheStepsItNeeds) {
   EXPECT_CONTAINS(w, "Emitters[0]: the emitter never emits");
   EXPECT_CONTAINS(w, "emitStartTime = 0.002 s is after the run's end at 0.001 s");
   EXPECT_CONTAINS(w, "raise numberOfSteps to at least 21");
+  j["Emitters"][0]["emitStartTime"] = 1e300;  // more steps away than a scene may have
+  EXPECT_CONTAINS(warnings_of(j), "start it earlier (numberOfSteps is at most 1e+12)");
   j["Emitters"][0]["emitStartTime"] = 5e-4;
   EXPECT_EQ(warnings_of(j), "");
 }
 
-TEST(Preflight, ABudgetTheRunCannotEmitIsAWarningSayingHowManyWillBe) {
+TEST(Preflight, ABudgetItsWindowCannotEmitIsAWarningSayingHowManyWillBe) {
   json j = emitter_scene();
-  j["Emitters"][0]["maxParticles"] = 100;  // one batch of 4 in 10 steps
-  const std::string w = warnings_of(j);
-  EXPECT_CONTAINS(w, "Emitters[0]: only 4 of its maxParticles = 100 particles will be emitted before the run ends");
-  EXPECT_CONTAINS(w, "raise numberOfSteps to at least 385");  // 25 batches, 16 steps apart
-  // Not when --steps (or --set) shortened the run on purpose.
-  EXPECT_EQ(warnings_of(j, {"Configuration.numberOfSteps=10"}), "");
-  // Its window closing first is named instead.
-  j["Configuration"]["numberOfSteps"] = 1000;
+  j["Emitters"][0]["maxParticles"] = 100;  // 25 batches of 4, 16 steps apart: 384 steps
+  // A run that ends first (one batch in 10 steps) is shortened on purpose: no warning.
+  EXPECT_EQ(warnings_of(j), "");
+  // A window that closes first (7 batches before 0.01 s) is named, with the end that would do.
   j["Emitters"][0]["emitEndTime"] = 0.01;
-  EXPECT_CONTAINS(warnings_of(j), "before emitEndTime = 0.01 s; to emit them all, raise emitEndTime to at least");
+  const std::string w = warnings_of(j);
+  EXPECT_CONTAINS(w,
+                  "Emitters[0]: only 28 of its maxParticles = 100 particles are emitted before emitEndTime = "
+                  "0.01 s; to emit them all, raise emitEndTime to at least 0.03845 s (or lower maxParticles to "
+                  "28)");
+  // The same warnings whether numberOfSteps comes from the file or a flag (a checkpoint's scene
+  // reads back to the same SceneDesc).
+  EXPECT_EQ(warnings_of(j, {"Configuration.numberOfSteps=10"}), w);
+  EXPECT_EQ(warnings_of(j, {"Configuration.numberOfSteps=5000"}), w);
+  j["Emitters"][0]["emitEndTime"] = 0.03845;
+  EXPECT_EQ(warnings_of(j), "");
+}
+
+TEST(Preflight, AWindowBetweenTwoStepsNeverEmits) {
+  json j = emitter_scene();
+  j["Emitters"][0]["emitStartTime"] = 2.6e-4;  // the first step reaching it (less half a step) is step 3,
+  j["Emitters"][0]["emitEndTime"] = 2.8e-4;    // at 3e-4 s: past the end
+  EXPECT_CONTAINS(warnings_of(j),
+                  "no step of the run falls between emitStartTime = 0.00026 s and emitEndTime = "
+                  "0.00028 s; raise emitEndTime to at least 0.00035 s");
 }
 
 TEST(Preflight, EmittedInRunCountsWhatTheSimulationEmits) {
@@ -259,8 +276,8 @@ TEST(Preflight, EmittedInRunCountsWhatTheSimulationEmits) {
     int max_particles, every;
     double start, end;
   };
-  const std::vector<Case> cases = {{1000, 16, 0, 1},     {1000, 16, 0.00149, 1},       {1000, 16, 0.0015, 1},
-                                   {1000, 20, 0.001, 0.0121}, {10, 16, 0, 1}, {1000, 11, 0.00234, 0.0099},
+  const std::vector<Case> cases = {{1000, 16, 0, 1},          {1000, 16, 0.00149, 1}, {1000, 16, 0.0015, 1},
+                                   {1000, 20, 0.001, 0.0121}, {10, 16, 0, 1},         {1000, 11, 0.00234, 0.0099},
                                    {1000, 16, 0.03, 1}};
   for (const Case& c : cases) {
     j["Emitters"][0]["maxParticles"] = c.max_particles;
@@ -299,6 +316,18 @@ TEST(Preflight, ObstaclesCoveringTheContainerAreRefused) {
               0.1, 1e-12);
 }
 
+TEST(Preflight, FreeVolumeIsExactForFewObstaclesAndNeverBelowTheTruthForMany) {
+  const sph::Box<2> box{{0, 0}, {1, 1}};
+  auto strips = [](int n) {
+    std::vector<sph::Box<2>> s;
+    for (int i = 0; i < n; ++i) s.push_back(sph::Box<2>{{i / double(n), 0}, {(i + 1) / double(n), 1}});
+    return s;
+  };
+  EXPECT_NEAR(sph::detail::free_volume<2>(box, strips(10)), 0, 1e-12);  // exact: the strips cover the box
+  // 200 strips: past the exact computation's size, the box less its largest obstacle (an upper bound).
+  EXPECT_NEAR(sph::detail::free_volume<2>(box, strips(200)), 1 - 1 / 200.0, 1e-12);
+}
+
 TEST(Preflight, EmittersOverfillingTheRoomObstaclesLeaveAreRefused) {
   json j = emitter_scene();
   j.erase("FluidBlocks");
@@ -326,7 +355,7 @@ json shifted(json j, double by) {
 TEST(Preflight, FloatCoordinatesFarFromTheOriginWarnThenAreRefused) {
   json j = base_scene();
   j["Configuration"]["precision"] = "float";
-  EXPECT_EQ(warnings_of(shifted(j, 100)), "");  // 101 m: float spacing 1.2e-5 m, 6e-4 of 0.02 m
+  EXPECT_EQ(warnings_of(shifted(j, 100)), "");          // 101 m: float spacing 1.2e-5 m, 6e-4 of 0.02 m
   const std::string w = warnings_of(shifted(j, 1000));  // 6e-3 of the spacing
   EXPECT_CONTAINS(w, "Container: coordinates reach 1001 m from the origin");
   EXPECT_CONTAINS(w, "use \"precision\": \"double\"");
@@ -339,9 +368,9 @@ TEST(Preflight, FloatCoordinatesFarFromTheOriginWarnThenAreRefused) {
 
 TEST(Preflight, DoubleCoordinatesFarFromTheOriginWarnThenAreRefused) {
   const json j = base_scene();
-  EXPECT_EQ(warnings_of(shifted(j, 1e10)), "");                          // 1.1e-4 of the spacing
+  EXPECT_EQ(warnings_of(shifted(j, 1e10)), "");                            // 1.1e-4 of the spacing
   EXPECT_CONTAINS(warnings_of(shifted(j, 1e11)), "double positions are");  // 1.1e-3
-  const std::string m = error_of(shifted(j, 1e12));                       // 1.1e-2
+  const std::string m = error_of(shifted(j, 1e12));                        // 1.1e-2
   EXPECT_CONTAINS(m, "move the scene near the origin");
   EXPECT_TRUE(m.find("precision") == std::string::npos) << m;
 }

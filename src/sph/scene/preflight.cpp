@@ -51,15 +51,15 @@ std::string separation_advice(const Box<D>& cut, const std::string& cut_name, co
     if (keep.lo[d] - cut.lo[d] >= dx && (keep.lo[d] - cut.lo[d]) / size > best_kept) {
       best_kept = (keep.lo[d] - cut.lo[d]) / size;
       moved.hi[d] = keep.lo[d];
-      best = fmt::format("shrink {} to end where {} starts along {}: \"end\": {}", cut_name, keep_name,
-                         kAxisNames[d], point_text<D>(moved.hi));
+      best = fmt::format("shrink {} to end where {} starts along {}: \"end\": {}", cut_name, keep_name, kAxisNames[d],
+                         point_text<D>(moved.hi));
       moved.hi[d] = cut.hi[d];
     }
     if (cut.hi[d] - keep.hi[d] >= dx && (cut.hi[d] - keep.hi[d]) / size > best_kept) {
       best_kept = (cut.hi[d] - keep.hi[d]) / size;
       moved.lo[d] = keep.hi[d];
-      best = fmt::format("shrink {} to start where {} ends along {}: \"start\": {}", cut_name, keep_name,
-                         kAxisNames[d], point_text<D>(moved.lo));
+      best = fmt::format("shrink {} to start where {} ends along {}: \"start\": {}", cut_name, keep_name, kAxisNames[d],
+                         point_text<D>(moved.lo));
     }
   }
   return best;
@@ -120,9 +120,9 @@ void check_coordinates(const ReadContext& ctx, SceneDesc& desc, const Simulation
   if (fraction <= kCoordinateWarnFraction) return;
   Vec<D, double> centre;
   for (int d = 0; d < D; ++d) centre[d] = 0.5 * (sim.container.lo[d] + sim.container.hi[d]);
-  const std::string advice = fmt::format(
-      "{}move the scene near the origin: subtract {} (the container's centre) from every coordinate", 
-      is_float ? "use \"precision\": \"double\", or " : "", point_text<D>(centre));
+  const std::string advice =
+      fmt::format("{}move the scene near the origin: subtract {} (the container's centre) from every coordinate",
+                  is_float ? "use \"precision\": \"double\", or " : "", point_text<D>(centre));
   const std::string what = fmt::format(
       "coordinates reach {:g} m from the origin, where {} positions are {:.3g} m apart: {:.3g} of the particle "
       "spacing {:g} m",
@@ -199,14 +199,14 @@ void check_mass(const ReadContext& ctx, SceneDesc& desc, const SimulationParams<
       "particleMass = {:.4g} kg is {:.3g} times the lattice mass {:.4g} kg, so the initial density would be about "
       "{:.3g} kg/m^{} instead of density0 = {:g}",
       sim.particle_mass, ratio, lattice, ratio * sim.fluid.rest_density, D, sim.fluid.rest_density);
-  const std::string advice =
-      fmt::format("use particleMass {:.6g} (or leave it out: that is the default)", lattice);
+  const std::string advice = fmt::format("use particleMass {:.6g} (or leave it out: that is the default)", lattice);
   if (factor > kMassRefuseFactor)
     ctx.fail("Fluid.particleMass", fmt::format("{}: more than {:g} times off, the fluid would {} at once; {}", what,
                                                kMassRefuseFactor, ratio > 1 ? "explode" : "collapse", advice));
-  desc.warnings.push_back(fmt::format("Fluid.particleMass: {}: more than {:g} times off, the fluid will {} at the "
-                                      "start; {}",
-                                      what, kMassWarnFactor, ratio > 1 ? "expand" : "contract", advice));
+  desc.warnings.push_back(
+      fmt::format("Fluid.particleMass: {}: more than {:g} times off, the fluid will {} at the "
+                  "start; {}",
+                  what, kMassWarnFactor, ratio > 1 ? "expand" : "contract", advice));
 }
 
 /// negativePressure "allow" with a free surface: tension pulls surface particles into clumps.

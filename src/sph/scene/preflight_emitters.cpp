@@ -19,6 +19,9 @@ namespace sph::detail {
 
 namespace {
 
+/// The most steps a scene may have (Configuration.numberOfSteps).
+constexpr double kMaxSteps = 1e12;
+
 /// An emitter with the axes of its nozzle (nozzle_axes) and where the preflight names it.
 template <int D>
 struct Nozzle {
@@ -79,7 +82,8 @@ std::optional<std::array<int, 2>> particle_in(const Nozzle<D>& n, const Vec<D, d
     if (!(lo <= hi)) continue;
     for (double b : {std::round(0.5 * (lo + hi)), std::ceil(lo), std::floor(hi)}) {
       if (b < 0 || b > n.rows() - 1) continue;
-      if (strictly_inside<D>(n.at(a, static_cast<int>(b)) + shift, o)) return std::array<int, 2>{a, static_cast<int>(b)};
+      if (strictly_inside<D>(n.at(a, static_cast<int>(b)) + shift, o))
+        return std::array<int, 2>{a, static_cast<int>(b)};
     }
   }
   return std::nullopt;
@@ -115,9 +119,10 @@ void check_inside(const ReadContext& ctx, const Nozzle<D>& n, const SimulationPa
   std::string advice;
   for (int d = 0; d < D && advice.empty(); ++d) {
     if (span.hi[d] - span.lo[d] > room.hi[d] - room.lo[d])
-      advice = fmt::format("the nozzle spans {:.4g} m along {}, more than the {:.4g} m the container leaves there: "
-                           "make it narrower",
-                           span.hi[d] - span.lo[d], kAxisNames[d], room.hi[d] - room.lo[d]);
+      advice = fmt::format(
+          "the nozzle spans {:.4g} m along {}, more than the {:.4g} m the container leaves there: "
+          "make it narrower",
+          span.hi[d] - span.lo[d], kAxisNames[d], room.hi[d] - room.lo[d]);
     else if (span.lo[d] < room.lo[d])
       shift[d] = room.lo[d] - span.lo[d];
     else if (span.hi[d] > room.hi[d])
@@ -128,8 +133,8 @@ void check_inside(const ReadContext& ctx, const Nozzle<D>& n, const SimulationPa
   ctx.fail(n.name, fmt::format("the nozzle's corner particle {} nozzle, at {}, is {:.3g} m too close to or outside "
                                "the container {} (every nozzle particle must be at least a particle radius, {:g} m, "
                                "inside it); {}",
-                               n.particle_text(corner[0], corner[1]), point_text<D>(n.at(corner[0], corner[1])),
-                               worst, box_text<D>(sim.container), r, advice));
+                               n.particle_text(corner[0], corner[1]), point_text<D>(n.at(corner[0], corner[1])), worst,
+                               box_text<D>(sim.container), r, advice));
 }
 
 /// Every nozzle particle clear (by a particle radius) of every obstacle and of the initial fluid.
@@ -171,10 +176,11 @@ void check_path(SceneDesc& desc, const Nozzle<D>& n, const SceneBody<D>& body) {
       if (particle_in<D>(n, shift, grown<D>(filled_box<D>(body.blocks[i].box, dx), r)))
         hit = fmt::format("the fluid of FluidBlocks[{}] {}", i, box_text<D>(body.blocks[i].box));
     if (hit.empty()) continue;
-    desc.warnings.push_back(fmt::format("{}: {} is {:.3g} m in front of the nozzle (less than {:g} particle "
-                                        "spacings): the first batches will run into it at {:g} m/s; move the "
-                                        "emitter or aim it elsewhere",
-                                        n.name, hit, ahead, kNozzlePathSpacings, n.e.speed));
+    desc.warnings.push_back(
+        fmt::format("{}: {} is {:.3g} m in front of the nozzle (less than {:g} particle "
+                    "spacings): the first batches will run into it at {:g} m/s; move the "
+                    "emitter or aim it elsewhere",
+                    n.name, hit, ahead, kNozzlePathSpacings, n.e.speed));
     return;
   }
 }
@@ -184,42 +190,50 @@ void check_path(SceneDesc& desc, const Nozzle<D>& n, const SceneBody<D>& body) {
 template <int D>
 double first_emitting_step(const EmitterParams<D>& e, double steps, double dt) {
   double first = std::clamp(std::ceil(e.start_time / dt - 0.5), 0.0, steps);
-  while (first > 0 && (first - 1) * dt + 0.5 * dt >= e.start_time) first -= 1;
-  while (first < steps && first * dt + 0.5 * dt < e.start_time) first += 1;
+  // The estimate is off by a step at most (rounding); past 2^53 steps whole numbers are not exact.
+  for (int k = 0; k < 2 && first > 0 && (first - 1) * dt + 0.5 * dt >= e.start_time; ++k) first -= 1;
+  for (int k = 0; k < 2 && first < steps && first * dt + 0.5 * dt < e.start_time; ++k) first += 1;
   return first;
 }
 
-/// The warnings of an emission window the run does not cover: an emitter that never emits, or
-/// one whose budget is not all emitted (with the numberOfSteps or emitEndTime that would).
+/// The warnings of an emission window: an emitter that never emits in the run (its window
+/// starts after the run's end, or no step falls in it), and one whose window closes before its
+/// maxParticles are out (how many will be, and the emitEndTime that would emit them all). A run
+/// that merely ends before the budget is out is not warned about: --steps shortens runs on
+/// purpose, and a scene's warnings must not depend on whether numberOfSteps came from a flag (a
+/// checkpoint's scene reads back to the same SceneDesc, warnings included).
 template <int D>
 void check_budget(SceneDesc& desc, const Nozzle<D>& n, double dt) {
   const EmitterParams<D>& e = n.e;
   const double steps = static_cast<double>(desc.steps);
-  const std::int64_t emitted = emitted_in_run<D>(e, desc.steps, dt);
-  if (emitted >= e.max_particles) return;
-  const double per_batch = static_cast<double>(e.width) * n.rows();
-  const double first = first_emitting_step<D>(e, std::numeric_limits<double>::max(), dt);
-  const double last = first + (std::ceil(static_cast<double>(e.max_particles) / per_batch) - 1) * e.every_steps;
-  std::string advice = last * dt > e.end_time ? fmt::format("raise emitEndTime to at least {:.6g} s", last * dt) : "";
-  if (last + 1 > steps)
-    advice += fmt::format("{}raise numberOfSteps to at least {:.0f}", advice.empty() ? "" : " and ", last + 1);
-  if (emitted == 0) {
-    desc.warnings.push_back(fmt::format(
-        "{}: the emitter never emits: {}; {}", n.name,
-        first >= steps ? fmt::format("emitStartTime = {:g} s is after the run's end at {:g} s ({} steps of {:g} s)",
-                                     e.start_time, steps * dt, desc.steps, dt)
-                       : fmt::format("no step of the run falls between emitStartTime = {:g} s and emitEndTime = "
-                                     "{:g} s",
-                                     e.start_time, e.end_time),
-        advice));
+  const double first = first_emitting_step<D>(e, kMaxSteps, dt);
+  if (emitted_in_run<D>(e, desc.steps, dt) == 0) {
+    std::string why, advice;
+    if (first >= steps) {
+      why = fmt::format("emitStartTime = {:g} s is after the run's end at {:g} s ({} steps of {:g} s)", e.start_time,
+                        steps * dt, desc.steps, dt);
+      advice = first + 1 > kMaxSteps
+                   ? fmt::format("start it earlier (numberOfSteps is at most {:g})", kMaxSteps)
+                   : fmt::format("start it earlier or raise numberOfSteps to at least {:.0f}", first + 1);
+    } else {
+      why = fmt::format("no step of the run falls between emitStartTime = {:g} s and emitEndTime = {:g} s",
+                        e.start_time, e.end_time);
+      advice = fmt::format("raise emitEndTime to at least {:.6g} s", (first + 0.5) * dt);
+    }
+    desc.warnings.push_back(fmt::format("{}: the emitter never emits: {}; {}", n.name, why, advice));
     return;
   }
-  desc.warnings.push_back(fmt::format("{}: only {} of its maxParticles = {} particles will be emitted before {}; to "
-                                      "emit them all, {} (or lower maxParticles to {})",
-                                      n.name, emitted, e.max_particles,
-                                      last * dt > e.end_time ? fmt::format("emitEndTime = {:g} s", e.end_time)
-                                                             : fmt::format("the run ends at {:g} s", steps * dt),
-                                      advice, emitted));
+  if (!std::isfinite(e.end_time)) return;
+  const std::int64_t in_window = emitted_in_run<D>(e, static_cast<std::int64_t>(kMaxSteps), dt);
+  if (in_window >= e.max_particles) return;
+  const double per_batch = static_cast<double>(e.width) * n.rows();
+  // The step of the last batch needed; half a step more is clear of round-off in its time.
+  const double last = first + (std::ceil(static_cast<double>(e.max_particles) / per_batch) - 1) * e.every_steps;
+  desc.warnings.push_back(
+      fmt::format("{}: only {} of its maxParticles = {} particles are emitted before "
+                  "emitEndTime = {:g} s; to emit them all, raise emitEndTime to at least {:.6g} s "
+                  "(or lower maxParticles to {})",
+                  n.name, in_window, e.max_particles, e.end_time, (last + 0.5) * dt, in_window));
 }
 
 /// Room in the container, less its obstacles, for the blocks' particles and those the emitters
@@ -250,8 +264,8 @@ std::int64_t emitted_in_run(const EmitterParams<D>& e, std::int64_t steps, doubl
   double last = n - 1;  // the last step at which it may emit: time not past emitEndTime
   if (std::isfinite(e.end_time)) {
     last = std::clamp(std::floor(e.end_time / dt), -1.0, n - 1);
-    while (last + 1 < n && (last + 1) * dt <= e.end_time) last += 1;
-    while (last >= 0 && last * dt > e.end_time) last -= 1;
+    for (int k = 0; k < 2 && last + 1 < n && (last + 1) * dt <= e.end_time; ++k) last += 1;
+    for (int k = 0; k < 2 && last >= 0 && last * dt > e.end_time; ++k) last -= 1;
   }
   if (!(first <= last)) return 0;
   const double batches = std::floor((last - first) / e.every_steps) + 1;
@@ -262,8 +276,6 @@ std::int64_t emitted_in_run(const EmitterParams<D>& e, std::int64_t steps, doubl
 template <int D>
 void check_emitters(const ReadContext& ctx, SceneDesc& desc, const SceneBody<D>& body) {
   const SimulationParams<D>& sim = body.sim;
-  // A run shortened by --steps (or --set Configuration.numberOfSteps) leaves budgets unemitted on purpose.
-  const bool steps_overridden = ctx.overridden.count("Configuration.numberOfSteps") > 0;
   for (std::size_t k = 0; k < sim.emitters.size(); ++k) {
     const EmitterParams<D>& e = sim.emitters[k];
     const auto [u, w] = nozzle_axes<D>(e.direction);
@@ -276,7 +288,7 @@ void check_emitters(const ReadContext& ctx, SceneDesc& desc, const SceneBody<D>&
     check_inside<D>(ctx, n, sim);
     check_clear<D>(ctx, n, body);
     check_path<D>(desc, n, body);
-    if (!steps_overridden) check_budget<D>(desc, n, sim.time_step);
+    check_budget<D>(desc, n, sim.time_step);
   }
   if (!sim.emitters.empty()) check_room<D>(ctx, desc, body);
 }

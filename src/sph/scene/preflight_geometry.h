@@ -52,19 +52,20 @@ Box<D> intersection(const Box<D>& a, const Box<D>& b) {
 
 /// The volume of the container not covered by any obstacle: exact (the cells between the
 /// obstacles' coordinates) while that grid has at most ~1e7 cells x obstacles; beyond it the
-/// container's volume less the sum of the obstacles' (a lower bound).
+/// container's volume less the largest obstacle's (an upper bound, so that a refusal on it is
+/// never wrong).
 template <int D>
 double free_volume(const Box<D>& container, const std::vector<Box<D>>& obstacles) {
   std::vector<Box<D>> inside;
-  double covered_sum = 0;
+  double largest = 0;
   for (const Box<D>& o : obstacles) {
     const Box<D> c = intersection<D>(o, container);
-    if (volume<D>(c) > 0) inside.push_back(c), covered_sum += volume<D>(c);
+    if (volume<D>(c) > 0) inside.push_back(c), largest = std::max(largest, volume<D>(c));
   }
   const double total = volume<D>(container);
   const double n = static_cast<double>(inside.size());
   if (inside.empty()) return total;
-  if (std::pow(2 * n + 1, D) * n > 1e7) return std::max(0.0, total - covered_sum);
+  if (std::pow(2 * n + 1, D) * n > 1e7) return std::max(0.0, total - largest);
   std::vector<double> cuts[D];
   for (int d = 0; d < D; ++d) {
     cuts[d] = {container.lo[d], container.hi[d]};

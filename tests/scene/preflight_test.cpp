@@ -160,7 +160,7 @@ TEST(Preflight, ANozzleParticleCloserThanARadiusToTheWallIsRefusedWithWhereToMov
   j["Emitters"][0]["translation"] = json::array({0.05, 0.97});  // top particle at 1.0: on the wall
   const std::string m = error_of(j);
   EXPECT_CONTAINS(m, "Emitters[0]");
-  EXPECT_CONTAINS(m, "corner particle 3 of the 4 nozzle, at [0.05, 1]");
+  EXPECT_CONTAINS(m, "corner particle 3 (of 4), at [0.05, 1]");
   EXPECT_CONTAINS(m, "0.01 m too close to or outside the container");
   EXPECT_CONTAINS(m, "\"translation\": [0.05, 0.96]");
   // Its centre a half radius from the side wall (the centre alone was checked before).
@@ -173,7 +173,7 @@ TEST(Preflight, A3dNozzleNamesItsCornerAndANozzleWiderThanTheContainerIsToldToNa
   EXPECT_EQ(warnings_of(j), "");
   j["Emitters"][0]["translation"] = json::array({0.05, 0.55, 0.3});  // rows up to y = 0.6
   const std::string m = error_of(j);
-  EXPECT_CONTAINS(m, "of the 6 x 6 nozzle");
+  EXPECT_CONTAINS(m, "(of 6 x 6), at");
   EXPECT_CONTAINS(m, "\"translation\": [0.05, 0.54, 0.3]");
   j["Emitters"][0]["translation"] = json::array({0.05, 0.3, 0.3});
   j["Emitters"][0]["width"] = 31;  // 0.6 m across, in 0.6 - 2 radii of room
@@ -188,7 +188,7 @@ TEST(Preflight, ANozzleInOrAgainstAnObstacleIsRefused) {
   j["Obstacles"][0]["end"] = json::array({0.2, 0.465});
   const std::string m = error_of(j);
   EXPECT_CONTAINS(m, "Emitters[0]");
-  EXPECT_CONTAINS(m, "particle 0 of the 4 nozzle, at [0.05, 0.47], is inside Obstacles[0]");
+  EXPECT_CONTAINS(m, "particle 0 (of 4), at [0.05, 0.47], is inside Obstacles[0]");
 }
 
 TEST(Preflight, ANozzleInTheInitialFluidIsRefused) {

@@ -32,8 +32,8 @@ struct Nozzle {
   int rows() const { return D == 3 ? e.height : 1; }
   Vec<D, double> at(int a, int b) const { return nozzle_position<D>(e, u, w, a, b); }
   std::string particle_text(int a, int b) const {
-    return D == 3 ? fmt::format("({}, {}) of the {} x {}", a, b, e.width, e.height)
-                  : fmt::format("{} of the {}", a, e.width);
+    return D == 3 ? fmt::format("({}, {}) (of {} x {})", a, b, e.width, e.height)
+                  : fmt::format("{} (of {})", a, e.width);
   }
   /// The bounding box of the nozzle's particles (its corners), moved by `shift`.
   Box<D> bounds(const Vec<D, double>& shift) const {
@@ -130,7 +130,7 @@ void check_inside(const ReadContext& ctx, const Nozzle<D>& n, const SimulationPa
   }
   if (advice.empty())
     advice = fmt::format("move it to \"translation\": {} or make it narrower", point_text<D>(n.e.origin + shift));
-  ctx.fail(n.name, fmt::format("the nozzle's corner particle {} nozzle, at {}, is {:.3g} m too close to or outside "
+  ctx.fail(n.name, fmt::format("the nozzle's corner particle {}, at {}, is {:.3g} m too close to or outside "
                                "the container {} (every nozzle particle must be at least a particle radius, {:g} m, "
                                "inside it); {}",
                                n.particle_text(corner[0], corner[1]), point_text<D>(n.at(corner[0], corner[1])), worst,
@@ -144,14 +144,14 @@ void check_clear(const ReadContext& ctx, const Nozzle<D>& n, const SceneBody<D>&
   const double r = sim.particle_radius, dx = 2 * r;
   for (std::size_t i = 0; i < sim.obstacles.size(); ++i)
     if (const auto p = particle_in<D>(n, Vec<D, double>{}, grown<D>(sim.obstacles[i], r)))
-      ctx.fail(n.name, fmt::format("the nozzle's particle {} nozzle, at {}, is inside Obstacles[{}] {} or closer "
+      ctx.fail(n.name, fmt::format("the nozzle's particle {}, at {}, is inside Obstacles[{}] {} or closer "
                                    "than a particle radius ({:g} m) to it: the emitter would place particles in the "
                                    "solid; move \"translation\" or the obstacle",
                                    n.particle_text((*p)[0], (*p)[1]), point_text<D>(n.at((*p)[0], (*p)[1])), i,
                                    box_text<D>(sim.obstacles[i]), r));
   for (std::size_t i = 0; i < body.blocks.size(); ++i)
     if (const auto p = particle_in<D>(n, Vec<D, double>{}, grown<D>(filled_box<D>(body.blocks[i].box, dx), r)))
-      ctx.fail(n.name, fmt::format("the nozzle's particle {} nozzle, at {}, is in the fluid of FluidBlocks[{}] {} "
+      ctx.fail(n.name, fmt::format("the nozzle's particle {}, at {}, is in the fluid of FluidBlocks[{}] {} "
                                    "(closer than a spacing, {:g} m, to its particles): emitted particles would "
                                    "land on the block's; move \"translation\" out of the fluid or shrink the block",
                                    n.particle_text((*p)[0], (*p)[1]), point_text<D>(n.at((*p)[0], (*p)[1])), i,

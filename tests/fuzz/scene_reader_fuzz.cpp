@@ -8,7 +8,8 @@
 // aborts and is reported as a finding, as are crashes, leaks and undefined behaviour.
 //
 // A scene the reader accepts must keep the promises of SceneDesc (finite, positive sizes and
-// masses, unit emitter directions, everything inside the container: check_accepted below); a
+// masses, unit emitter directions, everything inside the container: check_accepted below; and
+// the preflight's: no overlapping blocks, whole nozzles inside: check_preflight_promises); a
 // broken promise is a finding too. It is then built (particles and Simulation) and stepped
 // twice when it is small, so values that pass validation are also shown to be usable. What
 // scene_to_json writes of it must read back to an equal SceneDesc.
@@ -29,6 +30,7 @@
 #include <sph/scene/scene_desc.h>
 #include <sph/scene/scene_reader.h>
 #include <sph/scene/scene_writer.h>
+#include <sph/solver/nozzle.h>
 
 namespace {
 
@@ -118,6 +120,40 @@ double particle_budget(const sph::SceneDesc& desc) {
   return total;
 }
 
+/// The preflight's promises on a small accepted scene, checked on what the builders and the
+/// emitter make: no two particles of different fluid blocks closer than half a spacing, and
+/// every nozzle particle at least a particle radius inside the container.
+template <int D>
+void check_preflight_promises(const sph::SceneDesc& desc) {
+  const sph::SceneBody<D>& body = desc.body<D>();
+  const sph::SimulationParams<D>& p = body.sim;
+  const double dx = 2 * p.particle_radius;
+  const auto ps = sph::build_particles<D, double>(body);
+  std::vector<std::size_t> block_of;
+  for (std::size_t b = 0; b < body.blocks.size(); ++b) {
+    sph::SceneBody<D> one;
+    one.sim.particle_radius = p.particle_radius;
+    one.blocks.push_back(body.blocks[b]);
+    block_of.insert(block_of.end(), sph::count_block_particles<D>(one), b);
+  }
+  promise(block_of.size() == ps.size(), "one block per built particle");
+  for (std::size_t i = 0; i < ps.size(); ++i)
+    for (std::size_t j = i + 1; j < ps.size(); ++j)
+      if (block_of[i] != block_of[j])
+        promise(sph::norm(ps.position[i] - ps.position[j]) >= 0.5 * dx * (1 - 1e-9), "no overlapping blocks");
+  for (const auto& e : p.emitters) {
+    const auto [u, w] = sph::nozzle_axes<D>(e.direction);
+    for (int a : {0, e.width - 1})
+      for (int b : {0, D == 3 ? e.height - 1 : 0}) {
+        const auto x = sph::nozzle_position<D>(e, u, w, a, b);
+        for (int d = 0; d < D; ++d)
+          promise(x[d] >= p.container.lo[d] + p.particle_radius * (1 - 1e-6) &&
+                      x[d] <= p.container.hi[d] - p.particle_radius * (1 - 1e-6),
+                  "every nozzle particle a particle radius inside the container");
+      }
+  }
+}
+
 template <int D, class R>
 void simulate_briefly(const sph::SceneDesc& desc) {
   auto sim = sph::make_simulation<D, R>(desc);
@@ -128,6 +164,7 @@ template <int D>
 void check_and_simulate(const sph::SceneDesc& desc) {
   check_accepted<D>(desc);
   if (particle_budget<D>(desc) > kMaxSimulatedParticles) return;
+  check_preflight_promises<D>(desc);
   if (desc.precision == sph::Precision::Float)
     simulate_briefly<D, float>(desc);
   else

@@ -17,6 +17,7 @@
 #include <sph/scene/object_reader.h>
 #include <sph/scene/overrides.h>
 #include <sph/scene/scales.h>
+#include <sph/scene/preflight.h>
 #include <sph/scene/scene_keys.h>
 #include <sph/solver/time_step.h>
 #include <sph/solver/wcsph.h>
@@ -410,6 +411,7 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
   } catch (const Error& e) {
     root.ctx().fail(e.where(), e.message());
   }
+  preflight<D>(desc, root.ctx());
 }
 
 }  // namespace

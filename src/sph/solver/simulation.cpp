@@ -9,34 +9,12 @@
 #include <sph/core/parallel.h>
 #include <sph/core/state_stream.h>
 #include <sph/core/timer.h>
+#include <sph/solver/nozzle.h>
 #include <sph/solver/wcsph.h>
 
 namespace sph {
 
 namespace {
-
-/// Two unit vectors orthogonal to dir (and to each other); in 2D only the first is used.
-template <int D>
-std::pair<Vec<D, double>, Vec<D, double>> nozzle_axes(const Vec<D, double>& dir) {
-  Vec<D, double> u{}, w{};
-  if constexpr (D == 2) {
-    u[0] = -dir[1];
-    u[1] = dir[0];
-  } else {
-    // Pick the coordinate axis least aligned with dir, then Gram-Schmidt.
-    int k = 0;
-    for (int d = 1; d < 3; ++d)
-      if (std::abs(dir[d]) < std::abs(dir[k])) k = d;
-    Vec<D, double> e{};
-    e[k] = 1;
-    u = e - dir * dot(e, dir);
-    u *= 1.0 / norm(u);
-    w[0] = dir[1] * u[2] - dir[2] * u[1];
-    w[1] = dir[2] * u[0] - dir[0] * u[2];
-    w[2] = dir[0] * u[1] - dir[1] * u[0];
-  }
-  return {u, w};
-}
 
 /// Deterministic sum over particles: fixed chunks, partial sums added in chunk order.
 template <class F>
@@ -104,9 +82,7 @@ std::size_t Simulation<D, R>::emit() {
     const Vec<D, R> vel = vec_cast<R>(e.direction * e.speed);
     for (int b = 0; b < rows && s.emitted < e.max_particles; ++b)
       for (int a = 0; a < e.width && s.emitted < e.max_particles; ++a) {
-        Vec<D, double> x = e.origin + u * ((a - 0.5 * (e.width - 1)) * e.spacing);
-        if constexpr (D == 3) x += w * ((b - 0.5 * (e.height - 1)) * e.spacing);
-        particles_.add(vec_cast<R>(x), vel, static_cast<R>(params_.particle_mass));
+        particles_.add(vec_cast<R>(nozzle_position<D>(e, u, w, a, b)), vel, static_cast<R>(params_.particle_mass));
         ++s.emitted;
         ++added;
       }

@@ -132,6 +132,7 @@ TEST_F(RunDirectory, ACheckpointOfAnotherRunIsRefusedNamingBothIds) {
   fs::copy_file(at("b") / sph::kCheckpointFile, at("a") / sph::kCheckpointFile, fs::copy_options::overwrite_existing);
   const auto before = files(at("a"));
   expect_refused(sph({"run", "--resume", "a", "--steps", "20"}), {"run.json: names run " + run_a, run_b});
+  EXPECT_EQ(files(at("a")), before) << "a refused resume changes nothing";
   // With run.json copied too, summary.json still belongs to run a.
   fs::copy_file(at("b") / "run.json", at("a") / "run.json", fs::copy_options::overwrite_existing);
   expect_refused(sph({"run", "--resume", "a", "--steps", "20"}),
@@ -146,7 +147,6 @@ TEST_F(RunDirectory, ACheckpointOfAnotherRunIsRefusedNamingBothIds) {
   fs::remove(at("a") / "summary.json");
   expect_refused(sph({"run", "--resume", "a", "--steps", "20"}), {"scene.json: holds another scene (fingerprint"});
   EXPECT_FALSE(fs::exists(at("a") / "summary.json"));
-  (void)before;
 }
 
 TEST_F(RunDirectory, ANewRunDoesNotDeleteAnUnfinishedRunsCheckpointWithoutOverwrite) {

@@ -20,10 +20,12 @@
 #include <sph/io/atomic_file.h>
 #include <sph/io/frame_format.h>
 #include <sph/io/frames.h>
+#include <sph/io/run_directory.h>
 #include <sph/render/frame_image.h>
 #include <sph/render/png.h>
 #include <sph/render/video.h>
 
+#include "cli_checks.h"
 #include "commands.h"
 #include "progress.h"
 
@@ -35,7 +37,7 @@ namespace fs = std::filesystem;
 
 struct RenderCliOptions {
   std::string dir;
-  std::string output;
+  std::optional<std::string> output;  // -o DIR (given empty: refused)
   std::string color_by = "speed";
   std::string colormap;
   std::string range;
@@ -107,15 +109,13 @@ std::vector<std::size_t> parse_frames(const std::string& s, std::size_t count) {
 }
 
 /// Creates `dir` if needed, checks that it is writable and removes the images and movie of an
-/// earlier render, so that two renders are never mixed.
+/// earlier render (only the files a render makes: is_render_output), so that two renders are
+/// never mixed and a user's other files there are kept.
 void prepare_render_directory(const fs::path& dir) {
   make_writable_directory(dir, "the images");
   std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    const std::string f = entry.path().filename().string();
-    if ((f.rfind("frame_", 0) == 0 && entry.path().extension() == ".png") || f == "movie.mp4")
-      fs::remove(entry.path(), ec);
-  }
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (is_render_output(entry.path().filename().string()) && !entry.is_directory(ec)) fs::remove(entry.path(), ec);
 }
 
 int render(const RenderCliOptions& opt) {
@@ -133,6 +133,8 @@ int render(const RenderCliOptions& opt) {
     throw Error(fmt::format("unknown frame format \"{}\"; expected {}", opt.format, frame_format_list("", " or ")),
                 "--format");
   if (opt.no_png && !opt.mp4) throw Error("--no-png leaves nothing to write; give --mp4 with it", "--no-png");
+  if (opt.output) check_output_path(*opt.output, "-o/--output");
+  if (opt.mp4 && !video_encoder_available()) throw Error(kVideoEncoderMissing, "--mp4");
   if (opt.threads > 0) set_num_threads(opt.threads);
 
   std::vector<RunDirectory> runs;
@@ -164,7 +166,7 @@ int render(const RenderCliOptions& opt) {
   if (!color_by_is_scalar(*by))
     for (const RunDirectory& r : runs) particle_colors(read_frame(r.frames[frames.front()]), style.color, r);
 
-  const fs::path out = opt.output.empty() ? fs::path(opt.dir) / "render" : fs::path(opt.output);
+  const fs::path out = opt.output ? fs::path(*opt.output) : fs::path(opt.dir) / "render";
   prepare_render_directory(out);
   std::unique_ptr<VideoWriter> video;
   Stopwatch wall;
@@ -225,7 +227,8 @@ std::function<int()> add_render_command(CLI::App& app) {
   cmd->add_option("dir", opt->dir, "A run's output directory (sph run -o DIR) or a comparison's (sph compare -o DIR)")
       ->required();
   cmd->add_option("-o,--output", opt->output,
-                  "Directory for the images and movie (default: DIR/render); earlier images there are replaced");
+                  "Directory for the images and movie (default: DIR/render); the images and movie of an earlier "
+                  "render there (frame_NNNNNN.png, movie.mp4) are replaced, other files are kept");
   cmd->add_option("--color-by", opt->color_by,
                   "Color particles by speed, kinetic_energy, density, pressure or initial_position")
       ->default_str("speed");

@@ -15,6 +15,7 @@
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 #include <sph/io/checkpoint.h>
+#include <sph/io/run_directory.h>
 #include <sph/io/run_output.h>
 #include <sph/neighbors/neighbor_mode.h>
 #include <sph/run/driver.h>
@@ -23,6 +24,7 @@
 #include <sph/scene/dispatch.h>
 #include <sph/scene/scene_reader.h>
 
+#include "cli_checks.h"
 #include "commands.h"
 #include "progress.h"
 
@@ -32,13 +34,14 @@ namespace {
 
 struct RunOptions {
   std::string scene;
-  std::string output;
+  std::optional<std::string> output;  // -o DIR (given empty: refused)
   std::string neighbors;
   std::int64_t steps = 0;
   int threads = 0;
   std::vector<std::string> sets;
   bool no_progress = false;
   bool audit = false;
+  bool overwrite = false;
   std::int64_t checkpoint_every = 0;
   std::string resume;
   std::optional<std::string> formats;  // --format vtu,ply
@@ -137,9 +140,10 @@ class StopSignals {
   struct sigaction old_int_ = {}, old_term_ = {};
 };
 
-/// The lines of the closing message that say where the frames are.
-std::string frames_hint(const OutputDesc& output, const std::filesystem::path& dir) {
+/// The lines of the closing message that say where the frames are (none if none were written).
+std::string frames_hint(const OutputDesc& output, const std::filesystem::path& dir, std::size_t frames) {
   std::string s;
+  if (frames == 0) return s;
   for (FrameFormat f : output.formats) {
     const FrameFormatDesc& d = frame_format_desc(f);
     s += fmt::format("  {}/{} {}\n", dir.string(), d.look_at, d.hint);
@@ -162,7 +166,7 @@ void print_done(const RunDriver<D, R>& run, const RunResult& result, bool audit)
              ran, run.simulation().particles().size(), result.wall_seconds,
              1e3 * result.wall_seconds / static_cast<double>(std::max<std::int64_t>(ran, 1)),
              result.first_step > 0 ? "The run now has" : "Wrote", out.frames_written(),
-             frames_hint(run.scene().output, dir), dir.string(), dir.string(),
+             frames_hint(run.scene().output, dir, out.frames_written()), dir.string(), dir.string(),
              out.frames_written() > 0
                  ? fmt::format("  look at it: sph render {0} --mp4 (PNG frames, a movie); sph view {0} (a web page)\n",
                                shell_word(dir.string()))
@@ -232,7 +236,8 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesyste
 /// `sph run --resume DIR`: continues the run whose checkpoint is in DIR.
 int resume(RunOptions opt) {
   const char* conflict = !opt.scene.empty()       ? "a SCENE file"
-                         : !opt.output.empty()    ? "-o/--output"
+                         : opt.output             ? "-o/--output"
+                         : opt.overwrite          ? "--overwrite"
                          : !opt.sets.empty()      ? "--set"
                          : !opt.neighbors.empty() ? "--neighbors"
                          : opt.audit              ? "--audit"
@@ -257,6 +262,7 @@ int resume(RunOptions opt) {
 
 int run(const RunOptions& opt) {
   if (!opt.resume.empty()) return resume(opt);
+  if (opt.output) check_output_path(*opt.output, "-o/--output");
   if (opt.scene.empty())
     throw Error(
         "sph run needs a scene file: sph run SCENE.json (or --resume DIR to continue a run); see sph run --help");
@@ -270,7 +276,13 @@ int run(const RunOptions& opt) {
   desc.set_audit(opt.audit);
   for (const auto& w : desc.warnings) fmt::print(stderr, "sph: warning: {}\n", w);
   const std::filesystem::path dir =
-      opt.output.empty() ? std::filesystem::path("out") / desc.name : std::filesystem::path(opt.output);
+      opt.output ? std::filesystem::path(*opt.output) : std::filesystem::path("out") / desc.name;
+  if (!opt.overwrite)
+    if (const std::optional<std::string> unfinished = unfinished_run(dir))
+      throw Error(fmt::format("holds {}; continue it with sph run --resume {}, or give --overwrite to delete it "
+                              "(with the run's frames, stats and summary) and start this run there",
+                              *unfinished, shell_word(dir.string())),
+                  dir.string());
   return dispatch(desc, [&]<int D, class R>() { return run_scene<D, R>(desc, opt, dir, nullptr); });
 }
 
@@ -305,7 +317,7 @@ std::function<int()> add_run_command(CLI::App& app) {
   cmd->add_option("--fps", opt->fps,
                   "F frames per simulated second (frame k at the first step whose time reaches k / F), overriding "
                   "Configuration.outputFps and outputEveryNSteps")
-      ->check(CLI::PositiveNumber)
+      ->check(positive_number("a frame rate in frames per simulated second"))
       ->type_name("F");
   cmd->add_flag("--audit", opt->audit,
                 "Check the lists every step against exact lists and record the pairs within h they miss "
@@ -322,6 +334,10 @@ std::function<int()> add_run_command(CLI::App& app) {
                   "only --steps (a new total), --threads, --checkpoint-every and --no-progress may be given with it "
                   "(the frame settings are the run's)")
       ->type_name("DIR");
+  cmd->add_flag("--overwrite", opt->overwrite,
+                "Start the run even if the output directory holds an unfinished run's checkpoint (interrupted, "
+                "killed or failed), deleting it with that run's frames, stats.csv, summary.json, scene.json and "
+                "run.json (without it such a directory is refused; a finished run's files are always replaced)");
   cmd->add_flag("--no-progress", opt->no_progress,
                 "No progress output (default: a bar with ETA on a terminal, a line every 10 % otherwise)");
   return [opt, cmd]() -> int {

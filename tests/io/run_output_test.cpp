@@ -127,12 +127,14 @@ TEST(RunOutput, WritesFramesStatsAndSummary) {
   EXPECT_EQ(entries(dir / "frames"),
             (std::vector<std::string>{"frame_000000.vtu", "frame_000001.vtu", "frame_000002.vtu", "frame_000003.vtu"}));
   EXPECT_EQ(entries(dir.path()),
-            (std::vector<std::string>{"frames", "frames.pvd", "scene.json", "stats.csv", "summary.json"}));
+            (std::vector<std::string>{"frames", "frames.pvd", "run.json", "scene.json", "stats.csv", "summary.json"}));
   EXPECT_TRUE(parse_scene(slurp(dir / "scene.json"), desc.source) == desc) << "scene.json is the run's scene";
   const auto rows = lines(slurp(dir / "stats.csv"));
   ASSERT_EQ(rows.size(), 6u);
   EXPECT_EQ(rows[0], kStatsColumns);
-  for (int i = 0; i < 5; ++i) EXPECT_EQ(rows[static_cast<std::size_t>(i) + 1].substr(0, 2), std::to_string(i) + ",");
+  // step: the steps done after the row's step (1 to 5), as summary.json's steps counts them
+  for (int i = 0; i < 5; ++i)
+    EXPECT_EQ(rows[static_cast<std::size_t>(i) + 1].substr(0, 2), std::to_string(i + 1) + ",");
   const auto j = nlohmann::json::parse(slurp(dir / "summary.json"));
   EXPECT_EQ(j["status"], "completed");
   EXPECT_EQ(j["steps"], 5);
@@ -157,7 +159,7 @@ TEST(RunOutput, UnfinishedRunStillLeavesItsStats) {
   EXPECT_EQ(rows.size(), 4u);
   EXPECT_FALSE(fs::exists(dir / "summary.json"));
   EXPECT_FALSE(fs::exists(dir / "frames.pvd"));
-  EXPECT_EQ(entries(dir.path()), (std::vector<std::string>{"frames", "scene.json", "stats.csv"}));
+  EXPECT_EQ(entries(dir.path()), (std::vector<std::string>{"frames", "run.json", "scene.json", "stats.csv"}));
 }
 
 }  // namespace

@@ -156,7 +156,7 @@ def check_run(out, *, what, dim, precision, steps, every, dt, expected_particles
         step = int(r["step"])
         t = float(r["time"])
         n = int(r["particles"])
-        check(step == i, f"{what}: stats.csv row {i} has step {step}")
+        check(step == i + 1, f"{what}: stats.csv row {i} has step {step}, expected the steps done {i + 1}")
         check(math.isclose(t, (i + 1) * dt, rel_tol=1e-8), f"{what}: stats.csv step {i} time {t} != {(i + 1) * dt}")
         check(n == expected_particles(i + 1), f"{what}: stats.csv step {i} particles {n} != {expected_particles(i + 1)}")
         mn = float(r["mean_neighbors"])

@@ -60,7 +60,9 @@ std::vector<std::string> stats_rows(const fs::path& file) {
 /// resume history, the checkpoint step).
 nlohmann::json summary_facts(const fs::path& dir) {
   nlohmann::json s = nlohmann::json::parse(slurp(dir / "summary.json"));
-  for (const char* k : {"wall_seconds", "phase_seconds", "resumed_at_steps", "last_checkpoint_step"}) s.erase(k);
+  // (run_id: each run has its own; the resumed run keeps the id of the run it continues)
+  for (const char* k : {"wall_seconds", "phase_seconds", "resumed_at_steps", "last_checkpoint_step", "run_id"})
+    s.erase(k);
   return s;
 }
 

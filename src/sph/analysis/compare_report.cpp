@@ -195,6 +195,7 @@ std::string report_speed(const CompareResult& res) {
       "per step | pairs stored per particle |\n";
   md += "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
   for (const RunRecord& r : res.runs) {
+    const bool is_ref = &r == &ref;  // its ratio to itself is 1 by definition: say what it is instead
     const double total = r.totals.total();
     const double n = static_cast<double>(std::max<std::size_t>(1, r.steps.size()));
     double per_particle = 0;
@@ -204,15 +205,17 @@ std::string report_speed(const CompareResult& res) {
     for (const auto& s : r.steps)
       rebuilt_frac += s.particles ? static_cast<double>(s.lists_rebuilt) / static_cast<double>(s.particles) : 0;
     md += fmt::format(
-        "| {}{} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {}x | {:.1f} % | {:.1f} |\n", r.label,
+        "| {}{} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {} | {:.1f} % | {:.1f} |\n", r.label,
         r.failure.empty() ? "" : " (failed)", total, 1e3 * total / n, r.totals.grid, r.totals.lists, r.totals.density,
-        r.totals.forces, r.totals.integrate, fmt_ratio(total > 0 ? ref_total / total : kNaN), 100.0 * rebuilt_frac / n,
-        per_particle / n);
+        r.totals.forces, r.totals.integrate,
+        is_ref ? std::string("reference") : fmt_ratio(total > 0 ? ref_total / total : kNaN) + "x",
+        100.0 * rebuilt_frac / n, per_particle / n);
   }
   md +=
       "\nPhase columns are seconds over the whole run. \"speed vs standard\" is the standard run's total\n"
-      "time divided by this run's. The perturbed standard run repeats the standard algorithm: its\n"
-      "ratio shows how much timings vary between two runs of the same work.\n\n";
+      "time divided by this run's; the standard run is the reference the others are measured against.\n"
+      "The perturbed standard run repeats the standard algorithm: its ratio shows how much timings\n"
+      "vary between two runs of the same work.\n\n";
   return md;
 }
 
@@ -248,7 +251,8 @@ std::string report_accuracy(const CompareResult& res) {
   const double ke_ref = ref.steps.empty() ? kNaN : ref.steps.back().kinetic_energy;
   for (const RunRecord& r : res.runs) {
     const double ke = r.steps.empty() ? kNaN : r.steps.back().kinetic_energy;
-    md += fmt::format("| {} | {:.6g} | {} |\n", r.label, ke, fmt_ratio(ke / ke_ref));
+    md += fmt::format("| {} | {:.6g} | {} |\n", r.label, ke,
+                      &r == &ref ? std::string("reference") : fmt_ratio(ke / ke_ref));
   }
   return md;
 }

@@ -42,6 +42,8 @@ void write_checkpoint(const fs::path& dir, const SceneDesc& desc, const Simulati
   w.put(desc.source);
   w.put(static_cast<std::uint8_t>(sim.params().audit));
   w.put(checkpoint_every);
+  w.put(output.identity().run_id);
+  w.put(output.identity().scene_fingerprint);
   sim.save_state(w);
   output.save_state(w, sim, wall_seconds);
 
@@ -121,10 +123,13 @@ CheckpointReader::CheckpointReader(fs::path file) : file_(std::move(file)) {
   reader_->get(header_.scene_source);
   header_.audit = reader_->get<std::uint8_t>() != 0;
   reader_->get(header_.checkpoint_every);
+  reader_->get(header_.identity.run_id);
+  reader_->get(header_.identity.scene_fingerprint);
   reader_->expect(header_.dimension == 2 || header_.dimension == 3, "a dimension other than 2 or 3");
   reader_->expect(precision <= 1, "an unknown precision");
   reader_->expect(header_.step >= 0, "a negative step");
   reader_->expect(header_.checkpoint_every >= 0, "a negative checkpoint interval");
+  reader_->expect(!header_.identity.run_id.empty(), "no run id");
   header_.precision = precision == 0 ? Precision::Float : Precision::Double;
 }
 

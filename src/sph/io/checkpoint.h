@@ -5,7 +5,8 @@
 /// Layout (docs/reliability.md):
 ///   header   8 bytes "SPHCKPT" + NUL, u32 format version, u32 byte-order mark 0x01020304
 ///   payload  written by StateWriter: sph version, dimension, precision, step, the effective
-///            scene (JSON text) and its file name, the audit flag, --checkpoint-every, Simulation::save_state,
+///            scene (JSON text) and its file name, the audit flag, --checkpoint-every, the run id
+///            and the scene fingerprint (RunIdentity), Simulation::save_state,
 ///            RunOutput::save_state
 ///   trailer  u64 payload length, u64 payload checksum (Checksum), 8 bytes "SPHCKEND"
 /// The file is written under a temporary name, synced to disk and renamed over the previous
@@ -23,11 +24,12 @@
 
 namespace sph {
 
-/// The format version this build writes and reads. Version 3 stores the particle fields by
+/// The format version this build writes and reads. Version 4 records the run's identity (run id
+/// and scene fingerprint) after --checkpoint-every. Version 3 stores the particle fields by
 /// name and kind, in kParticleFields order, then the fields a run added (ParticleSet::save);
 /// version 2 kept the frames' times and the schedule's next tick instead of version 1's .vtu
 /// file list.
-inline constexpr std::uint32_t kCheckpointVersion = 3;
+inline constexpr std::uint32_t kCheckpointVersion = 4;
 /// The checkpoint's file name in a run's output directory.
 inline constexpr const char* kCheckpointFile = "checkpoint.sphc";
 
@@ -50,6 +52,7 @@ struct CheckpointHeader {
   std::string scene_source;           ///< the scene file the run started from
   bool audit = false;                 ///< the run audits its lists (sph run --audit)
   std::int64_t checkpoint_every = 0;  ///< the run's --checkpoint-every (0: none)
+  RunIdentity identity;               ///< the run that wrote it (run.json, summary.json)
 };
 
 /// An open checkpoint. The constructor refuses, with an sph::Error naming the file and what is

@@ -1,13 +1,21 @@
 #include <sph/io/run_directory.h>
 
 #include <algorithm>
+#include <chrono>
+#include <ctime>
 #include <fstream>
 #include <map>
+#include <random>
+#include <sstream>
+
+#include <unistd.h>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include <sph/core/error.h>
 #include <sph/io/atomic_file.h>
+#include <sph/io/checkpoint.h>
 #include <sph/io/frame_source.h>
 #include <sph/neighbors/strategy.h>
 #include <sph/scene/scene_reader.h>
@@ -29,6 +37,10 @@ std::optional<std::uint64_t> frame_number(const std::string& name, const std::st
 }
 
 }  // namespace
+
+bool is_render_output(const std::string& file_name) {
+  return file_name == "movie.mp4" || frame_number(file_name, "png").has_value();
+}
 
 std::vector<fs::path> list_frames(const fs::path& dir, FrameFormat format) {
   const std::string ext = frame_format_name(format);
@@ -153,6 +165,116 @@ std::vector<fs::path> run_directories(const fs::path& dir) {
     runs.push_back(dir / name);
   }
   return runs;
+}
+
+// --- Run identity --------------------------------------------------------------------------
+
+std::string new_run_id() {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y%m%dT%H%M%SZ", &utc);
+  static std::mt19937 rng{std::random_device{}()};
+  static std::uint32_t counter = 0;  // two ids of one process in one second still differ
+  return fmt::format("{}-{}-{:08x}", stamp, ::getpid(), static_cast<std::uint32_t>(rng()) ^ counter++);
+}
+
+std::string scene_fingerprint(const std::string& scene_json) {
+  nlohmann::json doc = nlohmann::json::parse(scene_json);  // keys sorted: one text per scene
+  if (doc.is_object() && doc.contains("Configuration") && doc["Configuration"].is_object())
+    doc["Configuration"].erase("numberOfSteps");
+  std::uint64_t h = 14695981039346656037ull;  // FNV-1a 64
+  for (const char c : doc.dump()) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  return fmt::format("{:016x}", h);
+}
+
+void write_run_identity(const fs::path& dir, const RunIdentity& id) {
+  nlohmann::ordered_json j;
+  j["run_id"] = id.run_id;
+  j["scene_fingerprint"] = id.scene_fingerprint;
+  write_file_atomic(dir / kRunIdentityFile, j.dump(2) + "\n");
+}
+
+namespace {
+
+/// DIR/NAME parsed as a JSON object, or nullopt if the file is not there. Throws sph::Error
+/// naming the file if it is not a JSON object.
+std::optional<nlohmann::json> read_json_object(const fs::path& file) {
+  std::error_code ec;
+  if (!fs::exists(file, ec)) return std::nullopt;
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  nlohmann::json j = nlohmann::json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
+  if (!in || !j.is_object())
+    throw Error("cannot be read as a JSON object; expected the file sph run wrote", file.string());
+  return j;
+}
+
+/// The string at `key` of `j`, or "" if it is not there or not a string.
+std::string string_at(const nlohmann::json& j, const char* key) {
+  const auto it = j.find(key);
+  return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
+}
+
+}  // namespace
+
+void check_run_identity(const fs::path& dir, const RunIdentity& checkpoint) {
+  const auto refuse = [&](const fs::path& file, const std::string& what) {
+    throw Error(fmt::format("{}; the checkpoint belongs to run {}: it was copied from another run's directory, or "
+                            "this directory was reused. Resume it in its own directory, or start a new run with "
+                            "sph run SCENE -o DIR",
+                            what, checkpoint.run_id),
+                file.string());
+  };
+  const fs::path run_file = dir / kRunIdentityFile;
+  const std::optional<nlohmann::json> run = read_json_object(run_file);
+  if (!run) refuse(run_file, "missing: nothing says which run this directory holds");
+  if (const std::string id = string_at(*run, "run_id"); id != checkpoint.run_id)
+    refuse(run_file, fmt::format("names run {}", id.empty() ? "(none)" : id));
+  const fs::path summary_file = dir / "summary.json";
+  if (const std::optional<nlohmann::json> summary = read_json_object(summary_file)) {
+    if (const std::string id = string_at(*summary, "run_id"); id != checkpoint.run_id)
+      refuse(summary_file, fmt::format("is the summary of run {}", id.empty() ? "(none: an older sph's run)" : id));
+  }
+  const fs::path scene_file = dir / "scene.json";
+  std::error_code ec;
+  if (fs::is_regular_file(scene_file, ec)) {
+    std::string fingerprint;
+    try {
+      fingerprint = scene_fingerprint(read_scene_text(scene_file.string()));
+    } catch (const std::exception&) {
+      refuse(scene_file, "is not a scene this sph wrote");
+    }
+    if (fingerprint != checkpoint.scene_fingerprint)
+      refuse(scene_file, fmt::format("holds another scene (fingerprint {}, the checkpoint's is {})", fingerprint,
+                                     checkpoint.scene_fingerprint));
+  }
+}
+
+std::optional<RunEnd> read_run_end(const fs::path& dir) {
+  const fs::path file = dir / "summary.json";
+  const std::optional<nlohmann::json> j = read_json_object(file);
+  if (!j) return std::nullopt;
+  const auto steps = j->find("steps");
+  if (string_at(*j, "status").empty() || steps == j->end() || !steps->is_number_integer())
+    throw Error("has no status or steps; expected the summary sph run wrote", file.string());
+  return RunEnd{string_at(*j, "status"), steps->get<std::int64_t>()};
+}
+
+std::optional<std::string> unfinished_run(const fs::path& dir) {
+  std::error_code ec;
+  if (!fs::exists(dir / kCheckpointFile, ec)) return std::nullopt;
+  std::optional<RunEnd> end;
+  try {
+    end = read_run_end(dir);
+  } catch (const Error&) {
+    return "the checkpoint of a run whose summary.json is unreadable";
+  }
+  if (!end) return "the checkpoint of a run that did not finish (no summary.json: it was killed, or is still running)";
+  if (end->finished()) return std::nullopt;
+  return fmt::format("the checkpoint of a run that did not finish (summary.json: {})", end->status);
 }
 
 }  // namespace sph

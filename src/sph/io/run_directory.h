@@ -5,6 +5,7 @@
 /// finds them.
 
 #include <array>
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -63,5 +64,61 @@ void write_run_list(const std::filesystem::path& dir, const std::vector<std::str
 /// order `sph compare` ran them, standard first). Throws sph::Error naming `dir` if it is
 /// neither, or naming runs.txt if it is malformed or lists a directory that is not a run.
 std::vector<std::filesystem::path> run_directories(const std::filesystem::path& dir);
+
+/// True for the names of the files `sph render` makes in its output directory:
+/// frame_NNNNNN.png (6 to 12 digits) and movie.mp4. A render removes only these (and a new run
+/// removes only these from DIR/render), never a user's other files.
+bool is_render_output(const std::string& file_name);
+
+// --- Run identity --------------------------------------------------------------------------
+
+/// The file of a run directory that names the run that owns it (docs/reliability.md, "Run
+/// directories"): a JSON object {"run_id": ..., "scene_fingerprint": ...}, written when the run
+/// starts and kept when it is resumed. scene.json stays a plain scene (sph run reads it), so its
+/// identity lives beside it; summary.json and the checkpoint record the same two values.
+inline constexpr const char* kRunIdentityFile = "run.json";
+
+/// Who a run is: made once when a new run starts, kept by every session that resumes it.
+struct RunIdentity {
+  /// "YYYYMMDDTHHMMSSZ-PID-RRRRRRRR": the start time (UTC), the process id and 32 random bits.
+  std::string run_id;
+  /// scene_fingerprint() of the run's effective scene.
+  std::string scene_fingerprint;
+};
+
+/// A new run id (see RunIdentity::run_id); two calls never give the same id.
+std::string new_run_id();
+
+/// The fingerprint of an effective scene (scene_text(desc)): 16 hex digits of the FNV-1a 64-bit
+/// hash of its JSON, keys sorted, without Configuration.numberOfSteps (which `--resume --steps`
+/// changes within one run). Two scenes that would run the same way give the same fingerprint.
+std::string scene_fingerprint(const std::string& scene_json);
+
+/// Writes DIR/run.json (atomically). Throws sph::Error naming the path.
+void write_run_identity(const std::filesystem::path& dir, const RunIdentity& id);
+
+/// For `sph run --resume DIR`: checks that the files of DIR belong to the run of the checkpoint
+/// (identity `checkpoint`): run.json and summary.json name its run id, and scene.json (if there)
+/// has its scene fingerprint. Throws sph::Error naming the file and both ids otherwise (a
+/// checkpoint copied into another run's directory), or if run.json is missing or unreadable.
+void check_run_identity(const std::filesystem::path& dir, const RunIdentity& checkpoint);
+
+/// What DIR/summary.json says about a run that ended, if it is there.
+struct RunEnd {
+  std::string status;      ///< "completed", "completed with warnings: ...", "interrupted by ...", "failed: ..."
+  std::int64_t steps = 0;  ///< steps done
+  /// The run did all its steps (status "completed" or "completed with warnings..."): it is
+  /// finished, and only a larger --steps continues it.
+  bool finished() const { return status.rfind("completed", 0) == 0; }
+};
+
+/// DIR/summary.json's status and steps; nullopt if there is no summary.json. Throws sph::Error
+/// naming the file if it is not a summary (not JSON, no status or steps).
+std::optional<RunEnd> read_run_end(const std::filesystem::path& dir);
+
+/// If DIR holds the checkpoint of a run that has not finished (interrupted, killed or failed: no
+/// summary.json saying it completed), a description of it such as "an interrupted run's
+/// checkpoint (at step 40; interrupted by SIGINT after step 40 of 100)"; else nullopt.
+std::optional<std::string> unfinished_run(const std::filesystem::path& dir);
 
 }  // namespace sph

@@ -43,6 +43,17 @@ void remove_stale_temporaries(const fs::path& dir) {
   }
 }
 
+/// Removes the pictures `sph render` and `sph view` made of an earlier run in `dir`
+/// (render/frame_NNNNNN.png, render/movie.mp4, render/ itself once empty, view.html), so that
+/// they never sit beside a new run's frames. Other files are left alone.
+void remove_pictures(const fs::path& dir) {
+  std::error_code ec;
+  fs::remove(dir / "view.html", ec);
+  for (const auto& entry : fs::directory_iterator(dir / "render", ec))
+    if (is_render_output(entry.path().filename().string())) fs::remove(entry.path(), ec);
+  if (fs::is_empty(dir / "render", ec)) fs::remove(dir / "render", ec);
+}
+
 }  // namespace
 
 void prepare_resume_directory(const fs::path& dir) {
@@ -61,8 +72,9 @@ void prepare_output_directory(const fs::path& dir) {
   remove_stale_temporaries(dir);
   remove_stale_temporaries(dir / "frames");
   // Remove what a previous run left, so that frames of two runs are never mixed.
-  for (const char* name : {"frames.pvd", "stats.csv", "summary.json", "scene.json", "checkpoint.sphc"})
+  for (const char* name : {"frames.pvd", "stats.csv", "summary.json", "scene.json", "checkpoint.sphc", "run.json"})
     fs::remove(dir / name, ec);
+  remove_pictures(dir);
   for (const auto& entry : fs::directory_iterator(dir / "frames", ec)) {
     const std::string f = entry.path().filename().string();
     const std::string ext = entry.path().extension().string();
@@ -71,12 +83,14 @@ void prepare_output_directory(const fs::path& dir) {
 }
 
 template <int D, std::floating_point R>
-RunOutput<D, R>::RunOutput(fs::path dir, const SceneDesc& desc, RunInfo info)
+RunOutput<D, R>::RunOutput(fs::path dir, const SceneDesc& desc, RunInfo info, std::string run_id)
     : dir_(std::move(dir)),
       desc_(desc),
       info_(std::move(info)),
       frames_(dir_, desc.output),
-      stats_tmp_(dir_ / ".stats.csv.partial") {}
+      stats_tmp_(dir_ / ".stats.csv.partial") {
+  identity_ = {run_id.empty() ? new_run_id() : std::move(run_id), scene_fingerprint(scene_text(desc))};
+}
 
 template <int D, std::floating_point R>
 void RunOutput<D, R>::open_stats() {
@@ -99,13 +113,15 @@ void RunOutput<D, R>::begin(const Simulation<D, R>& sim) {
   Stopwatch w;
   open_stats();
   write_file_atomic(dir_ / "scene.json", scene_text(desc_) + "\n");
+  write_run_identity(dir_, identity_);
   frames_.write_due(sim, false);  // frame 0, if the run writes frames
   output_seconds_ += w.lap();
 }
 
 namespace {
 
-/// The complete rows of a stats file whose step (first column) is below `steps`, and their count.
+/// The complete rows of a stats file whose step (first column: steps done) is at most `steps`,
+/// and their count.
 std::pair<std::string, std::int64_t> stats_rows_before(const fs::path& file, std::int64_t steps) {
   std::ifstream in(file);
   std::string line, rows;
@@ -117,7 +133,7 @@ std::pair<std::string, std::int64_t> stats_rows_before(const fs::path& file, std
     const std::string row = all.substr(begin, end - begin + 1);  // only whole lines
     std::int64_t step = -1;
     std::istringstream(row.substr(0, row.find(','))) >> step;
-    if (step != count || step >= steps) break;  // rows are consecutive steps from 0
+    if (step != count + 1 || step > steps) break;  // rows are consecutive steps from 1
     rows += row;
     ++count;
   }
@@ -143,6 +159,7 @@ std::string RunOutput<D, R>::resume(const Simulation<D, R>& sim, StateReader& in
   const std::int64_t steps = sim.steps_done();
   resumed_at_.push_back(steps);
   write_file_atomic(dir_ / "scene.json", scene_text(desc_) + "\n");
+  write_run_identity(dir_, identity_);
   std::error_code ec;
   fs::remove(dir_ / "summary.json", ec);
 
@@ -160,7 +177,7 @@ std::string RunOutput<D, R>::resume(const Simulation<D, R>& sim, StateReader& in
     return fmt::format(
         "stats.csv held only the first {} of the {} steps before the checkpoint; the rows of "
         "steps {} to {} are missing from it",
-        count, steps, count, steps - 1);
+        count, steps, count + 1, steps);
   return {};
 }
 
@@ -193,7 +210,7 @@ double RunOutput<D, R>::after_step(const Simulation<D, R>& sim, const StepInfo& 
                                                        info.audit.particles_missing, info.audit.max_penetration)
                                          : std::string(",,");
   stats_ << fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.6g},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n",
-                        info.step, info.time, info.particles, sim.kinetic_energy(), sim.max_speed(), mean_neighbors,
+                        info.step + 1, info.time, info.particles, sim.kinetic_energy(), sim.max_speed(), mean_neighbors,
                         info.neighbors.lists_rebuilt, info.neighbors.pairs_stored, info.pairs_within_h, audit,
                         info.seconds.grid, info.seconds.lists, info.seconds.density, info.seconds.forces,
                         info.seconds.integrate, t_output);
@@ -218,6 +235,8 @@ void RunOutput<D, R>::finish(const Simulation<D, R>& sim, const std::string& sta
 
   nlohmann::ordered_json s;
   s["sph_version"] = kVersion;
+  s["run_id"] = identity_.run_id;
+  s["scene_fingerprint"] = identity_.scene_fingerprint;
   s["status"] = status;
   s["scene"] = desc_.name;
   s["scene_file"] = desc_.source;

@@ -8,6 +8,7 @@
 ///   DIR/stats.csv              one row per step (see kStatsColumns)
 ///   DIR/summary.json           written at the end: scene, mode, steps, timings, status
 ///   DIR/scene.json             the effective scene (after --set overrides)
+///   DIR/run.json               the run's id and scene fingerprint (run_directory.h, RunIdentity)
 ///   DIR/checkpoint.sphc        the latest checkpoint (see checkpoint.h), if one was written
 /// Every file appears whole or not at all.
 
@@ -18,13 +19,16 @@
 #include <vector>
 
 #include <sph/io/frame_writer.h>
+#include <sph/io/run_directory.h>
 #include <sph/io/vtk.h>
 #include <sph/scene/scene_desc.h>
 #include <sph/solver/simulation.h>
 
 namespace sph {
 
-/// Header of stats.csv (README.md, "What a run writes", explains each column). The three audit columns
+/// Header of stats.csv (README.md, "What a run writes", explains each column). `step` is the
+/// number of steps done after the row's step (1 for the first row, numberOfSteps for the last),
+/// as summary.json's "steps" and --steps count them; `time` is the simulated time then. The three audit columns
 /// (missed_pairs, particles_missing, max_missed_penetration) are empty unless the run audits.
 inline constexpr const char* kStatsColumns =
     "step,time,particles,kinetic_energy,max_speed,mean_neighbors,lists_rebuilt,pairs_stored,pairs_within_h,"
@@ -37,7 +41,8 @@ struct RunInfo {
 };
 
 /// Creates `dir` if needed and checks that files can be created in it; removes the files a
-/// previous run left there (frames, stats, summary). Throws sph::Error naming the path.
+/// previous run left there (frames, stats, summary, run.json, and the pictures of `sph render`
+/// and `sph view`: render/frame_NNNNNN.png, render/movie.mp4, view.html). Throws sph::Error naming the path.
 void prepare_output_directory(const std::filesystem::path& dir);
 
 /// For a resumed run: checks that `dir` is a directory where files can be created, and
@@ -48,8 +53,9 @@ void prepare_resume_directory(const std::filesystem::path& dir);
 template <int D, std::floating_point R>
 class RunOutput {
  public:
-  /// `dir` must have been prepared with prepare_output_directory.
-  RunOutput(std::filesystem::path dir, const SceneDesc& desc, RunInfo info);
+  /// `dir` must have been prepared with prepare_output_directory. `run_id`: the id of the run
+  /// continued (from its checkpoint), or empty for a new run (a new_run_id()).
+  RunOutput(std::filesystem::path dir, const SceneDesc& desc, RunInfo info, std::string run_id = {});
   ~RunOutput();
 
   /// Writes frame 0 (the initial state) and scene.json, and starts stats.csv.
@@ -75,6 +81,8 @@ class RunOutput {
   void finish(const Simulation<D, R>& sim, const std::string& status, double wall_seconds);
 
   std::size_t frames_written() const { return frames_.frames_written(); }
+  /// The run's id and scene fingerprint, as run.json, summary.json and checkpoints record them.
+  const RunIdentity& identity() const { return identity_; }
   /// Audit totals over the steps so far: missed pairs summed, deepest penetration (zero
   /// without auditing).
   const ListAudit& audit_totals() const { return audit_; }
@@ -87,6 +95,7 @@ class RunOutput {
   std::filesystem::path dir_;
   const SceneDesc& desc_;
   RunInfo info_;
+  RunIdentity identity_;
   FrameWriter<D, R> frames_;
   std::ofstream stats_;
   std::filesystem::path stats_tmp_;

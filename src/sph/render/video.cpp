@@ -92,10 +92,7 @@ VideoWriter::VideoWriter(fs::path path, int width, int height, double fps)
       even_height_(height + height % 2) {
   if (width < 1 || height < 1) throw Error(fmt::format("video size {} x {} must be positive", width, height));
   if (!(fps > 0 && fps <= 1000)) throw Error(fmt::format("video frame rate {} is out of range (0, 1000]", fps));
-  if (!video_encoder_available())
-    throw Error(
-        "making an MP4 needs ffmpeg with its H.264 encoder (libx264), which was not found on PATH; install it "
-        "with `apt-get install ffmpeg` (bash scripts/setup.sh does), or leave out --mp4");
+  if (!video_encoder_available()) throw Error(kVideoEncoderMissing);
   {
     std::ofstream probe(log_);
     if (!probe) throw Error("cannot create a file in this directory (is it writable?)", log_.parent_path().string());

@@ -18,6 +18,12 @@ namespace sph {
 /// True if an `ffmpeg` program that can encode H.264 (libx264) runs.
 bool video_encoder_available();
 
+/// The message for a missing encoder (VideoWriter throws it; `sph render --mp4` checks
+/// video_encoder_available() before it writes any image).
+inline constexpr const char* kVideoEncoderMissing =
+    "making an MP4 needs ffmpeg with its H.264 encoder (libx264), which was not found on PATH; install it with "
+    "`apt-get install ffmpeg` (bash scripts/setup.sh does), or leave out --mp4";
+
 /// Writes images as the frames of an MP4 file, by piping raw RGB to ffmpeg from a thread of its
 /// own, so that the caller renders the next frames while ffmpeg encodes. The movie appears
 /// at `path` only when finish() succeeds (it is encoded under a temporary name and renamed);

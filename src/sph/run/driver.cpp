@@ -55,7 +55,7 @@ RunDriver<D, R>::RunDriver(SceneDesc desc, CheckpointReader& checkpoint, RunSett
       resumed_(true) {
   SPH_CHECK(!settings_.dir.empty(), "RunDriver: a resumed run needs its directory");
   prepare_resume_directory(settings_.dir);
-  output_ = std::make_unique<RunOutput<D, R>>(settings_.dir, desc_, info_);
+  output_ = std::make_unique<RunOutput<D, R>>(settings_.dir, desc_, info_, checkpoint.header().identity.run_id);
   wall_ = Stopwatch();
   resume_warning_ = checkpoint.restore(sim_, *output_);
   first_step_ = sim_.steps_done();
@@ -102,7 +102,9 @@ RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver
                      fmt::format("interrupted by {} after step {} of {}", cause, sim_.steps_done(), steps));
         }
       }
-      if (settings_.checkpoint_every > 0 && (sim_.steps_done() % settings_.checkpoint_every == 0 || last))
+      // A resumed run also checkpoints its last step, so that its checkpoint is never behind its end.
+      if ((settings_.checkpoint_every > 0 && (sim_.steps_done() % settings_.checkpoint_every == 0 || last)) ||
+          (resumed_ && last))
         write_checkpoint(settings_.dir, desc_, sim_, *output_, wall_.elapsed(), settings_.checkpoint_every);
     }
   } catch (const Error& e) {

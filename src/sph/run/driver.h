@@ -38,8 +38,9 @@ struct RunSettings {
   /// The run's output directory (frames, stats.csv, summary.json, scene.json, checkpoints);
   /// empty: the run writes nothing.
   std::filesystem::path dir;
-  /// A checkpoint every N steps and at the last step (0: only on a stop request). Recorded in
-  /// the checkpoint, so that a resumed run goes on as often. Needs `dir`.
+  /// A checkpoint every N steps and at the last step (0: only on a stop request, and at the last
+  /// step of a resumed run). Recorded in the checkpoint, so that a resumed run goes on as often.
+  /// Needs `dir`.
   std::int64_t checkpoint_every = 0;
 };
 

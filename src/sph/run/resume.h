@@ -28,9 +28,11 @@ struct RunToResume {
 
 /// Opens the checkpoint of the run in `dir` and reads its scene; `steps` > 0 is the new total
 /// of steps (0: the run's own). Refuses with sph::Error naming the path: a missing directory or
-/// checkpoint, a damaged checkpoint (CheckpointReader), a run that has already done all its steps
-/// (or `steps` not beyond the checkpoint), and a checkpoint whose dimension or precision differs
-/// from its scene's. Touches nothing in `dir`.
+/// checkpoint, a damaged checkpoint (CheckpointReader), a checkpoint of another run than the
+/// directory's files (check_run_identity), a run that has already done all its steps (or `steps`
+/// not beyond the checkpoint; for a finished run, per its summary.json, a plain resume or `steps`
+/// not beyond the steps it did: never dropping frames or stats rows), and a checkpoint whose
+/// dimension or precision differs from its scene's. Touches nothing in `dir`.
 RunToResume open_run_to_resume(const std::filesystem::path& dir, std::int64_t steps = 0);
 
 }  // namespace sph

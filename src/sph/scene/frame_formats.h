@@ -25,7 +25,7 @@ struct FrameFormatDesc {
 /// Every format, in the order frames are looked for in a run directory (vtu, vtk, ply).
 inline constexpr FrameFormatDesc kFrameFormats[] = {
     {FrameFormat::Vtu, "vtu", "ParaView", "frames.pvd  ",
-     "open in ParaView (Filters > Point Gaussian to see particles)"},
+     "open in ParaView (Representation: Point Gaussian to see particles)"},
     {FrameFormat::Vtk, "vtk", "legacy VTK", "frames/*.vtk", "legacy VTK frames (ParaView, VisIt, meshio)"},
     {FrameFormat::Ply, "ply", "Blender, Houdini", "frames/*.ply",
      "point clouds (Blender: File > Import > Stanford PLY; Houdini: File node)"},

@@ -21,7 +21,43 @@ std::string describe(const json& j) {
   return std::string(j.type_name()) + " " + text;
 }
 
+namespace {
+
+/// "LINE:COLUMN" (1-based) of byte `at` of `text`.
+std::string line_column(const std::string& text, std::size_t at) {
+  std::size_t line = 1, col = 1;
+  for (std::size_t k = 0; k < at && k < text.size(); ++k) {
+    if (text[k] == '\n')
+      ++line, col = 1;
+    else
+      ++col;
+  }
+  return fmt::format("{}:{}", line, col);
+}
+
+/// Refuses text that is not UTF-8, naming the encoding it looks like.
+void check_utf8(const std::string& text, const std::string& source) {
+  const auto byte = [&](std::size_t k) { return k < text.size() ? static_cast<unsigned char>(text[k]) : 0x100u; };
+  if ((byte(0) == 0xFF && byte(1) == 0xFE) || (byte(0) == 0xFE && byte(1) == 0xFF))
+    throw Error("the scene file is UTF-16 (it starts with a UTF-16 byte-order mark); save it as UTF-8", source);
+  if (byte(0) == 0 && byte(1) == 0 && byte(2) == 0xFE && byte(3) == 0xFF)
+    throw Error("the scene file is UTF-32 (it starts with a UTF-32 byte-order mark); save it as UTF-8", source);
+  if (const std::size_t nul = text.find('\0'); nul != std::string::npos)
+    throw Error(fmt::format("the scene file holds NUL bytes (the first at line {}), as UTF-16 text does; save it as "
+                            "UTF-8",
+                            line_column(text, nul)),
+                source);
+  if (const std::size_t bad = invalid_utf8_at(text); bad != std::string::npos)
+    throw Error(fmt::format("the scene file is not UTF-8 text: byte 0x{:02X} at line {} is not valid UTF-8 (is it "
+                            "Latin-1 or Windows-1252?); save it as UTF-8",
+                            static_cast<unsigned char>(text[bad]), line_column(text, bad)),
+                source);
+}
+
+}  // namespace
+
 json parse_json(const std::string& text, const std::string& source) {
+  check_utf8(text, source);
   if (text.find_first_not_of(" \t\r\n") == std::string::npos)
     throw Error("the scene file is empty; expected a JSON object (see docs/scene-format.md)", source);
   // Duplicate keys would silently keep the last value: refuse them.

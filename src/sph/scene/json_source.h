@@ -14,7 +14,9 @@ namespace sph::detail {
 /// value of 20,000 levels did).
 inline constexpr int kMaxJsonDepth = 64;
 
-/// Parses a scene's JSON text. Throws sph::Error for empty text, syntax errors (where:
+/// Parses a scene's JSON text. Throws sph::Error for text that is not UTF-8 (a UTF-16 or UTF-32
+/// byte-order mark, NUL bytes, bytes of another encoding such as Latin-1, each named as such
+/// with the advice to save the file as UTF-8), empty text, syntax errors (where:
 /// "SOURCE:LINE:COLUMN"), duplicate keys in one object, nesting deeper than kMaxJsonDepth and
 /// numbers out of a double's range.
 nlohmann::json parse_json(const std::string& text, const std::string& source);

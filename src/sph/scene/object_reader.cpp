@@ -17,7 +17,7 @@ void ReadContext::fail(const std::string& path, const std::string& message) cons
       break;
     }
   if (!path.empty()) where += ": " + path;
-  throw Error(message, where);
+  throw Error(message + note, where);
 }
 
 ObjectReader::ObjectReader(const json& j, std::string path, const ReadContext& ctx,
@@ -54,6 +54,7 @@ double ObjectReader::number(const json& v, const std::string& key, const std::st
 
 double ObjectReader::positive(const std::string& key, const std::string& what, std::optional<double> def,
                               bool allow_zero) {
+  check_file_value(key, [&](ObjectReader& r) { r.positive(key, what, def, allow_zero); });
   const json* v = find(key);
   if (!v) {
     if (def) return *def;
@@ -66,6 +67,7 @@ double ObjectReader::positive(const std::string& key, const std::string& what, s
 
 std::int64_t ObjectReader::integer(const std::string& key, const std::string& what, std::int64_t min, std::int64_t max,
                                    std::optional<std::int64_t> def) {
+  check_file_value(key, [&](ObjectReader& r) { r.integer(key, what, min, max, def); });
   const json* v = find(key);
   if (!v) {
     if (def) return *def;
@@ -80,6 +82,7 @@ std::int64_t ObjectReader::integer(const std::string& key, const std::string& wh
 }
 
 std::string ObjectReader::string(const std::string& key, const std::string& what, std::optional<std::string> def) {
+  check_file_value(key, [&](ObjectReader& r) { r.string(key, what, def); });
   const json* v = find(key);
   if (!v) {
     if (def) return *def;
@@ -101,6 +104,7 @@ std::string quoted_list(const std::vector<std::string>& choices) {
 std::string ObjectReader::choice(const std::string& key, const std::vector<std::string>& choices,
                                  const std::string& def) {
   const std::string list = quoted_list(choices);
+  check_file_value(key, [&](ObjectReader& r) { r.choice(key, choices, def); });
   const std::string s = string(key, "one of " + list, def);
   if (std::find(choices.begin(), choices.end(), s) == choices.end())
     ctx_.fail(child(key), "unknown value \"" + s + "\"; expected one of " + list);
@@ -110,6 +114,7 @@ std::string ObjectReader::choice(const std::string& key, const std::vector<std::
 std::optional<std::vector<std::string>> ObjectReader::string_set(const std::string& key,
                                                                  const std::vector<std::string>& choices,
                                                                  const std::string& what) {
+  check_file_value(key, [&](ObjectReader& r) { r.string_set(key, choices, what); });
   const json* v = find(key);
   if (!v) return std::nullopt;
   const std::string list = quoted_list(choices);

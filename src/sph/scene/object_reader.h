@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -21,6 +22,11 @@ namespace sph::detail {
 struct ReadContext {
   std::string source;
   std::set<std::string> overridden;
+  /// The scene file's own values at overridden paths (apply_overrides' `replaced`): each is
+  /// checked as the reader checks the key, before the flag's value is read.
+  std::map<std::string, nlohmann::json> replaced;
+  /// Appended to every message (set for the check of a replaced value).
+  std::string note;
 
   /// Throws sph::Error(message) whose where() names the source, the --set flag that gave the
   /// value (if `path` is, or is within or around, an overridden path) and `path`.
@@ -58,6 +64,7 @@ class ObjectReader {
 
   template <int D>
   Vec<D, double> vec(const std::string& key, const std::string& what, std::optional<Vec<D, double>> def = {}) {
+    check_file_value(key, [&](ObjectReader& r) { r.vec<D>(key, what, def); });
     const json* v = find(key);
     const std::string expect = fmt::format("{} as an array of {} numbers", what, D);
     if (!v) {
@@ -75,6 +82,21 @@ class ObjectReader {
     }
     return out;
   }
+  /// If a flag replaced the scene file's own value at `key` (ReadContext::replaced), reads that
+  /// value with `read` (the same check as the flag's value gets): a bad value in the file is
+  /// refused even when a flag overrides it, naming the file's value.
+  template <class F>
+  void check_file_value(const std::string& key, F&& read) const {
+    const auto it = ctx_.replaced.find(child(key));
+    if (it == ctx_.replaced.end()) return;
+    ReadContext file;
+    file.source = ctx_.source;
+    file.note = " (the value in the scene file, which a flag overrides; it must be valid too)";
+    const json one = {{key, it->second}};
+    ObjectReader r(one, path_, file, {key});
+    read(r);
+  }
+
   /// An optional array of objects; calls f(reader, index) for each.
   template <class F>
   void array_of_objects(const std::string& key, const std::vector<std::string>& keys, F&& f) {

@@ -84,7 +84,8 @@ json& walk(json& doc, const std::vector<std::string>& parts, const std::string& 
 
 }  // namespace
 
-std::set<std::string> apply_overrides(json& doc, const std::vector<std::string>& overrides) {
+std::set<std::string> apply_overrides(json& doc, const std::vector<std::string>& overrides,
+                                      std::map<std::string, json>* replaced) {
   std::set<std::string> overridden;
   for (const std::string& o : overrides) {
     // JSON text is UTF-8: a key or a plain-string value with other bytes could never be written
@@ -102,6 +103,7 @@ std::set<std::string> apply_overrides(json& doc, const std::vector<std::string>&
     std::string path;
     json& node = walk(doc, parts, key, path);
     if (parts.empty()) throw Error("empty key path", "--set");
+    if (replaced && !node.is_null() && !overridden.count(path)) replaced->emplace(path, node);
     node = std::move(value);
     overridden.insert(path);
   }

@@ -1,6 +1,7 @@
 #pragma once
 /// \file --set overrides: "KEY.PATH=VALUE" strings applied to a scene's JSON before it is read.
 
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -11,10 +12,13 @@ namespace sph::detail {
 
 /// Applies "a.b[2].c=VALUE" overrides to `doc` in order; VALUE is JSON if it parses as JSON,
 /// else a string. A missing object on the path is created; a missing array element is an error.
-/// Returns the key paths set (as "a.b[2].c"). Throws sph::Error (where: "--set" or "--set KEY")
+/// Returns the key paths set (as "a.b[2].c"); `replaced` (if given) receives, for each path
+/// whose value the document had before its first override, that value (so that the reader can
+/// check the file's own value too). Throws sph::Error (where: "--set" or "--set KEY")
 /// for text that is not UTF-8, no "=", an empty or malformed path, a path through a value of
 /// another type, an index out of range, a number out of range and nesting deeper than
 /// kMaxJsonDepth.
-std::set<std::string> apply_overrides(nlohmann::json& doc, const std::vector<std::string>& overrides);
+std::set<std::string> apply_overrides(nlohmann::json& doc, const std::vector<std::string>& overrides,
+                                      std::map<std::string, nlohmann::json>* replaced = nullptr);
 
 }  // namespace sph::detail

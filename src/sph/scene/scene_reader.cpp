@@ -139,11 +139,13 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
                 1'000'000'000, sim.full_rebuild_period));
   sim.verlet_skin = c.positive("verletSkin", "a positive verlet skin in metres (default 0.1 h)",
                                kDefaultSkinFraction * sim.kernel_radius);
-  if (sim.verlet_skin > 2.0 * sim.kernel_radius)
+  // Only the verlet mode uses the skin; in the other modes it is read (positive) and has no effect.
+  if (sim.neighbors == NeighborMode::Verlet && sim.verlet_skin > 2.0 * sim.kernel_radius)
     c.ctx().fail(c.child("verletSkin"),
                  fmt::format("a skin of {:g} m is more than twice h = {:g} m: lists would hold over 27 times the "
-                             "pairs needed in 3D; expected a skin between 0.05 h and 0.5 h",
-                             sim.verlet_skin, sim.kernel_radius));
+                             "pairs needed in 3D; expected a skin above 0 and at most 2 h = {:g} m (typical: 0.05 h "
+                             "to 0.5 h)",
+                             sim.verlet_skin, sim.kernel_radius, 2.0 * sim.kernel_radius));
 }
 
 /// Configuration.numberOfSteps or stopAt (an end time, turned into steps of dt), and the output
@@ -420,7 +422,9 @@ SceneDesc parse_scene(const std::string& text, const std::string& source, const 
   json doc = detail::parse_json(text, source);
   if (!doc.is_object())
     throw Error("expected a JSON object { ... } at the top level, got " + detail::describe(doc), source);
-  const detail::ReadContext ctx{source, detail::apply_overrides(doc, overrides)};
+  detail::ReadContext ctx;
+  ctx.source = source;
+  ctx.overridden = detail::apply_overrides(doc, overrides, &ctx.replaced);
   SceneDesc desc;
   desc.source = source;
   ObjectReader root(doc, "", ctx, detail::kRootKeys);
@@ -440,14 +444,30 @@ SceneDesc parse_scene(const std::string& text, const std::string& source, const 
 }
 
 std::string read_scene_text(const std::string& path) {
+  namespace fs = std::filesystem;
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw Error("is a directory; expected a scene file (.json)", path);
+  if (fs::is_directory(path, ec)) throw Error("is a directory; expected a scene file (.json)", path);
+  const fs::file_status st = fs::status(path, ec);
+  if (!ec && fs::exists(st) && !fs::is_regular_file(st))
+    throw Error("is not a regular file (a device, FIFO or socket); expected a scene file (.json)", path);
+  const auto too_large = [&] {
+    return Error(fmt::format("the scene file is larger than {} MiB; a scene is a few kB of JSON (is this the right "
+                             "file?)",
+                             kMaxSceneBytes >> 20),
+                 path);
+  };
+  if (fs::is_regular_file(st) && fs::file_size(path, ec) > kMaxSceneBytes && !ec) throw too_large();
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error("cannot open the scene file (does it exist and is it readable?)", path);
-  std::ostringstream ss;
-  ss << in.rdbuf();
+  // Read in blocks up to the limit: a file that grows while it is read is refused too.
+  std::string text;
+  std::vector<char> block(std::size_t{1} << 16);
+  while (in.read(block.data(), static_cast<std::streamsize>(block.size())) || in.gcount() > 0) {
+    text.append(block.data(), static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxSceneBytes) throw too_large();
+  }
   if (in.bad()) throw Error("cannot read the scene file", path);
-  return ss.str();
+  return text;
 }
 
 SceneDesc read_scene_file(const std::string& path, const std::vector<std::string>& overrides) {

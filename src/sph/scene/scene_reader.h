@@ -1,6 +1,7 @@
 #pragma once
 /// \file Strict reader of JSON scene files (format: docs/scene-format.md).
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -14,8 +15,12 @@ namespace sph {
 /// is expected (unknown keys, wrong types, missing or impossible values).
 SceneDesc read_scene_file(const std::string& path, const std::vector<std::string>& overrides = {});
 
-/// Reads a scene file's text; throws sph::Error naming the path if it is missing, a directory
-/// or unreadable.
+/// The largest scene file read_scene_text reads (64 MiB; a scene is a few kB of JSON).
+inline constexpr std::size_t kMaxSceneBytes = std::size_t{64} << 20;
+
+/// Reads a scene file's text; throws sph::Error naming the path if it is missing, a directory,
+/// not a regular file (a device such as /dev/zero, a FIFO, a socket), larger than
+/// kMaxSceneBytes or unreadable.
 std::string read_scene_text(const std::string& path);
 
 /// Same as read_scene_file for scene text held in memory; `source` names it in messages.

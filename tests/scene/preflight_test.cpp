@@ -42,6 +42,9 @@ json base_scene() {
 json emitter_scene() {
   json j = base_scene();
   j["FluidBlocks"][0] = json::parse(R"({ "start": [0.6, 0], "end": [0.8, 0.2] })");
+  // Walls that stop the 20 m/s jet within two radii (softer ones draw the defaults' warning).
+  j["Container"]["wallStiffness"] = 2e6;
+  j["Container"]["wallDamping"] = 500;
   j["Emitters"] = json::parse(
       R"([ { "translation": [0.05, 0.5], "direction": [1, 0], "velocity": 20.0, "width": 4, "maxParticles": 4 } ])");
   return j;

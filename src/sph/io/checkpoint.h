@@ -23,11 +23,12 @@
 
 namespace sph {
 
-/// The format version this build writes and reads. Version 3 stores the particle fields by
+/// The format version this build writes and reads. Version 4 adds the health monitor's state
+/// (HealthMonitor::save_state) after the neighbor strategy's; version 3 stores the particle fields by
 /// name and kind, in kParticleFields order, then the fields a run added (ParticleSet::save);
 /// version 2 kept the frames' times and the schedule's next tick instead of version 1's .vtu
 /// file list.
-inline constexpr std::uint32_t kCheckpointVersion = 3;
+inline constexpr std::uint32_t kCheckpointVersion = 4;
 /// The checkpoint's file name in a run's output directory.
 inline constexpr const char* kCheckpointFile = "checkpoint.sphc";
 

@@ -330,8 +330,8 @@ std::function<int()> add_run_command(CLI::App& app) {
       ->type_name("N");
   cmd->add_option("--resume", opt->resume,
                   "Continue the run in DIR from its checkpoint, bitwise identically to a run never interrupted; "
-                  "only --steps (a new total), --threads, --checkpoint-every, --strict and --no-progress may be given with it "
-                  "(the frame settings are the run's)")
+                  "only --steps (a new total), --threads, --checkpoint-every, --strict and --no-progress may be given "
+                  "with it (the frame settings are the run's)")
       ->type_name("DIR");
   cmd->add_flag("--no-progress", opt->no_progress,
                 "No progress output (default: a bar with ETA on a terminal, a line every 10 % otherwise)");

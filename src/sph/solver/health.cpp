@@ -102,18 +102,20 @@ void HealthMonitor::check(HealthStats& st, std::int64_t step, double time, std::
 
   // Supersonic first: it is the cause of most of what follows.
   if (st.max_mach > watch(HealthKind::Mach).fail)
-    fail(fmt::format("simulation went supersonic {}: particle id {} moves at {:.4g} m/s, Mach {:.3g} (sound "
-                     "speed sqrt(Fluid.stiffness) = {:.4g} m/s); {}, or lower Configuration.timeStepSize (now {:.3g} s)",
-                     at(), st.mach_id, top_speed, st.max_mach, s.sound_speed, speed_advice(s, top_speed), s.time_step));
+    fail(
+        fmt::format("simulation went supersonic {}: particle id {} moves at {:.4g} m/s, Mach {:.3g} (sound "
+                    "speed sqrt(Fluid.stiffness) = {:.4g} m/s); {}, or lower Configuration.timeStepSize (now {:.3g} s)",
+                    at(), st.mach_id, top_speed, st.max_mach, s.sound_speed, speed_advice(s, top_speed), s.time_step));
   const auto contained = [&](HealthKind kind, std::uint64_t count, double depth, std::uint64_t id, double speed,
                              const char* where) {
     const double fraction = static_cast<double>(count) / n;
     if (fraction > watch(kind).fail || depth > h)
-      fail(fmt::format("simulation lost its fluid {}: {} of {} particles are {} (more than {} % of them, or one "
-                       "deeper than h = {:.3g} m); the deepest, particle id {}, is {:.3g} m past the wall at "
-                       "{:.3g} m/s; {}",
-                       at(), count, particles, where, 100.0 * watch(kind).fail, h, id, depth, speed,
-                       wall_advice(s, std::max(top_speed, speed))));
+      fail(
+          fmt::format("simulation lost its fluid {}: {} of {} particles are {} (more than {} % of them, or one "
+                      "deeper than h = {:.3g} m); the deepest, particle id {}, is {:.3g} m past the wall at "
+                      "{:.3g} m/s; {}",
+                      at(), count, particles, where, 100.0 * watch(kind).fail, h, id, depth, speed,
+                      wall_advice(s, std::max(top_speed, speed))));
     if (count > 0 && fraction > watch(kind).warn)
       warn(st, kind,
            fmt::format("{} particles {} {} (the deepest, particle id {}, {:.3g} m past the wall at {:.3g} m/s); {}",
@@ -132,10 +134,11 @@ void HealthMonitor::check(HealthStats& st, std::int64_t step, double time, std::
 
   const double stiff_for_1pct = s.stiffness * (st.rho_max - 1.0) / 0.01;
   if (st.rho_max > watch(HealthKind::Compression).fail)
-    fail(fmt::format("simulation collapsed {}: particle id {} is compressed to {:.3g} times the rest density; "
-                     "Fluid.stiffness >= {:.3g} (now {:.3g}) keeps the compression near 1 %, or lower "
-                     "Configuration.timeStepSize (now {:.3g} s)",
-                     at(), st.rho_max_id, st.rho_max, stiff_for_1pct, s.stiffness, s.time_step));
+    fail(
+        fmt::format("simulation collapsed {}: particle id {} is compressed to {:.3g} times the rest density; "
+                    "Fluid.stiffness >= {:.3g} (now {:.3g}) keeps the compression near 1 %, or lower "
+                    "Configuration.timeStepSize (now {:.3g} s)",
+                    at(), st.rho_max_id, st.rho_max, stiff_for_1pct, s.stiffness, s.time_step));
   if (st.rho_max > watch(HealthKind::Compression).warn)
     warn(st, HealthKind::Compression,
          fmt::format("density {:.3g} times the rest density {} (particle id {}); Fluid.stiffness >= {:.3g} (now "
@@ -151,14 +154,15 @@ void HealthMonitor::check(HealthStats& st, std::int64_t step, double time, std::
     const double growth = (st.energy - initial_energy_) / energy_scale();
     const auto advice = [&] {
       return fmt::format(
-        "a closed, damped scene cannot gain energy: lower Configuration.timeStepSize (now {:.3g} s, e.g. to "
-        "{:.3g} s) or raise Fluid.viscosity (now {:.3g}; Monaghan's alpha = 0.1 is about {:.3g})",
+          "a closed, damped scene cannot gain energy: lower Configuration.timeStepSize (now {:.3g} s, e.g. to "
+          "{:.3g} s) or raise Fluid.viscosity (now {:.3g}; Monaghan's alpha = 0.1 is about {:.3g})",
           s.time_step, 0.5 * s.time_step, s.viscosity, suggested_viscosity(s));
     };
     if (growth > watch(HealthKind::Energy).fail)
-      fail(fmt::format("simulation gained energy {}: total energy {:.4g} J is {:.3g} times its scale above the "
-                       "initial {:.4g} J; {}",
-                       at(), st.energy, growth, initial_energy_, advice()));
+      fail(
+          fmt::format("simulation gained energy {}: total energy {:.4g} J is {:.3g} times its scale above the "
+                      "initial {:.4g} J; {}",
+                      at(), st.energy, growth, initial_energy_, advice()));
     if (growth > watch(HealthKind::Energy).warn)
       warn(st, HealthKind::Energy,
            fmt::format("total energy {:.4g} J {} is {:.1f} % of its scale above the initial {:.4g} J; {}", st.energy,

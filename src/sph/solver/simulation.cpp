@@ -53,7 +53,6 @@ double chunked_sum(std::size_t n, std::vector<double>& partial, F&& term) {
   return s;
 }
 
-
 /// Measures one particle for the health statistics (after its motion): containment, speed,
 /// density ratio, and its energy, kinetic + gravity (from the container's lowest point along g)
 /// + the wall springs it compresses (the penetrations of WallContact, ks pen^2 / 2 per kg); and,
@@ -95,7 +94,8 @@ class HealthProbe {
     }
     const double ratio = static_cast<double>(rho) / p_.fluid.rest_density;
     if constexpr (kInternal)
-      if (ratio > 1 || (tension_ && ratio > 0)) c.internal += md * p_.fluid.stiffness * (std::log(ratio) + 1 / ratio - 1);
+      if (ratio > 1 || (tension_ && ratio > 0))
+        c.internal += md * p_.fluid.stiffness * (std::log(ratio) + 1 / ratio - 1);
     if (rho > m * w0_) {  // a neighbour within h added to its own contribution
       if (ratio < c.rho_min) c.rho_min = ratio, c.rho_min_i = i;
       if (ratio > c.rho_max) c.rho_max = ratio, c.rho_max_i = i;
@@ -282,14 +282,17 @@ HealthStats Simulation<D, R>::reduce_health() const {
     if (better(c.inside_depth, c.inside_i, all.inside_depth, all.inside_i, true))
       all.inside_depth = c.inside_depth, all.inside_i = c.inside_i;
     if (better(c.v2, c.v_i, all.v2, all.v_i, true)) all.v2 = c.v2, all.v_i = c.v_i;
-    if (better(c.rho_min, c.rho_min_i, all.rho_min, all.rho_min_i, false)) all.rho_min = c.rho_min, all.rho_min_i = c.rho_min_i;
-    if (better(c.rho_max, c.rho_max_i, all.rho_max, all.rho_max_i, true)) all.rho_max = c.rho_max, all.rho_max_i = c.rho_max_i;
+    if (better(c.rho_min, c.rho_min_i, all.rho_min, all.rho_min_i, false))
+      all.rho_min = c.rho_min, all.rho_min_i = c.rho_min_i;
+    if (better(c.rho_max, c.rho_max_i, all.rho_max, all.rho_max_i, true))
+      all.rho_max = c.rho_max, all.rho_max_i = c.rho_max_i;
   }
   const auto speed = [&](std::size_t i) { return std::sqrt(static_cast<double>(norm2(particles_.velocity[i]))); };
   HealthStats s;
   s.outside = all.outside, s.inside_solid = all.inside, s.energy = all.energy;
   if (all.outside_i != detail::HealthChunk::npos)
-    s.outside_depth = all.outside_depth, s.outside_id = particles_.id[all.outside_i], s.outside_speed = speed(all.outside_i);
+    s.outside_depth = all.outside_depth, s.outside_id = particles_.id[all.outside_i],
+    s.outside_speed = speed(all.outside_i);
   if (all.inside_i != detail::HealthChunk::npos)
     s.inside_depth = all.inside_depth, s.inside_id = particles_.id[all.inside_i], s.inside_speed = speed(all.inside_i);
   const double c0 = std::sqrt(std::max(params_.fluid.stiffness, 0.0));

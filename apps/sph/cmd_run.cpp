@@ -42,6 +42,7 @@ struct RunOptions {
   bool no_progress = false;
   bool audit = false;
   bool overwrite = false;
+  bool strict = false;
   std::int64_t checkpoint_every = 0;
   std::string resume;
   std::optional<std::string> formats;  // --format vtu,ply
@@ -184,7 +185,7 @@ void print_done(const RunDriver<D, R>& run, const RunResult& result, bool audit)
 template <int D, std::floating_point R>
 int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesystem::path& dir,
               CheckpointReader* checkpoint) {
-  const RunSettings settings{dir, opt.checkpoint_every};
+  const RunSettings settings{dir, opt.checkpoint_every, opt.strict};
   std::optional<RunDriver<D, R>> run;
   if (checkpoint)
     run.emplace(desc, *checkpoint, settings);
@@ -199,12 +200,14 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesyste
              info.threads == 1 ? "" : "s", sim.particles().size(),
              sim.params().emitters.empty() ? "" : " (emitters add more)", desc.steps, sim.params().time_step,
              checkpoint ? fmt::format(", resumed at step {}", first) : std::string(), dir.string());
-  Progress progress(
-      desc.steps - first,
-      opt.no_progress ? Progress::Mode::Off : (::isatty(STDERR_FILENO) ? Progress::Mode::Bar : Progress::Mode::Lines),
-      stderr);
+  const Progress::Mode mode =
+      opt.no_progress ? Progress::Mode::Off : (::isatty(STDERR_FILENO) ? Progress::Mode::Bar : Progress::Mode::Lines);
+  Progress progress(desc.steps - first, mode, stderr);
   RunCallbacks callbacks;
   callbacks.progress = [&](std::int64_t done, std::size_t particles) { progress.update(done - first, particles); };
+  callbacks.warning = [&](const std::string& w) {
+    fmt::print(stderr, "{}sph: warning: {}\n", mode == Progress::Mode::Bar ? "\n" : "", w);
+  };
   callbacks.stop_requested = [](std::int64_t) -> std::string {
     const int sig = g_stop_signal;
     return sig == 0 ? "" : sig == SIGINT ? "SIGINT" : "SIGTERM";
@@ -230,6 +233,11 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesyste
       break;
   }
   print_done(*run, result, opt.audit);
+  if (!result.warnings.empty())
+    fmt::print(stderr,
+               "sph: completed with {} health warning{} (above, and in {}/summary.json); the results may not be "
+               "trustworthy (--strict makes warnings failures)\n",
+               result.warnings.size(), result.warnings.size() == 1 ? "" : "s", dir.string());
   return kOk;
 }
 
@@ -323,6 +331,9 @@ std::function<int()> add_run_command(CLI::App& app) {
                 "Check the lists every step against exact lists and record the pairs within h they miss "
                 "(stats.csv columns missed_pairs, particles_missing, max_missed_penetration; costs about one "
                 "extra standard list build per step)");
+  cmd->add_flag("--strict", opt->strict,
+                "Health warnings (particles outside the container, Mach above 0.3, density 30 % above rest, energy "
+                "growing; docs/reliability.md) fail the run: exit 1, status \"failed: ... (--strict)\"");
   cmd->add_option("--checkpoint-every", opt->checkpoint_every,
                   "Write DIR/checkpoint.sphc every N steps and at the last step (the latest replaces the "
                   "previous, atomically). Ctrl-C or SIGTERM always writes one: the run finishes its step, "
@@ -331,8 +342,8 @@ std::function<int()> add_run_command(CLI::App& app) {
       ->type_name("N");
   cmd->add_option("--resume", opt->resume,
                   "Continue the run in DIR from its checkpoint, bitwise identically to a run never interrupted; "
-                  "only --steps (a new total), --threads, --checkpoint-every and --no-progress may be given with it "
-                  "(the frame settings are the run's)")
+                  "only --steps (a new total), --threads, --checkpoint-every, --strict and --no-progress may be given "
+                  "with it (the frame settings are the run's)")
       ->type_name("DIR");
   cmd->add_flag("--overwrite", opt->overwrite,
                 "Start the run even if the output directory holds an unfinished run's checkpoint (interrupted, "

@@ -63,7 +63,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "sph: Smoothed Particle Hydrodynamics fluids in 2D and 3D with adaptive neighbor pairing.\n\n"
       "  sph run SCENE.json [-o DIR] [--neighbors standard|adaptive|verlet] [--steps N] [--threads N]\n"
-      "                     [--set KEY=VALUE]... [--checkpoint-every N]   run a scene (sph run --help)\n"
+      "                     [--set KEY=VALUE]... [--checkpoint-every N] [--strict]   run a scene (sph run --help);\n"
+      "                     health warnings end it \"completed with warnings\" (--strict: failed, exit 1)\n"
       "  sph run --resume DIR [--steps N]   continue an interrupted run from its checkpoint (or a\n"
       "                     finished one further: --steps above the steps it did)\n"
       "  sph compare SCENE.json [-o DIR] [--modes standard,adaptive,verlet] [--steps N]\n"

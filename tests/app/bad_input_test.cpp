@@ -90,20 +90,22 @@ TEST(BadInputThroughTheProgram, AParticleCountBeyondTheMachinesMemoryIsRefusedBe
 }
 
 TEST(BlowUp, StopsInTheStepNamingStepParticleAndQuantityAndKeepsTheFrames) {
-  // 30 km/s: far beyond the scene's blow-up limit (20 sound speeds plus free fall).
+  // 30 km/s: 750 times the sound speed sqrt(1600) = 40 m/s. The health monitor fails a supersonic
+  // step (Mach above 1), which replaced the old blow-up limit of 20 sound speeds plus free fall.
   TempDir tmp;
   const CommandResult r = sph::test::run_sph(
       {"run", kDamBreak, "--set", "FluidBlocks[0].velocity=[30000,0]", "--steps", "50", "--no-progress", "-o", "o"},
       tmp.path(), tmp / "e.txt");
   EXPECT_EQ(r.code, 1) << r.err;
-  EXPECT_CONTAINS(r.err, "blew up at step 0");
-  EXPECT_CONTAINS(r.err, "particle id 0");
-  EXPECT_CONTAINS(r.err, "exceeds the blow-up limit");
+  EXPECT_CONTAINS(r.err, "went supersonic at step 0");
+  EXPECT_CONTAINS(r.err, "particle id ");
+  EXPECT_CONTAINS(r.err, "Mach 750");
+  EXPECT_CONTAINS(r.err, "Fluid.stiffness >= (10 v)^2");
   EXPECT_CONTAINS(r.err, "frames written before the failure are kept");
   EXPECT_TRUE(fs::is_regular_file(tmp / "o" / "frames" / "frame_000000.vtu"));
   EXPECT_TRUE(fs::is_regular_file(tmp / "o" / "stats.csv"));
   const auto summary = nlohmann::json::parse(slurp(tmp / "o" / "summary.json"));
-  EXPECT_CONTAINS(summary.at("status").get<std::string>(), "failed: simulation blew up at step 0");
+  EXPECT_CONTAINS(summary.at("status").get<std::string>(), "failed: simulation went supersonic at step 0");
 }
 
 }  // namespace

@@ -25,7 +25,8 @@
 namespace sph {
 
 /// The format version this build writes and reads. Version 4 records the run's identity (run id
-/// and scene fingerprint) after --checkpoint-every. Version 3 stores the particle fields by
+/// and scene fingerprint) after --checkpoint-every, and the health monitor's state
+/// (HealthMonitor::save_state) after the neighbor strategy's. Version 3 stores the particle fields by
 /// name and kind, in kParticleFields order, then the fields a run added (ParticleSet::save);
 /// version 2 kept the frames' times and the schedule's next tick instead of version 1's .vtu
 /// file list.

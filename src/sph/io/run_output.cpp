@@ -209,17 +209,21 @@ double RunOutput<D, R>::after_step(const Simulation<D, R>& sim, const StepInfo& 
   const std::string audit = info.audited ? fmt::format("{},{},{:.6g}", info.audit.missed_pairs,
                                                        info.audit.particles_missing, info.audit.max_penetration)
                                          : std::string(",,");
-  stats_ << fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.6g},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n",
+  stats_ << fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.6g},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}",
                         info.step + 1, info.time, info.particles, sim.kinetic_energy(), sim.max_speed(), mean_neighbors,
                         info.neighbors.lists_rebuilt, info.neighbors.pairs_stored, info.pairs_within_h, audit,
                         info.seconds.grid, info.seconds.lists, info.seconds.density, info.seconds.forces,
                         info.seconds.integrate, t_output);
+  const HealthStats& h = info.health;
+  stats_ << fmt::format(",{},{:.6g},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g}", h.outside, h.outside_depth, h.inside_solid,
+                        h.inside_depth, h.max_mach, h.rho_min, h.rho_max, h.energy);
   if (info.audited) {
     audit_.missed_pairs += info.audit.missed_pairs;
     audit_.max_penetration = std::max(audit_.max_penetration, info.audit.max_penetration);
     audit_steps_with_misses_ += info.audit.missed_pairs > 0 ? 1 : 0;
   }
   totals_lists_rebuilt_ += info.neighbors.lists_rebuilt;
+  stats_ << '\n';
   if (last || wrote) stats_.flush();
   return t_output;
 }
@@ -269,6 +273,18 @@ void RunOutput<D, R>::finish(const Simulation<D, R>& sim, const std::string& sta
                   {"max_missed_penetration", audit_.max_penetration}};
   s["kinetic_energy"] = sim.kinetic_energy();
   s["max_speed"] = sim.max_speed();
+  // The health monitor (docs/reliability.md, "Health monitor"): warnings in the order given,
+  // the steps each kind's condition held, and the extremes of the run.
+  const HealthMonitor& health = sim.health();
+  s["warnings"] = health.warnings();
+  nlohmann::ordered_json counts;
+  for (const HealthWatch& w : kHealthWatches) counts[w.name] = health.counts()[static_cast<std::size_t>(w.kind)];
+  s["warning_counts"] = counts;
+  s["health"] = {{"max_mach", health.max_mach()},
+                 {"rho_min", health.rho_min()},
+                 {"rho_max", health.rho_max()},
+                 {"initial_energy", health.initial_energy()},
+                 {"max_energy", health.max_energy()}};
   write_file_atomic(dir_ / "summary.json", s.dump(2) + "\n");
 }
 

@@ -30,9 +30,11 @@ namespace sph {
 /// number of steps done after the row's step (1 for the first row, numberOfSteps for the last),
 /// as summary.json's "steps" and --steps count them; `time` is the simulated time then. The three audit columns
 /// (missed_pairs, particles_missing, max_missed_penetration) are empty unless the run audits.
+/// The last eight are the health monitor's statistics of the step (HealthStats; docs/reliability.md).
 inline constexpr const char* kStatsColumns =
     "step,time,particles,kinetic_energy,max_speed,mean_neighbors,lists_rebuilt,pairs_stored,pairs_within_h,"
-    "missed_pairs,particles_missing,max_missed_penetration,t_grid,t_lists,t_density,t_forces,t_integrate,t_output";
+    "missed_pairs,particles_missing,max_missed_penetration,t_grid,t_lists,t_density,t_forces,t_integrate,t_output,"
+    "outside,outside_depth,inside_solid,inside_depth,max_mach,rho_min,rho_max,energy";
 
 /// Facts about the run that are not in the scene.
 struct RunInfo {

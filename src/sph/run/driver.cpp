@@ -80,6 +80,7 @@ RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver
     result.status = status;
     result.message = std::move(message);
     result.steps_done = sim_.steps_done();
+    result.warnings = sim_.health().warnings();
     result.wall_seconds = wall_.elapsed();
     if (output_) output_->finish(sim_, result.message, result.wall_seconds);
     return result;
@@ -90,6 +91,17 @@ RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver
     for (std::int64_t s = sim_.steps_done(); s < steps; ++s) {
       const StepInfo& step = sim_.step();
       const bool last = s + 1 == steps;
+      if (step.health.new_warnings != 0) {
+        for (std::size_t k = 0; k < kHealthKinds; ++k) {
+          if ((step.health.new_warnings >> k & 1u) == 0) continue;
+          const std::string& w = sim_.health().warning(static_cast<HealthKind>(k));
+          if (callbacks.warning) callbacks.warning(w);
+          if (settings_.strict) {
+            result.error = w + " (--strict)";
+            return end(RunStatus::Failed, "failed: " + result.error);
+          }
+        }
+      }
       if (on_step) on_step(sim_, step);
       if (output_) output_->after_step(sim_, step, last);
       if (callbacks.progress) callbacks.progress(sim_.steps_done(), step.particles);
@@ -111,7 +123,11 @@ RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver
     result.error = e.what();
     return end(RunStatus::Failed, std::string("failed: ") + e.what());
   }
-  return end(RunStatus::Completed, "completed");
+  const std::vector<std::string> warnings = sim_.health().warnings();
+  if (warnings.empty()) return end(RunStatus::Completed, "completed");
+  std::string message = "completed with warnings: ";
+  for (std::size_t k = 0; k < warnings.size(); ++k) message += (k ? "; " : "") + warnings[k];
+  return end(RunStatus::Completed, message);
 }
 
 template class RunDriver<2, float>;

@@ -14,6 +14,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <sph/core/timer.h>
 #include <sph/io/checkpoint.h>
@@ -25,7 +26,7 @@ namespace sph {
 
 /// How a run ended.
 enum class RunStatus {
-  Completed,    ///< every step of the scene was done
+  Completed,    ///< every step of the scene was done (RunResult::warnings may hold health warnings)
   Interrupted,  ///< a stop request ended it after a step (with a checkpoint if it writes output)
   Failed,       ///< a step or the output threw sph::Error (a blow-up, a full disk)
 };
@@ -42,9 +43,12 @@ struct RunSettings {
   /// step of a resumed run). Recorded in the checkpoint, so that a resumed run goes on as often.
   /// Needs `dir`.
   std::int64_t checkpoint_every = 0;
+  /// Health warnings fail the run (`sph run --strict`): the step that raises the first one ends
+  /// it, status "failed: WARNING (--strict)".
+  bool strict = false;
 };
 
-/// What the caller hears during the run. Both are called between steps; either may be empty.
+/// What the caller hears during the run. Each is called between steps; any may be empty.
 struct RunCallbacks {
   /// Polled after each step but the scene's last (a request during the last step lets the run
   /// complete), with the steps done: a non-empty return (the cause, e.g. "SIGINT") stops the run
@@ -53,14 +57,19 @@ struct RunCallbacks {
   /// After each step's output: the steps done (counted from the start of the run, not of this
   /// session) and the particles.
   std::function<void(std::int64_t steps_done, std::size_t particles)> progress;
+  /// Once per kind of health warning, after the step that first raised it (before its output),
+  /// with the warning's text (HealthMonitor::warning).
+  std::function<void(const std::string& warning)> warning;
 };
 
 /// How a run ended, for the caller to report.
 struct RunResult {
   RunStatus status = RunStatus::Completed;
-  /// The status as summary.json records it: "completed", "interrupted by CAUSE after step K of
-  /// N", "failed: ERROR".
+  /// The status as summary.json records it: "completed", "completed with warnings: W1; W2",
+  /// "interrupted by CAUSE after step K of N", "failed: ERROR" (a --strict warning: "failed:
+  /// WARNING (--strict)").
   std::string message;
+  std::vector<std::string> warnings;  ///< the health warnings given, in order (also a resumed run's earlier ones)
   std::string error;            ///< Failed: the error's text
   std::string stop_cause;       ///< Interrupted: what stop_requested returned
   std::int64_t first_step = 0;  ///< steps done when this session started (0 unless resumed)

@@ -116,6 +116,9 @@ struct SimulationParams {
   /// Audit the lists every step against exact lists (StepInfo::audit); costs about one
   /// standard list build per step.
   bool audit = false;
+  /// The health monitor (health.h) fails a step past a failure threshold; false: it only
+  /// measures and warns (tests of machinery on deliberately unphysical setups).
+  bool health_failures = true;
 
   friend bool operator==(const SimulationParams&, const SimulationParams&) = default;
 };

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <sph/core/error.h>
+#include <sph/core/kernels.h>
 #include <sph/core/parallel.h>
 #include <sph/core/state_stream.h>
 #include <sph/core/timer.h>
@@ -30,11 +31,74 @@ double chunked_sum(std::size_t n, std::vector<double>& partial, F&& term) {
   return s;
 }
 
+/// Measures one particle for the health statistics (after its motion): containment, speed,
+/// density ratio, and its energy, kinetic + gravity (from the container's lowest point along g)
+/// + the wall springs it compresses (the penetrations of WallContact, ks pen^2 / 2 per kg); and,
+/// for the initial state only (kInternal), the internal energy of the EOS p = k (rho - rho0),
+/// e = k (ln(rho / rho0) + rho0 / rho - 1) >= 0 per kg where the pressure is not clamped.
+template <int D, std::floating_point R>
+class HealthProbe {
+ public:
+  HealthProbe(const SimulationParams<D>& p, R w0)
+      : p_(p),
+        tol_(kOutsideTolerance * 2.0 * p.particle_radius),
+        r_(p.particle_radius),
+        w0_(w0),
+        tension_(p.fluid.negative_pressure == NegativePressure::Allow) {
+    for (int d = 0; d < D; ++d) low_ += std::max(p.gravity[d] * p.container.lo[d], p.gravity[d] * p.container.hi[d]);
+  }
+
+  template <bool kInternal>
+  void add(detail::HealthChunk& c, std::size_t i, const Vec<D, R>& xr, const Vec<D, R>& vr, R m, R rho) const {
+    const Vec<D, double> x = vec_cast<double>(xr);
+    const double v2 = static_cast<double>(norm2(vr)), md = static_cast<double>(m);
+    if (v2 > c.v2) c.v2 = v2, c.v_i = i;
+    double out = -kNoLimit, springs = 0;  // signed distance past the container's planes
+    for (int d = 0; d < D; ++d) {
+      out = std::max({out, p_.container.lo[d] - x[d], x[d] - p_.container.hi[d]});
+      springs += squared_positive(p_.container.lo[d] + r_ - x[d]) + squared_positive(x[d] - (p_.container.hi[d] - r_));
+    }
+    if (out > tol_) ++c.outside;
+    if (out > 0 && out > c.outside_depth) c.outside_depth = out, c.outside_i = i;
+    for (const Box<D>& b : p_.obstacles) {
+      double in = kNoLimit, grown = kNoLimit;  // depth inside the box, and inside the box grown by r
+      for (int d = 0; d < D; ++d) {
+        in = std::min({in, x[d] - b.lo[d], b.hi[d] - x[d]});
+        grown = std::min({grown, x[d] - (b.lo[d] - r_), (b.hi[d] + r_) - x[d]});
+      }
+      if (in > tol_) ++c.inside;
+      if (in > 0 && in > c.inside_depth) c.inside_depth = in, c.inside_i = i;
+      springs += squared_positive(grown);
+    }
+    const double ratio = static_cast<double>(rho) / p_.fluid.rest_density;
+    if constexpr (kInternal)
+      if (ratio > 1 || (tension_ && ratio > 0))
+        c.internal += md * p_.fluid.stiffness * (std::log(ratio) + 1 / ratio - 1);
+    if (rho > m * w0_) {  // a neighbour within h added to its own contribution
+      if (ratio < c.rho_min) c.rho_min = ratio, c.rho_min_i = i;
+      if (ratio > c.rho_max) c.rho_max = ratio, c.rho_max_i = i;
+    }
+    c.energy += md * (0.5 * v2 + (low_ - dot(p_.gravity, x)) + 0.5 * p_.walls.stiffness * springs);
+    c.mass += md;
+  }
+
+ private:
+  static double squared_positive(double a) { return a > 0 ? a * a : 0.0; }
+
+  const SimulationParams<D>& p_;
+  double tol_, r_, low_ = 0;
+  R w0_;
+  bool tension_;
+};
+
 }  // namespace
 
 template <int D, std::floating_point R>
 Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> particles)
-    : params_(std::move(params)), particles_(std::move(particles)), emitters_(params_.emitters.size()) {
+    : params_(std::move(params)),
+      particles_(std::move(particles)),
+      emitters_(params_.emitters.size()),
+      monitor_(health_scene(params_), params_.health_failures) {
   NeighborOptions opt;
   opt.radius = params_.kernel_radius;
   opt.full_rebuild_period = params_.full_rebuild_period;
@@ -42,9 +106,6 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
   SPH_CHECK(params_.reorder_period >= 0, "reorder period must be >= 0");
   neighbors_ = make_neighbor_strategy<D, R>(params_.neighbors, opt);
   if (params_.audit) auditor_ = std::make_unique<ListAuditor<D, R>>();
-  double extent = 0;
-  for (int d = 0; d < D; ++d) extent = std::max(extent, params_.container.hi[d] - params_.container.lo[d]);
-  speed_limit_ = 20.0 * std::sqrt(params_.fluid.stiffness) + std::sqrt(2.0 * norm(params_.gravity) * extent);
   reserve_for_emitters();
   // Density and pressure of the initial state, so that frame 0 shows real values. Exact lists
   // from a throwaway standard strategy: the run's own strategy starts at step 0.
@@ -53,6 +114,13 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
     exact->update(particles_);
     compute_density_pressure(particles_, exact->lists(), static_cast<R>(params_.kernel_radius), params_.fluid);
   }
+  // The initial state's energy, the reference of the energy watch (measured as each step is).
+  integrate_and_check<false>(R(0));
+  // The bound E0 adds the initial internal energy of the EOS (>= 0 at every density), which a
+  // start off rest density releases; the steps' energy leaves it out (it is >= 0).
+  double energy = 0, mass = 0;
+  for (const detail::HealthChunk& c : health_chunks_) energy += c.energy + c.internal, mass += c.mass;
+  monitor_.set_initial(energy, mass);
 }
 
 template <int D, std::floating_point R>
@@ -127,8 +195,9 @@ const StepInfo& Simulation<D, R>::step() {
   compute_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity), walls,
                         neighbors_->pair_exit_flags(), dt);
   info.seconds.forces = watch.lap();
-  ++steps_;  // counted even if the check below throws (as before the passes were fused)
-  integrate_and_check(dt);
+  ++steps_;  // counted even if the checks below throw (as before the passes were fused)
+  info.health = integrate_and_check<true>(dt);
+  monitor_.check(info.health, steps_ - 1, time(), particles_.size());
   info.seconds.integrate = watch.lap();
 
   info.time = time();
@@ -138,45 +207,78 @@ const StepInfo& Simulation<D, R>::step() {
 }
 
 template <int D, std::floating_point R>
-void Simulation<D, R>::integrate_and_check(R dt) {
-  // Symplectic Euler (v += dt a; x += dt v) and the blow-up check in one pass.
+template <bool kIntegrate>
+HealthStats Simulation<D, R>::integrate_and_check(R dt) {
+  // Symplectic Euler (v += dt a; x += dt v), the blow-up check and the health statistics in one pass.
   const std::size_t n = particles_.size();
-  const double limit2 = speed_limit_ * speed_limit_;
-  std::vector<std::uint8_t>& bad = bad_;
-  bad.assign(chunk_count(n), 0);
+  const HealthProbe<D, R> probe(params_, Poly6Kernel<D, R>(static_cast<R>(params_.kernel_radius)).w_zero());
+  health_chunks_.assign(chunk_count(n), detail::HealthChunk{});
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
+    detail::HealthChunk& chunk = health_chunks_[c];
     bool any = false;
     for (std::size_t i = b; i < e; ++i) {
-      particles_.velocity[i] += particles_.acceleration[i] * dt;
-      particles_.position[i] += particles_.velocity[i] * dt;
-      any = any || !all_finite(particles_.position[i]) || !all_finite(particles_.velocity[i]) ||
-            static_cast<double>(norm2(particles_.velocity[i])) > limit2;
+      if constexpr (kIntegrate) {
+        particles_.velocity[i] += particles_.acceleration[i] * dt;
+        particles_.position[i] += particles_.velocity[i] * dt;
+      }
+      const auto& x = particles_.position[i];
+      const auto& v = particles_.velocity[i];
+      any = any || !all_finite(x) || !all_finite(v);
+      probe.template add<!kIntegrate>(chunk, i, x, v, particles_.mass[i], particles_.density[i]);
     }
-    bad[c] = any ? 1 : 0;
+    chunk.bad = any;
   });
   // Name the first bad particle in index order (a deterministic message).
-  for (std::size_t c = 0; c < bad.size(); ++c) {
-    if (!bad[c]) continue;
+  for (std::size_t c = 0; kIntegrate && c < health_chunks_.size(); ++c) {
+    if (!health_chunks_[c].bad) continue;
     for (std::size_t i = c * kChunkSize; i < std::min(n, (c + 1) * kChunkSize); ++i) {
       const auto& x = particles_.position[i];
       const auto& v = particles_.velocity[i];
-      std::string what;
-      if (!all_finite(x))
-        what = "position is not finite";
-      else if (!all_finite(v))
-        what = "velocity is not finite";
-      else if (static_cast<double>(norm2(v)) > limit2)
-        what = fmt::format("speed {:.4g} m/s exceeds the blow-up limit {:.4g} m/s", static_cast<double>(norm(v)),
-                           speed_limit_);
-      else
-        continue;
+      if (all_finite(x) && all_finite(v)) continue;
       throw Error(
-          fmt::format("simulation blew up at step {} (t = {:.6g} s): particle id {}: {}; density {:.6g}, "
-                      "pressure {:.6g}. Lower Configuration.timeStepSize or raise Fluid.viscosity",
-                      steps_ - 1, time(), particles_.id[i], what, static_cast<double>(particles_.density[i]),
-                      static_cast<double>(particles_.pressure[i])));
+          fmt::format("simulation blew up at step {} (t = {:.6g} s): particle id {}: {} is not finite; density "
+                      "{:.6g}, pressure {:.6g}. Lower Configuration.timeStepSize or raise Fluid.viscosity",
+                      steps_ - 1, time(), particles_.id[i], all_finite(x) ? "velocity" : "position",
+                      static_cast<double>(particles_.density[i]), static_cast<double>(particles_.pressure[i])));
     }
   }
+  return reduce_health();
+}
+
+template <int D, std::floating_point R>
+HealthStats Simulation<D, R>::reduce_health() const {
+  detail::HealthChunk all;
+  const auto better = [](double a, std::size_t ia, double b, std::size_t ib, bool larger) {
+    return ia != detail::HealthChunk::npos && (ib == detail::HealthChunk::npos || (larger ? a > b : a < b));
+  };
+  for (const detail::HealthChunk& c : health_chunks_) {  // chunk order; ties keep the lower index
+    all.outside += c.outside, all.inside += c.inside, all.energy += c.energy;
+    if (better(c.outside_depth, c.outside_i, all.outside_depth, all.outside_i, true))
+      all.outside_depth = c.outside_depth, all.outside_i = c.outside_i;
+    if (better(c.inside_depth, c.inside_i, all.inside_depth, all.inside_i, true))
+      all.inside_depth = c.inside_depth, all.inside_i = c.inside_i;
+    if (better(c.v2, c.v_i, all.v2, all.v_i, true)) all.v2 = c.v2, all.v_i = c.v_i;
+    if (better(c.rho_min, c.rho_min_i, all.rho_min, all.rho_min_i, false))
+      all.rho_min = c.rho_min, all.rho_min_i = c.rho_min_i;
+    if (better(c.rho_max, c.rho_max_i, all.rho_max, all.rho_max_i, true))
+      all.rho_max = c.rho_max, all.rho_max_i = c.rho_max_i;
+  }
+  const auto speed = [&](std::size_t i) { return std::sqrt(static_cast<double>(norm2(particles_.velocity[i]))); };
+  HealthStats s;
+  s.outside = all.outside, s.inside_solid = all.inside, s.energy = all.energy;
+  if (all.outside_i != detail::HealthChunk::npos)
+    s.outside_depth = all.outside_depth, s.outside_id = particles_.id[all.outside_i],
+    s.outside_speed = speed(all.outside_i);
+  if (all.inside_i != detail::HealthChunk::npos)
+    s.inside_depth = all.inside_depth, s.inside_id = particles_.id[all.inside_i], s.inside_speed = speed(all.inside_i);
+  const double c0 = std::sqrt(std::max(params_.fluid.stiffness, 0.0));
+  if (all.v_i != detail::HealthChunk::npos) {
+    s.max_mach = c0 > 0 ? std::sqrt(all.v2) / c0 : (all.v2 > 0 ? kNoLimit : 0.0);
+    s.mach_id = particles_.id[all.v_i];
+  }
+  if (all.rho_min_i != detail::HealthChunk::npos) s.rho_min = all.rho_min;
+  if (all.rho_max_i != detail::HealthChunk::npos) s.rho_max = all.rho_max, s.rho_max_id = particles_.id[all.rho_max_i];
+  return s;
 }
 
 template <int D, std::floating_point R>
@@ -240,6 +342,7 @@ void Simulation<D, R>::save_state(StateWriter& out) const {
   out.put(emitters_);
   particles_.save(out);
   neighbors_->save_state(out);
+  monitor_.save_state(out);
 }
 
 template <int D, std::floating_point R>
@@ -254,6 +357,7 @@ void Simulation<D, R>::load_state(StateReader& in) {
               "an emitter's count out of range");
   particles_.load(in);
   neighbors_->load_state(in, particles_.size());
+  monitor_.load_state(in);
   reserve_for_emitters();
   info_ = StepInfo{};
 }

@@ -8,6 +8,7 @@
 #include <sph/neighbors/audit.h>
 #include <sph/neighbors/reorder.h>
 #include <sph/neighbors/strategy.h>
+#include <sph/solver/health.h>
 #include <sph/solver/params.h>
 
 namespace sph {
@@ -34,7 +35,20 @@ struct StepInfo {
   bool audited = false;              ///< SimulationParams::audit was on: `audit` is filled
   ListAudit audit;                   ///< pairs within h that the lists missed this step
   PhaseTimes seconds;                ///< (the audit's own time is in none of the phases)
+  HealthStats health;                ///< measured in the integrate pass, judged by the health monitor
 };
+
+namespace detail {
+/// One chunk's share of the health statistics (indices into the particle arrays; npos: none).
+struct HealthChunk {
+  static constexpr std::size_t npos = ~std::size_t{0};
+  std::uint64_t outside = 0, inside = 0;
+  double outside_depth = 0, inside_depth = 0, v2 = -1, rho_min = kNoLimit, rho_max = -kNoLimit;
+  double energy = 0, internal = 0, mass = 0;
+  std::size_t outside_i = npos, inside_i = npos, v_i = npos, rho_min_i = npos, rho_max_i = npos;
+  bool bad = false;  // a non-finite position or velocity
+};
+}  // namespace detail
 
 /// Progress of one emitter (part of the simulation state).
 struct EmitterState {
@@ -50,17 +64,22 @@ struct EmitterState {
 ///   3. density and pressure (Eq. 4, EOS),
 ///   4. pressure, viscous, gravity and wall accelerations (Eq. 5, 6), with the Eq. 7 test if
 ///      the strategy asks for it (the force pass gathers every neighbor's velocity anyway),
-///   5. symplectic Euler integration, then a check that every value is finite.
+///   5. symplectic Euler integration, then a check that every value is finite; the same pass
+///      measures the health statistics (StepInfo::health), which the health monitor judges.
 template <int D, std::floating_point R>
 class Simulation {
  public:
   /// Takes the initial particles; throws sph::Error if the neighbor mode is unavailable.
   Simulation(SimulationParams<D> params, ParticleSet<D, R> particles);
 
-  /// Advances one time step. Throws sph::Error if a particle's state becomes non-finite or
-  /// its speed runs away, naming the step and the particle id. The speed limit is 20 times the
-  /// sound speed sqrt(k) plus the speed of free fall over the container's size.
+  /// Advances one time step. Throws sph::Error if a particle's state becomes non-finite
+  /// ("simulation blew up") or the health monitor fails the step (supersonic, fluid lost
+  /// through the walls, collapsed, energy gained: see kHealthWatches), naming the step, the
+  /// time, the particle id, the quantity and what to change. Warnings the step raised are in
+  /// StepInfo::health.new_warnings (their text in health()).
   const StepInfo& step();
+  /// The health monitor: the warnings given so far, their counts, the extremes seen.
+  const HealthMonitor& health() const { return monitor_; }
 
   const ParticleSet<D, R>& particles() const { return particles_; }
   const SimulationParams<D>& params() const { return params_; }
@@ -85,7 +104,7 @@ class Simulation {
   void perturb_positions(std::size_t first, double amplitude, std::uint64_t seed);
 
   /// Writes the complete state for a checkpoint: steps done, every particle field and id,
-  /// emitter progress, and the neighbor strategy's state (lists and flags). There is no random
+  /// emitter progress, the neighbor strategy's state (lists and flags) and the health monitor's. There is no random
   /// state: nothing in a step draws random numbers.
   void save_state(StateWriter& out) const;
   /// Replaces the state with what save_state() wrote (by a simulation of the same scene and
@@ -96,8 +115,12 @@ class Simulation {
  private:
   std::size_t emit();
   void reserve_for_emitters();
-  /// Integrates (symplectic Euler) and checks every value: throws on a blow-up.
-  void integrate_and_check(R dt);
+  /// Integrates (symplectic Euler; none with kIntegrate false), checks every value (throws on a
+  /// blow-up) and measures the health statistics, in one pass.
+  template <bool kIntegrate>
+  HealthStats integrate_and_check(R dt);
+  /// Folds the per-chunk statistics (in chunk order: the same for any thread count).
+  HealthStats reduce_health() const;
 
   SimulationParams<D> params_;
   ParticleSet<D, R> particles_;
@@ -106,10 +129,10 @@ class Simulation {
   MortonOrder<D, R> morton_;
   std::vector<std::uint32_t> perm_;
   mutable std::vector<double> partial_;    // per-chunk partial sums (kept: no allocation per step)
-  mutable std::vector<std::uint8_t> bad_;  // per-chunk blow-up flags
+  std::vector<detail::HealthChunk> health_chunks_;  // per-chunk health statistics (kept)
   std::vector<EmitterState> emitters_;
   std::int64_t steps_ = 0;
-  double speed_limit_ = 0;  // m/s: a faster particle means the run blew up (step() throws)
+  HealthMonitor monitor_;
   StepInfo info_;
 };
 

@@ -1,0 +1,214 @@
+#include <sph/solver/health.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include <sph/core/error.h>
+
+namespace sph {
+
+namespace {
+
+const HealthWatch& watch(HealthKind kind) { return kHealthWatches[static_cast<std::size_t>(kind)]; }
+
+/// Monaghan's artificial viscosity alpha = 0.1 as a dynamic viscosity: mu = rho0 alpha (h / 2) c0 / 8
+/// (his smoothing length is about half the kernel support h).
+double suggested_viscosity(const HealthScene& s) {
+  return s.rest_density * 0.1 * (0.5 * s.kernel_radius) * s.sound_speed / 8.0;
+}
+
+/// What walls that hold a particle need: stiffness for the speed v within r and for the head,
+/// critical damping, and the step the springs allow.
+std::string wall_advice(const HealthScene& s, double v) {
+  const double r = s.particle_radius;
+  const double ks_speed = (v / r) * (v / r);
+  const double ks_head = s.gravity * s.head / (2.0 * r * r);
+  const double ks = std::max(ks_speed, ks_head);
+  return fmt::format(
+      "walls that stop a particle at the run's top speed v = {:.3g} m/s within r = {:.3g} m need "
+      "Container.wallStiffness >= (v / r)^2 = {:.3g}, and >= g H / (2 r^2) = {:.3g} for the head H = {:.3g} m "
+      "(now {:.3g}), with Container.wallDamping about 2 sqrt(wallStiffness) = {:.3g} (now {:.3g}) and "
+      "Configuration.timeStepSize <= 0.5 / sqrt(wallStiffness) = {:.3g} s (now {:.3g} s)",
+      v, r, ks_speed, ks_head, s.head, s.wall_stiffness, 2.0 * std::sqrt(ks), s.wall_damping,
+      0.5 / std::sqrt(std::max(ks, s.wall_stiffness)), s.time_step);
+}
+
+std::string speed_advice(const HealthScene& s, double v) {
+  return fmt::format(
+      "Fluid.stiffness >= (10 v)^2 = {:.3g} (now {:.3g}) keeps it at Mach 0.1; or slow the flow with "
+      "Fluid.viscosity (now {:.3g}; Monaghan's alpha = 0.1 is about {:.3g})",
+      100.0 * v * v, s.stiffness, s.viscosity, suggested_viscosity(s));
+}
+
+}  // namespace
+
+template <int D>
+HealthScene health_scene(const SimulationParams<D>& p) {
+  HealthScene s;
+  s.sound_speed = std::sqrt(std::max(p.fluid.stiffness, 0.0));
+  s.kernel_radius = p.kernel_radius;
+  s.particle_radius = p.particle_radius;
+  s.rest_density = p.fluid.rest_density;
+  s.stiffness = p.fluid.stiffness;
+  s.viscosity = p.fluid.viscosity;
+  s.wall_stiffness = p.walls.stiffness;
+  s.wall_damping = p.walls.damping;
+  s.time_step = p.time_step;
+  s.gravity = norm(p.gravity);
+  if (s.gravity > 0) {
+    double head = 0;  // the container's extent along g
+    for (int d = 0; d < D; ++d) head += std::abs(p.gravity[d]) * (p.container.hi[d] - p.container.lo[d]);
+    s.head = head / s.gravity;
+  }
+  s.closed = p.emitters.empty();
+  s.tension = p.fluid.negative_pressure == NegativePressure::Allow;
+  return s;
+}
+
+template HealthScene health_scene<2>(const SimulationParams<2>&);
+template HealthScene health_scene<3>(const SimulationParams<3>&);
+
+HealthMonitor::HealthMonitor(const HealthScene& scene, bool fail) : scene_(scene), fail_(fail) {}
+
+double HealthMonitor::energy_scale() const {
+  return std::abs(initial_energy_) + total_mass_ * scene_.sound_speed * scene_.sound_speed / 2e4;
+}
+
+void HealthMonitor::warn(HealthStats& stats, HealthKind kind, std::string message) {
+  const auto k = static_cast<std::size_t>(kind);
+  ++counts_[k];
+  if (order_[k] != 0) return;
+  order_[k] = ++raised_;
+  messages_[k] = std::move(message);
+  stats.new_warnings |= 1u << k;
+}
+
+void HealthMonitor::check(HealthStats& st, std::int64_t step, double time, std::size_t particles) {
+  const HealthScene& s = scene_;
+  const double n = static_cast<double>(std::max<std::size_t>(particles, 1));
+  const double h = s.kernel_radius;
+  const double top_speed = st.max_mach * s.sound_speed;
+  max_mach_ = std::max(max_mach_, st.max_mach);
+  rho_max_ = std::max(rho_max_, st.rho_max);
+  rho_min_ = std::min(rho_min_, st.rho_min);
+  max_energy_ = std::max(max_energy_, st.energy);
+  // Messages are made only when a threshold is crossed: a healthy step allocates nothing.
+  const auto at = [&] { return fmt::format("at step {} (t = {:.6g} s)", step, time); };
+  const auto fail = [&](const std::string& what) {
+    if (fail_) throw Error(what);
+  };
+
+  // Supersonic first: it is the cause of most of what follows.
+  if (st.max_mach > watch(HealthKind::Mach).fail)
+    fail(
+        fmt::format("simulation went supersonic {}: particle id {} moves at {:.4g} m/s, Mach {:.3g} (sound "
+                    "speed sqrt(Fluid.stiffness) = {:.4g} m/s); {}, or lower Configuration.timeStepSize (now {:.3g} s)",
+                    at(), st.mach_id, top_speed, st.max_mach, s.sound_speed, speed_advice(s, top_speed), s.time_step));
+  const auto contained = [&](HealthKind kind, std::uint64_t count, double depth, std::uint64_t id, double speed,
+                             const char* where) {
+    const double fraction = static_cast<double>(count) / n;
+    if (fraction > watch(kind).fail || depth > h)
+      fail(
+          fmt::format("simulation lost its fluid {}: {} of {} particles are {} (more than {} % of them, or one "
+                      "deeper than h = {:.3g} m); the deepest, particle id {}, is {:.3g} m past the wall at "
+                      "{:.3g} m/s; {}",
+                      at(), count, particles, where, 100.0 * watch(kind).fail, h, id, depth, speed,
+                      wall_advice(s, std::max(top_speed, speed))));
+    if (count > 0 && fraction > watch(kind).warn)
+      warn(st, kind,
+           fmt::format("{} particles {} {} (the deepest, particle id {}, {:.3g} m past the wall at {:.3g} m/s); {}",
+                       count, where, at(), id, depth, speed, wall_advice(s, std::max(top_speed, speed))));
+  };
+  contained(HealthKind::Outside, st.outside, st.outside_depth, st.outside_id, st.outside_speed,
+            "outside the container");
+  contained(HealthKind::InsideSolid, st.inside_solid, st.inside_depth, st.inside_id, st.inside_speed,
+            "inside an obstacle");
+
+  if (st.max_mach > watch(HealthKind::Mach).warn)
+    warn(st, HealthKind::Mach,
+         fmt::format("Mach {:.3g} {}: particle id {} moves at {:.4g} m/s (sound speed {:.4g} m/s); the density "
+                     "error of weakly compressible SPH grows as Ma^2; {}",
+                     st.max_mach, at(), st.mach_id, top_speed, s.sound_speed, speed_advice(s, top_speed)));
+
+  const double stiff_for_1pct = s.stiffness * (st.rho_max - 1.0) / 0.01;
+  if (st.rho_max > watch(HealthKind::Compression).fail)
+    fail(
+        fmt::format("simulation collapsed {}: particle id {} is compressed to {:.3g} times the rest density; "
+                    "Fluid.stiffness >= {:.3g} (now {:.3g}) keeps the compression near 1 %, or lower "
+                    "Configuration.timeStepSize (now {:.3g} s)",
+                    at(), st.rho_max_id, st.rho_max, stiff_for_1pct, s.stiffness, s.time_step));
+  if (st.rho_max > watch(HealthKind::Compression).warn)
+    warn(st, HealthKind::Compression,
+         fmt::format("density {:.3g} times the rest density {} (particle id {}); Fluid.stiffness >= {:.3g} (now "
+                     "{:.3g}) keeps the compression near 1 %",
+                     st.rho_max, at(), st.rho_max_id, stiff_for_1pct, s.stiffness));
+  if (s.tension && 1.0 - st.rho_min > watch(HealthKind::Tension).warn)
+    warn(st, HealthKind::Tension,
+         fmt::format("density {:.3g} times the rest density {} under Fluid.negativePressure \"allow\": the "
+                     "negative pressure pulls particles into clumps; use \"clamp\" for a free surface",
+                     st.rho_min, at()));
+
+  if (s.closed) {
+    const double growth = (st.energy - initial_energy_) / energy_scale();
+    const auto advice = [&] {
+      return fmt::format(
+          "a closed, damped scene cannot gain energy: lower Configuration.timeStepSize (now {:.3g} s, e.g. to "
+          "{:.3g} s) or raise Fluid.viscosity (now {:.3g}; Monaghan's alpha = 0.1 is about {:.3g})",
+          s.time_step, 0.5 * s.time_step, s.viscosity, suggested_viscosity(s));
+    };
+    if (growth > watch(HealthKind::Energy).fail)
+      fail(
+          fmt::format("simulation gained energy {}: total energy {:.4g} J is {:.3g} times its scale above the "
+                      "initial {:.4g} J; {}",
+                      at(), st.energy, growth, initial_energy_, advice()));
+    if (growth > watch(HealthKind::Energy).warn)
+      warn(st, HealthKind::Energy,
+           fmt::format("total energy {:.4g} J {} is {:.1f} % of its scale above the initial {:.4g} J; {}", st.energy,
+                       at(), 100.0 * growth, initial_energy_, advice()));
+  }
+}
+
+std::vector<std::string> HealthMonitor::warnings() const {
+  std::vector<std::pair<std::int64_t, std::size_t>> raised;
+  for (std::size_t k = 0; k < kHealthKinds; ++k)
+    if (order_[k] != 0) raised.emplace_back(order_[k], k);
+  std::sort(raised.begin(), raised.end());
+  std::vector<std::string> out;
+  for (const auto& [rank, k] : raised) out.push_back(messages_[k]);
+  return out;
+}
+
+void HealthMonitor::save_state(StateWriter& out) const {
+  out.put(initial_energy_);
+  out.put(total_mass_);
+  out.put(counts_);
+  out.put(order_);
+  out.put(raised_);
+  for (const std::string& m : messages_) out.put(m);
+  out.put(max_mach_);
+  out.put(rho_max_);
+  out.put(rho_min_);
+  out.put(max_energy_);
+}
+
+void HealthMonitor::load_state(StateReader& in) {
+  in.get(initial_energy_);
+  in.get(total_mass_);
+  in.get(counts_);
+  in.get(order_);
+  in.get(raised_);
+  in.expect(raised_ >= 0 && raised_ <= static_cast<std::int64_t>(kHealthKinds), "a health warning count out of range");
+  for (std::size_t k = 0; k < kHealthKinds; ++k) {
+    in.get(messages_[k]);
+    in.expect(order_[k] >= 0 && order_[k] <= raised_ && (order_[k] == 0) == messages_[k].empty(),
+              "a health warning out of range");
+  }
+  in.get(max_mach_);
+  in.get(rho_max_);
+  in.get(rho_min_);
+  in.get(max_energy_);
+}
+
+}  // namespace sph

@@ -1,0 +1,92 @@
+// The health monitor through the run driver: a warning is given once through the callback and
+// recorded in the status, summary.json and stats.csv; RunSettings::strict makes it a failure in
+// the step that raised it; a resumed run remembers the warnings given before its checkpoint.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sph/run/driver.h>
+#include <sph/run/resume.h>
+#include <sph/scene/scene_reader.h>
+
+#include "support/temp_dir.h"
+
+namespace sph {
+namespace {
+
+namespace fs = std::filesystem;
+using test::slurp;
+using test::TempDir;
+
+/// The 2D dam break with its column thrown at the right wall at 13 m/s: Mach 0.33 (c0 = 40 m/s).
+SceneDesc thrown_dam_break(std::int64_t steps = 40) {
+  return read_scene_file(SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json",
+                         {"Configuration.numberOfSteps=" + std::to_string(steps), "Configuration.outputEveryNSteps=10",
+                          "FluidBlocks[0].velocity=[13,0]"});
+}
+
+TEST(HealthRun, AWarningIsGivenOnceAndRecordedInTheStatusSummaryAndStats) {
+  TempDir tmp;
+  std::vector<std::string> heard;
+  RunCallbacks callbacks;
+  callbacks.warning = [&](const std::string& w) { heard.push_back(w); };
+  RunDriver<2, double> run(thrown_dam_break(), RunSettings{tmp / "o", 0});
+  const RunResult r = run.run(callbacks);
+  ASSERT_EQ(r.status, RunStatus::Completed) << r.message;
+  ASSERT_EQ(heard.size(), 1u);
+  EXPECT_NE(heard[0].find("Mach 0.3"), std::string::npos) << heard[0];
+  EXPECT_EQ(r.warnings, heard);
+  EXPECT_EQ(r.message, "completed with warnings: " + heard[0]);
+  const auto summary = nlohmann::json::parse(slurp(tmp / "o" / "summary.json"));
+  EXPECT_EQ(summary.at("status"), r.message);
+  EXPECT_EQ(summary.at("warnings").size(), 1u);
+  EXPECT_GE(summary.at("warning_counts").at("mach").get<int>(), 1);
+  EXPECT_EQ(summary.at("warning_counts").at("outside").get<int>(), 0);
+  EXPECT_GT(summary.at("health").at("max_mach").get<double>(), 0.3);
+  const std::string stats = slurp(tmp / "o" / "stats.csv");
+  EXPECT_NE(stats.find(",outside,outside_depth,inside_solid,inside_depth,max_mach,rho_min,rho_max,energy\n"),
+            std::string::npos);
+}
+
+TEST(HealthRun, StrictMakesTheFirstWarningAFailureInItsStep) {
+  TempDir tmp;
+  RunSettings settings{tmp / "o", 0};
+  settings.strict = true;
+  RunDriver<2, double> run(thrown_dam_break(), settings);
+  const RunResult r = run.run();
+  ASSERT_EQ(r.status, RunStatus::Failed) << r.message;
+  EXPECT_EQ(r.steps_done, 1) << "the warning of step 0 stops the run there";
+  EXPECT_NE(r.error.find("Mach 0.3"), std::string::npos) << r.error;
+  EXPECT_EQ(r.message, "failed: " + r.error);
+  EXPECT_EQ(r.error.substr(r.error.size() - 11), " (--strict)");
+  EXPECT_EQ(nlohmann::json::parse(slurp(tmp / "o" / "summary.json")).at("status"), r.message);
+}
+
+TEST(HealthRun, AResumedRunRemembersTheWarningsGivenBeforeItsCheckpoint) {
+  TempDir tmp;
+  RunCallbacks stop;
+  int heard = 0;
+  stop.warning = [&](const std::string&) { ++heard; };
+  stop.stop_requested = [](std::int64_t done) { return done == 20 ? std::string("test") : std::string(); };
+  {
+    RunDriver<2, double> run(thrown_dam_break(), RunSettings{tmp / "o", 0});
+    ASSERT_EQ(run.run(stop).status, RunStatus::Interrupted);
+  }
+  EXPECT_EQ(heard, 1);
+  RunToResume again = open_run_to_resume(tmp / "o");
+  RunDriver<2, double> run(again.desc, *again.checkpoint, RunSettings{tmp / "o", 0});
+  RunCallbacks rest;
+  rest.warning = [&](const std::string&) { ++heard; };
+  const RunResult r = run.run(rest);
+  ASSERT_EQ(r.status, RunStatus::Completed) << r.message;
+  EXPECT_EQ(heard, 1) << "the warning is not given again after the resume";
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_EQ(r.message, "completed with warnings: " + r.warnings[0]);
+}
+
+}  // namespace
+}  // namespace sph

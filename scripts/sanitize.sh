@@ -1,19 +1,29 @@
 #!/usr/bin/env bash
 # Runs the tests under sanitizers and fuzzes the scene reader, each in its own build directory
-# (the normal build/ is not touched), with clang and Debian's compiler-rt and libomp:
-#   asan  build-asan: every ctest test (gtest programs, the sph binary they run, the Python
-#         readback tests; not the browser test and the repeats of the small benchmark) under
-#         AddressSanitizer + UndefinedBehaviorSanitizer, leak
-#         detection on, any undefined behaviour fatal. Built portable (-DSPH_NATIVE=OFF): the
-#         scalar code paths (no AVX-512), so that CI tests both (build/ is native).
-#   tsan  build-tsan: the tests of the parallel code (core, neighbors, solver: determinism tests
-#         included), bench.smoke, and sph render (parallel frames, the ffmpeg feeder thread) and
-#         view on a short run under ThreadSanitizer, OpenMP made visible to it by LLVM's Archer
-#         tool; first a self-check that a race planted in a parallel_for body is reported and a
-#         race-free one is not.
-#   fuzz  build-fuzz: the libFuzzer target of the scene reader (tests/fuzz) under ASan + UBSan:
-#         the saved crashers are replayed, then it fuzzes for SPH_FUZZ_SECONDS (default 60).
-# Usage: bash scripts/sanitize.sh [asan] [tsan] [fuzz]     (no argument: all three)
+# (the normal build/ is not touched), with clang and Debian's compiler-rt and libomp, at -O1 (the
+# sanitizers' usual level: a third less compile time than -O3, the same findings):
+#   asan        build-asan: every ctest test (gtest programs, the sph binary they run, the Python
+#               readback tests; not the browser test and the repeats of the small benchmark) under
+#               AddressSanitizer + UndefinedBehaviorSanitizer, leak detection on, any undefined
+#               behaviour fatal. Built portable (-DSPH_NATIVE=OFF): the scalar code paths (no
+#               AVX-512), so that both are tested (build/ is native).
+#   asan-units  build-asan as above, but only the test programs of the layers whose tests never
+#               run the sph binary (core, neighbors, solver, scene: tests/CMakeLists.txt's
+#               SPH_SELF_CONTAINED_TEST_LAYERS), which build without the rest. CI runs this one.
+#   tsan        build-tsan: the tests of the parallel code (core, neighbors, solver: determinism
+#               tests included), bench.smoke, and sph render (parallel frames, the ffmpeg feeder
+#               thread) and view on a short run under ThreadSanitizer, OpenMP made visible to it
+#               by LLVM's Archer tool; first a self-check that a race planted in a parallel_for
+#               body is reported and a race-free one is not.
+#   tsan-units  build-tsan: the self-check and the core, neighbors and solver tests (every
+#               parallel loop of the neighbor search and the solver), without building the sph
+#               binary. CI runs this one.
+#   fuzz        build-fuzz: the libFuzzer target of the scene reader (tests/fuzz) under ASan +
+#               UBSan: the saved crashers are replayed, then it fuzzes for SPH_FUZZ_SECONDS
+#               (default 60).
+# Usage: bash scripts/sanitize.sh [STAGE...]     (no argument: asan tsan fuzz, the whole set)
+# scripts/test.sh (CI) runs asan-units tsan-units fuzz, to keep CI short on 2 cores; run the
+# whole set before a release or after changing threaded, I/O or app code.
 # Prints a summary; exits non-zero if any stage failed. JOBS (default: nproc) sets the build and
 # ctest parallelism. Run scripts/setup.sh first (scripts/test.sh does).
 set -uo pipefail
@@ -29,7 +39,9 @@ cxx=$(command -v "${SPH_SANITIZE_CXX:-clang++-14}") || {
 stages=("$@")
 [ ${#stages[@]} -eq 0 ] && stages=(asan tsan fuzz)
 for s in "${stages[@]}"; do
-  case $s in asan | tsan | fuzz) ;; *) echo "sanitize: unknown stage '$s' (expected asan, tsan or fuzz)" >&2; exit 2 ;; esac
+  case $s in asan | asan-units | tsan | tsan-units | fuzz) ;;
+    *) echo "sanitize: unknown stage '$s' (expected asan, asan-units, tsan, tsan-units or fuzz)" >&2; exit 2 ;;
+  esac
 done
 
 llvm_dir=$(dirname "$(dirname "$(readlink -f "$cxx")")")  # /usr/lib/llvm-14
@@ -59,7 +71,8 @@ configure_and_build() {  # dir, then cmake cache settings, then -- and the targe
   if [ -f "$dir/CMakeCache.txt" ] && ! grep -q "^CMAKE_CXX_COMPILER:[A-Z]*=$cxx\$" "$dir/CMakeCache.txt"; then
     rm -rf "$dir/CMakeCache.txt" "$dir/CMakeFiles"
   fi
-  cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER="$cxx" "${defs[@]}" >/dev/null || return 1
+  cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" \
+    -DCMAKE_CXX_COMPILER="$cxx" "${defs[@]}" >/dev/null || return 1
   local d
   for d in "${defs[@]}"; do
     local name=${d#-D}
@@ -106,6 +119,22 @@ stage_asan() {
   local built=$SECONDS
   run_suite build-asan || status=FAIL
   record asan $status $((SECONDS - t0)) "build $((built - t0))s, tests $((SECONDS - built))s"
+}
+
+# The test programs of the self-contained layers only (they build without the sph binary).
+unit_layers=(core neighbors solver scene)
+unit_targets=("${unit_layers[@]/#/test_}")
+unit_label="^($(IFS='|'; echo "${unit_layers[*]}"))\$"
+
+stage_asan-units() {
+  local t0=$SECONDS status=ok
+  echo "== sanitize asan-units: build-asan (AddressSanitizer + UndefinedBehaviorSanitizer, portable), the ${unit_layers[*]} tests"
+  if ! configure_and_build build-asan -DSPH_SANITIZE=address,undefined -DSPH_NATIVE=OFF -- "${unit_targets[@]}"; then
+    record asan-u FAIL $((SECONDS - t0)) "build failed"; return
+  fi
+  local built=$SECONDS
+  ctest --test-dir build-asan --output-on-failure --no-tests=error -j "$jobs" -L "$unit_label" || status=FAIL
+  record asan-u $status $((SECONDS - t0)) "build $((built - t0))s, tests $((SECONDS - built))s"
 }
 
 # A parallel_for whose body writes one shared variable from every thread (argument "race"), or
@@ -168,11 +197,14 @@ tsan_render_check() {
   fi
 }
 
-stage_tsan() {
-  local t0=$SECONDS status=ok
-  echo "== sanitize tsan: build-tsan (ThreadSanitizer + Archer), the core, neighbors and solver tests, bench.smoke"
-  if ! configure_and_build build-tsan -DSPH_SANITIZE=thread -- sph test_core test_neighbors test_solver; then
-    record tsan FAIL $((SECONDS - t0)) "build failed"; return
+# tsan (whole: with the sph binary, bench.smoke and the render check) or tsan-units (argument
+# "units": the self-check and the core, neighbors and solver tests only).
+run_tsan() {
+  local units=${1:-} name=tsan t0=$SECONDS status=ok targets=(sph test_core test_neighbors test_solver)
+  [ -n "$units" ] && name=tsan-u targets=(test_core test_neighbors test_solver)
+  echo "== sanitize $name: build-tsan (ThreadSanitizer + Archer), the core, neighbors and solver tests${units:+ only}"
+  if ! configure_and_build build-tsan -DSPH_SANITIZE=thread -- "${targets[@]}"; then
+    record $name FAIL $((SECONDS - t0)) "build failed"; return
   fi
   local built=$SECONDS
   # Archer (LLVM's OMPT tool) tells TSan where OpenMP synchronizes (fork, join, barriers, the
@@ -187,13 +219,17 @@ stage_tsan() {
   # 4 threads) and, through bench.smoke (sph bench --threads 1,2), the benchmark's list checks.
   ctest --test-dir build-tsan --output-on-failure --no-tests=error -j "$jobs" -L '^(core|neighbors|solver)$' ||
     status=FAIL
-  ctest --test-dir build-tsan --output-on-failure --no-tests=error -R '^bench\.smoke$' || status=FAIL
-  # The other threads: sph render draws frames in a parallel_for and feeds ffmpeg from a thread
-  # of its own; sph compare and sph view read what the runs wrote.
-  tsan_render_check || status=FAIL
+  if [ -z "$units" ]; then
+    ctest --test-dir build-tsan --output-on-failure --no-tests=error -R '^bench\.smoke$' || status=FAIL
+    # The other threads: sph render draws frames in a parallel_for and feeds ffmpeg from a thread
+    # of its own; sph compare and sph view read what the runs wrote.
+    tsan_render_check || status=FAIL
+  fi
   unset OMP_TOOL_LIBRARIES TSAN_OPTIONS
-  record tsan $status $((SECONDS - t0)) "build $((built - t0))s, self-check + tests $((SECONDS - built))s"
+  record $name $status $((SECONDS - t0)) "build $((built - t0))s, self-check + tests $((SECONDS - built))s"
 }
+stage_tsan() { run_tsan; }
+stage_tsan-units() { run_tsan units; }
 
 stage_fuzz() {
   local t0=$SECONDS status=ok note

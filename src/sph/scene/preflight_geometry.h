@@ -1,5 +1,5 @@
 #pragma once
-/// \file Internals of the preflight (preflight.cpp, preflight_emitters.cpp): boxes as text, their
+/// \file Internals of the scene checks (preflight.cpp, preflight_emitters.cpp, scene_reader.cpp): boxes as text, their
 /// volumes and intersections, the room obstacles leave, and the emitters' checks.
 
 #include <algorithm>

@@ -18,6 +18,7 @@
 #include <sph/scene/overrides.h>
 #include <sph/scene/scales.h>
 #include <sph/scene/preflight.h>
+#include <sph/scene/preflight_geometry.h>
 #include <sph/scene/scene_keys.h>
 #include <sph/solver/time_step.h>
 #include <sph/solver/wcsph.h>
@@ -28,6 +29,7 @@ namespace {
 
 using json = nlohmann::json;
 using detail::ObjectReader;
+using detail::point_text;
 
 /// The keys a scene left out (or set to "auto") whose values come from its scales (scales.h),
 /// filled in by resolve_defaults once the whole body is read.
@@ -50,13 +52,6 @@ bool inside(const Vec<D, double>& x, const Box<D>& b) {
 }
 
 template <int D>
-std::string vec_text(const Vec<D, double>& v) {
-  std::string s = "[";
-  for (int d = 0; d < D; ++d) s += fmt::format("{}{:g}", d ? ", " : "", v[d]);
-  return s + "]";
-}
-
-template <int D>
 Box<D> read_box(ObjectReader& r, const char* what) {
   Box<D> b;
   b.lo = r.vec<D>("start", std::string("the lower corner of the ") + what + ", m");
@@ -65,13 +60,13 @@ Box<D> read_box(ObjectReader& r, const char* what) {
     if (!(b.hi[d] > b.lo[d]))
       r.ctx().fail(r.child("end"), fmt::format("must be greater than \"start\" in every coordinate; got start {} "
                                                "and end {}",
-                                               vec_text<D>(b.lo), vec_text<D>(b.hi)));
+                                               point_text<D>(b.lo), point_text<D>(b.hi)));
   // Corners near +-1.8e308 would make the size itself infinite (and every count built on it).
   for (int d = 0; d < D; ++d)
     if (!std::isfinite(b.hi[d] - b.lo[d]))
       r.ctx().fail(r.child("end"), fmt::format("the {} from start {} to end {} is too large: its size overflows a "
                                                "double in some coordinate",
-                                               what, vec_text<D>(b.lo), vec_text<D>(b.hi)));
+                                               what, point_text<D>(b.lo), point_text<D>(b.hi)));
   return b;
 }
 
@@ -242,8 +237,8 @@ double read_blocks(ObjectReader& root, SceneBody<D>& body) {
     blk.velocity = b.vec<D>("velocity", "the initial velocity in m/s", Vec<D, double>{});
     if (!inside<D>(blk.box.lo, sim.container) || !inside<D>(blk.box.hi, sim.container))
       b.ctx().fail(b.child("start"),
-                   fmt::format("the block {} .. {} is not inside the container {} .. {}", vec_text<D>(blk.box.lo),
-                               vec_text<D>(blk.box.hi), vec_text<D>(sim.container.lo), vec_text<D>(sim.container.hi)));
+                   fmt::format("the block {} .. {} is not inside the container {} .. {}", point_text<D>(blk.box.lo),
+                               point_text<D>(blk.box.hi), point_text<D>(sim.container.lo), point_text<D>(sim.container.hi)));
     // Each axis on its own: a product taken first could be inf * 0 = NaN, which no comparison
     // refuses (a block far longer than 2e9 spacings one way and thinner than one the other).
     double count = 1;
@@ -283,7 +278,7 @@ EmitterParams<D> read_emitter(ObjectReader& e, const SimulationParams<D>& sim) {
   em.end_time = e.positive("emitEndTime", "an end time > 0 in s", std::numeric_limits<double>::infinity());
   if (!inside<D>(em.origin, sim.container))
     e.ctx().fail(e.child("translation"),
-                 fmt::format("the nozzle center {} is outside the container", vec_text<D>(em.origin)));
+                 fmt::format("the nozzle center {} is outside the container", point_text<D>(em.origin)));
   return em;
 }
 

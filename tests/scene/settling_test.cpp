@@ -30,7 +30,7 @@ struct Settling {
   double end_bulk_speed = 0;     ///< the largest 95th-percentile speed over the last tenth, m/s
   double free_fall = 0;          ///< sqrt(2 g H) of the scene's scales, m/s
   double peak_kinetic = 0;
-  double peak_density = 0;  ///< the largest rho / rho0 of any particle in any step
+  double peak_density = 0;      ///< the largest rho / rho0 of any particle in any step
   double end_kinetic = 0;       ///< at the last step
   double end_max_density = 0;   ///< the largest rho / rho0 at the end
   double end_mean_density = 0;  ///< the mean rho / rho0 at the end
@@ -84,7 +84,8 @@ Settling run_scene(const std::string& json) {
       "  %lld steps of %.3g s, %zu particles: outside %zu, peak Mach %.3f, speed peak %.3g end %.3g (free fall "
       "%.3g, 95 %% end %.3g) m/s, kinetic peak %.3g end %.3g, density peak %.4f end max %.4f mean %.4f\n",
       static_cast<long long>(s.steps), p.time_step, s.particles, s.most_outside, s.peak_mach, s.peak_speed, s.end_speed,
-      s.free_fall, s.end_bulk_speed, s.peak_kinetic, s.end_kinetic, s.peak_density, s.end_max_density, s.end_mean_density);
+      s.free_fall, s.end_bulk_speed, s.peak_kinetic, s.end_kinetic, s.peak_density, s.end_max_density,
+      s.end_mean_density);
   return s;
 }
 

@@ -70,11 +70,11 @@ struct RunResult {
   /// WARNING (--strict)").
   std::string message;
   std::vector<std::string> warnings;  ///< the health warnings given, in order (also a resumed run's earlier ones)
-  std::string error;            ///< Failed: the error's text
-  std::string stop_cause;       ///< Interrupted: what stop_requested returned
-  std::int64_t first_step = 0;  ///< steps done when this session started (0 unless resumed)
-  std::int64_t steps_done = 0;  ///< steps done at the end
-  double wall_seconds = 0;      ///< this session's wall seconds, from the driver's construction
+  std::string error;                  ///< Failed: the error's text
+  std::string stop_cause;             ///< Interrupted: what stop_requested returned
+  std::int64_t first_step = 0;        ///< steps done when this session started (0 unless resumed)
+  std::int64_t steps_done = 0;        ///< steps done at the end
+  double wall_seconds = 0;            ///< this session's wall seconds, from the driver's construction
 };
 
 /// One run of one scene in dimension D and precision R. Not copyable or movable (its output

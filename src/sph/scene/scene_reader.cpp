@@ -16,9 +16,9 @@
 #include <sph/scene/json_source.h>
 #include <sph/scene/object_reader.h>
 #include <sph/scene/overrides.h>
-#include <sph/scene/scales.h>
 #include <sph/scene/preflight.h>
 #include <sph/scene/preflight_geometry.h>
+#include <sph/scene/scales.h>
 #include <sph/scene/scene_keys.h>
 #include <sph/solver/time_step.h>
 #include <sph/solver/wcsph.h>
@@ -236,9 +236,9 @@ double read_blocks(ObjectReader& root, SceneBody<D>& body) {
     blk.box = read_box<D>(b, "fluid block");
     blk.velocity = b.vec<D>("velocity", "the initial velocity in m/s", Vec<D, double>{});
     if (!inside<D>(blk.box.lo, sim.container) || !inside<D>(blk.box.hi, sim.container))
-      b.ctx().fail(b.child("start"),
-                   fmt::format("the block {} .. {} is not inside the container {} .. {}", point_text<D>(blk.box.lo),
-                               point_text<D>(blk.box.hi), point_text<D>(sim.container.lo), point_text<D>(sim.container.hi)));
+      b.ctx().fail(b.child("start"), fmt::format("the block {} .. {} is not inside the container {} .. {}",
+                                                 point_text<D>(blk.box.lo), point_text<D>(blk.box.hi),
+                                                 point_text<D>(sim.container.lo), point_text<D>(sim.container.hi)));
     // Each axis on its own: a product taken first could be inf * 0 = NaN, which no comparison
     // refuses (a block far longer than 2e9 spacings one way and thinner than one the other).
     double count = 1;

@@ -66,8 +66,8 @@ inline constexpr HealthWatch kHealthWatches[kHealthKinds] = {
      "in steady flow WCSPH's density variation is about Ma^2 (Monaghan 2005), but an impact sends a pressure "
      "pulse rho0 c0 dv, a compression dv / c0 = Ma (water hammer): at the Mach warning level 0.3 that is 30 %; "
      "a fluid compressed to twice its rest density is no longer a liquid"},
-    {HealthKind::Tension, "tension", "1 - min rho / rho0 over particles with neighbours (negativePressure allow)",
-     0.1, kNoLimit, "",
+    {HealthKind::Tension, "tension", "1 - min rho / rho0 over particles with neighbours (negativePressure allow)", 0.1,
+     kNoLimit, "",
      "with negativePressure \"allow\" a particle 10 % below rest density pulls its neighbours (tensile "
      "instability, clumping at free surfaces); with \"clamp\" low density is a free surface and is not judged"},
     {HealthKind::Energy, "energy", "(E - E0) / (|E0| + M c0^2 / 2e4), closed scenes", 0.05, 1.0, "",
@@ -82,9 +82,9 @@ struct HealthScene {
   double sound_speed = 1;  ///< c0 = sqrt(Fluid.stiffness), m/s
   double kernel_radius = 0, particle_radius = 0, rest_density = 1000;
   double stiffness = 0, viscosity = 0, wall_stiffness = 0, wall_damping = 0, time_step = 0;
-  double gravity = 0;  ///< |g|, m/s^2
-  double head = 0;     ///< the container's extent along g (0 without gravity), m
-  bool closed = true;  ///< no emitter (the energy is judged)
+  double gravity = 0;    ///< |g|, m/s^2
+  double head = 0;       ///< the container's extent along g (0 without gravity), m
+  bool closed = true;    ///< no emitter (the energy is judged)
   bool tension = false;  ///< NegativePressure::Allow
 };
 

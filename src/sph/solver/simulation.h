@@ -128,7 +128,7 @@ class Simulation {
   std::unique_ptr<ListAuditor<D, R>> auditor_;
   MortonOrder<D, R> morton_;
   std::vector<std::uint32_t> perm_;
-  mutable std::vector<double> partial_;    // per-chunk partial sums (kept: no allocation per step)
+  mutable std::vector<double> partial_;             // per-chunk partial sums (kept: no allocation per step)
   std::vector<detail::HealthChunk> health_chunks_;  // per-chunk health statistics (kept)
   std::vector<EmitterState> emitters_;
   std::int64_t steps_ = 0;

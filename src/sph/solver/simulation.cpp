@@ -249,7 +249,7 @@ template <int D, std::floating_point R>
 HealthStats Simulation<D, R>::reduce_health() const {
   detail::HealthChunk all;
   const auto better = [](double a, std::size_t ia, double b, std::size_t ib, bool larger) {
-    return ia != detail::HealthChunk::npos && (ib == detail::HealthChunk::npos || (larger ? a > b : a < b));
+    return ia != detail::HealthChunk::kNone && (ib == detail::HealthChunk::kNone || (larger ? a > b : a < b));
   };
   for (const detail::HealthChunk& c : health_chunks_) {  // chunk order; ties keep the lower index
     all.outside += c.outside, all.inside += c.inside, all.energy += c.energy;
@@ -266,18 +266,18 @@ HealthStats Simulation<D, R>::reduce_health() const {
   const auto speed = [&](std::size_t i) { return std::sqrt(static_cast<double>(norm2(particles_.velocity[i]))); };
   HealthStats s;
   s.outside = all.outside, s.inside_solid = all.inside, s.energy = all.energy;
-  if (all.outside_i != detail::HealthChunk::npos)
+  if (all.outside_i != detail::HealthChunk::kNone)
     s.outside_depth = all.outside_depth, s.outside_id = particles_.id[all.outside_i],
     s.outside_speed = speed(all.outside_i);
-  if (all.inside_i != detail::HealthChunk::npos)
+  if (all.inside_i != detail::HealthChunk::kNone)
     s.inside_depth = all.inside_depth, s.inside_id = particles_.id[all.inside_i], s.inside_speed = speed(all.inside_i);
   const double c0 = std::sqrt(std::max(params_.fluid.stiffness, 0.0));
-  if (all.v_i != detail::HealthChunk::npos) {
+  if (all.v_i != detail::HealthChunk::kNone) {
     s.max_mach = c0 > 0 ? std::sqrt(all.v2) / c0 : (all.v2 > 0 ? kNoLimit : 0.0);
     s.mach_id = particles_.id[all.v_i];
   }
-  if (all.rho_min_i != detail::HealthChunk::npos) s.rho_min = all.rho_min;
-  if (all.rho_max_i != detail::HealthChunk::npos) s.rho_max = all.rho_max, s.rho_max_id = particles_.id[all.rho_max_i];
+  if (all.rho_min_i != detail::HealthChunk::kNone) s.rho_min = all.rho_min;
+  if (all.rho_max_i != detail::HealthChunk::kNone) s.rho_max = all.rho_max, s.rho_max_id = particles_.id[all.rho_max_i];
   return s;
 }
 

@@ -39,13 +39,13 @@ struct StepInfo {
 };
 
 namespace detail {
-/// One chunk's share of the health statistics (indices into the particle arrays; npos: none).
+/// One chunk's share of the health statistics (indices into the particle arrays; kNone: none).
 struct HealthChunk {
-  static constexpr std::size_t npos = ~std::size_t{0};
+  static constexpr std::size_t kNone = ~std::size_t{0};
   std::uint64_t outside = 0, inside = 0;
   double outside_depth = 0, inside_depth = 0, v2 = -1, rho_min = kNoLimit, rho_max = -kNoLimit;
   double energy = 0, internal = 0, mass = 0;
-  std::size_t outside_i = npos, inside_i = npos, v_i = npos, rho_min_i = npos, rho_max_i = npos;
+  std::size_t outside_i = kNone, inside_i = kNone, v_i = kNone, rho_min_i = kNone, rho_max_i = kNone;
   bool bad = false;  // a non-finite position or velocity
 };
 }  // namespace detail

@@ -21,7 +21,8 @@
 #               parallel loop of the neighbor search and the solver; the determinism tests at 1 to
 #               4 threads), less the long physics runs, without building the sph binary. CI runs
 #               this one.
-#   fuzz        build-fuzz: the libFuzzer target of the scene reader (tests/fuzz) under ASan +
+#   fuzz        build-asan: the libFuzzer target of the scene reader (tests/fuzz; its corpus and
+#               logs in build-fuzz/) under ASan +
 #               UBSan: the saved crashers are replayed, then it fuzzes for SPH_FUZZ_SECONDS
 #               (default 60).
 # Usage: bash scripts/sanitize.sh [STAGE...]     (no argument: asan tsan fuzz, the whole set)
@@ -115,7 +116,7 @@ run_suite() {  # dir
 stage_asan() {
   local t0=$SECONDS status=ok
   echo "== sanitize asan: build-asan (AddressSanitizer + UndefinedBehaviorSanitizer, portable: scalar paths), whole ctest suite"
-  if ! configure_and_build build-asan -DSPH_SANITIZE=address,undefined -DSPH_NATIVE=OFF; then
+  if ! configure_and_build build-asan -DSPH_SANITIZE=address,undefined -DSPH_NATIVE=OFF -DSPH_FUZZ=ON; then
     record asan FAIL $((SECONDS - t0)) "build failed"; return
   fi
   local built=$SECONDS
@@ -133,7 +134,7 @@ long_physics='^(Hydrostatic|Conservation|Settling)\.'
 stage_asan-units() {
   local t0=$SECONDS status=ok
   echo "== sanitize asan-units: build-asan (AddressSanitizer + UndefinedBehaviorSanitizer, portable), the ${unit_layers[*]} tests"
-  if ! configure_and_build build-asan -DSPH_SANITIZE=address,undefined -DSPH_NATIVE=OFF -- "${unit_targets[@]}"; then
+  if ! configure_and_build build-asan -DSPH_SANITIZE=address,undefined -DSPH_NATIVE=OFF -DSPH_FUZZ=ON -- "${unit_targets[@]}"; then
     record asan-u FAIL $((SECONDS - t0)) "build failed"; return
   fi
   local built=$SECONDS
@@ -240,12 +241,15 @@ stage_tsan-units() { run_tsan units; }
 
 stage_fuzz() {
   local t0=$SECONDS status=ok note
-  echo "== sanitize fuzz: build-fuzz (libFuzzer + ASan + UBSan), scene reader for ${fuzz_seconds}s"
-  if ! configure_and_build build-fuzz -DSPH_SANITIZE=address,undefined -DSPH_FUZZ=ON -DSPH_BUILD_TESTS=OFF \
+  echo "== sanitize fuzz: build-asan (libFuzzer + ASan + UBSan), scene reader for ${fuzz_seconds}s"
+  # In build-asan (the same sanitizers and libraries as the asan stages, sph_scene with the
+  # fuzzer's coverage as well): one build of the libraries for both.
+  if ! configure_and_build build-asan -DSPH_SANITIZE=address,undefined -DSPH_NATIVE=OFF -DSPH_FUZZ=ON \
     -- scene_reader_fuzz; then
     record fuzz FAIL $((SECONDS - t0)) "build failed"; return
   fi
-  local fuzzer=build-fuzz/tests/fuzz/scene_reader_fuzz
+  local fuzzer=build-asan/tests/fuzz/scene_reader_fuzz
+  mkdir -p build-fuzz
   # Inputs that once crashed the reader, each run whole (some are longer than -max_len below).
   if ! "$fuzzer" tests/fuzz/regressions/* >build-fuzz/regressions.log 2>&1; then
     cat build-fuzz/regressions.log

@@ -16,6 +16,6 @@ bash scripts/check_install.sh build
 # The unit tests of the layers below io (core, neighbors, solver, scene) again under
 # AddressSanitizer + UndefinedBehaviorSanitizer (portable build: the scalar paths), the parallel
 # code's tests under ThreadSanitizer, and 30 s of fuzzing the scene reader (build-asan,
-# build-tsan, build-fuzz). The whole suite under the sanitizers is `bash scripts/sanitize.sh`
+# build-tsan). The whole suite under the sanitizers is `bash scripts/sanitize.sh`
 # (too long for CI on 2 cores; docs/reliability.md, "Sanitizers").
 SPH_FUZZ_SECONDS=${SPH_FUZZ_SECONDS:-30} bash scripts/sanitize.sh asan-units tsan-units fuzz

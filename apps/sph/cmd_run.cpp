@@ -175,9 +175,9 @@ void print_done(const RunDriver<D, R>& run, const RunResult& result, bool audit)
   if (audit)
     fmt::print(stderr,
                "sph: audit: {} pairs within h were missing from the lists, in {} of {} steps; the deepest miss "
-               "was (h - r) / h = {:.3g}\n",
+               "was (h - r) / h = {:.3g}; {} fluid-boundary pairs were missing from the boundary lists\n",
                out.audit_totals().missed_pairs, out.audit_steps_with_misses(), result.steps_done,
-               out.audit_totals().max_penetration);
+               out.audit_totals().max_penetration, out.boundary_missed_pairs());
 }
 
 /// Runs `desc` into `dir`: a new run, or (with `checkpoint`) the continuation of the run that

@@ -11,6 +11,7 @@
 #include <sph/core/state_stream.h>
 #include <sph/core/timer.h>
 #include <sph/core/version.h>
+#include <sph/io/vtk.h>
 #include <sph/io/atomic_file.h>
 #include <sph/scene/scene_writer.h>
 
@@ -72,7 +73,8 @@ void prepare_output_directory(const fs::path& dir) {
   remove_stale_temporaries(dir);
   remove_stale_temporaries(dir / "frames");
   // Remove what a previous run left, so that frames of two runs are never mixed.
-  for (const char* name : {"frames.pvd", "stats.csv", "summary.json", "scene.json", "checkpoint.sphc", "run.json"})
+  for (const char* name :
+       {"frames.pvd", "stats.csv", "summary.json", "scene.json", "checkpoint.sphc", "run.json", "boundary.vtu"})
     fs::remove(dir / name, ec);
   remove_pictures(dir);
   for (const auto& entry : fs::directory_iterator(dir / "frames", ec)) {
@@ -114,8 +116,21 @@ void RunOutput<D, R>::begin(const Simulation<D, R>& sim) {
   open_stats();
   write_file_atomic(dir_ / "scene.json", scene_text(desc_) + "\n");
   write_run_identity(dir_, identity_);
+  if (desc_.output.boundary) write_boundary(sim);
   frames_.write_due(sim, false);  // frame 0, if the run writes frames
   output_seconds_ += w.lap();
+}
+
+template <int D, std::floating_point R>
+void RunOutput<D, R>::write_boundary(const Simulation<D, R>& sim) const {
+  const BoundarySet<D, R>& b = sim.boundary();
+  if (b.size() == 0) return;
+  ParticleSet<D, R> samples;
+  samples.reserve(b.size());
+  const std::size_t psi = samples.add_field({"psi", FieldKind::Real, "kg/m", "kg", "a boundary sample's psi = rho0 V_b"});
+  for (std::size_t k = 0; k < b.size(); ++k) samples.add(b.position[k], Vec<D, R>{}, b.psi[k]);
+  samples.real_field(psi) = b.psi;
+  write_vtu(dir_ / "boundary.vtu", samples, 0.0, FrameFields::only({"id", "psi"}));
 }
 
 namespace {
@@ -152,6 +167,8 @@ std::string RunOutput<D, R>::resume(const Simulation<D, R>& sim, StateReader& in
   in.get(totals_lists_rebuilt_);
   in.get(audit_);
   in.get(audit_steps_with_misses_);
+  in.get(boundary_missed_);
+  in.get(boundary_steps_with_misses_);
   in.get(output_seconds_);
   in.get(earlier_wall_seconds_);
   in.get(resumed_at_);
@@ -190,6 +207,8 @@ void RunOutput<D, R>::save_state(StateWriter& out, const Simulation<D, R>& sim, 
   out.put(totals_lists_rebuilt_);
   out.put(audit_);
   out.put(audit_steps_with_misses_);
+  out.put(boundary_missed_);
+  out.put(boundary_steps_with_misses_);
   out.put(output_seconds_);
   out.put(earlier_wall_seconds_ + wall_seconds);
   out.put(resumed_at_);
@@ -217,7 +236,11 @@ double RunOutput<D, R>::after_step(const Simulation<D, R>& sim, const StepInfo& 
   const HealthStats& h = info.health;
   stats_ << fmt::format(",{},{:.6g},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g}", h.outside, h.outside_depth, h.inside_solid,
                         h.inside_depth, h.max_mach, h.rho_min, h.rho_max, h.energy);
+  stats_ << fmt::format(",{},{}", info.neighbors.boundary_pairs_stored,
+                        info.audited ? std::to_string(info.boundary_audit.missed_pairs) : std::string());
   if (info.audited) {
+    boundary_missed_ += info.boundary_audit.missed_pairs;
+    boundary_steps_with_misses_ += info.boundary_audit.missed_pairs > 0 ? 1 : 0;
     audit_.missed_pairs += info.audit.missed_pairs;
     audit_.max_penetration = std::max(audit_.max_penetration, info.audit.max_penetration);
     audit_steps_with_misses_ += info.audit.missed_pairs > 0 ? 1 : 0;
@@ -270,7 +293,9 @@ void RunOutput<D, R>::finish(const Simulation<D, R>& sim, const std::string& sta
   if (sim.params().audit)
     s["audit"] = {{"missed_pairs", audit_.missed_pairs},
                   {"steps_with_misses", audit_steps_with_misses_},
-                  {"max_missed_penetration", audit_.max_penetration}};
+                  {"max_missed_penetration", audit_.max_penetration},
+                  {"boundary_missed_pairs", boundary_missed_},
+                  {"boundary_steps_with_misses", boundary_steps_with_misses_}};
   s["kinetic_energy"] = sim.kinetic_energy();
   s["max_speed"] = sim.max_speed();
   // The health monitor (docs/reliability.md, "Health monitor"): warnings in the order given,

@@ -30,11 +30,14 @@ namespace sph {
 /// number of steps done after the row's step (1 for the first row, numberOfSteps for the last),
 /// as summary.json's "steps" and --steps count them; `time` is the simulated time then. The three audit columns
 /// (missed_pairs, particles_missing, max_missed_penetration) are empty unless the run audits.
-/// The last eight are the health monitor's statistics of the step (HealthStats; docs/reliability.md).
+/// Then eight of the health monitor's statistics of the step (HealthStats; docs/reliability.md),
+/// and the boundary particles' lists: entries stored, and (audited runs) the fluid-boundary
+/// pairs within h they missed (0 and empty with penalty walls).
 inline constexpr const char* kStatsColumns =
     "step,time,particles,kinetic_energy,max_speed,mean_neighbors,lists_rebuilt,pairs_stored,pairs_within_h,"
     "missed_pairs,particles_missing,max_missed_penetration,t_grid,t_lists,t_density,t_forces,t_integrate,t_output,"
-    "outside,outside_depth,inside_solid,inside_depth,max_mach,rho_min,rho_max,energy";
+    "outside,outside_depth,inside_solid,inside_depth,max_mach,rho_min,rho_max,energy,boundary_pairs_stored,"
+    "boundary_missed_pairs";
 
 /// Facts about the run that are not in the scene.
 struct RunInfo {
@@ -90,9 +93,13 @@ class RunOutput {
   const ListAudit& audit_totals() const { return audit_; }
   /// Audited steps with at least one missed pair.
   std::uint64_t audit_steps_with_misses() const { return audit_steps_with_misses_; }
+  /// Fluid-boundary pairs within h the boundary lists missed, summed over the audited steps.
+  std::uint64_t boundary_missed_pairs() const { return boundary_missed_; }
 
  private:
   void open_stats();
+  /// boundary.vtu: the boundary particles' positions, ids (sample indices) and psi, once.
+  void write_boundary(const Simulation<D, R>& sim) const;
 
   std::filesystem::path dir_;
   const SceneDesc& desc_;
@@ -105,6 +112,7 @@ class RunOutput {
   std::uint64_t totals_lists_rebuilt_ = 0;
   ListAudit audit_;  // summed missed pairs, largest penetration
   std::uint64_t audit_steps_with_misses_ = 0;
+  std::uint64_t boundary_missed_ = 0, boundary_steps_with_misses_ = 0;  // boundary lists (audited runs)
   double output_seconds_ = 0;
   double earlier_wall_seconds_ = 0;
   std::vector<std::int64_t> resumed_at_;  // steps this run was resumed from, in order

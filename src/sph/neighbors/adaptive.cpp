@@ -30,6 +30,7 @@ void AdaptiveNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
     grid_.build(particles.position, radius_);
     counters_.grid_seconds = watch.lap();
     builder_.build(grid_, particles.position, radius_, lists_);
+    this->boundary_.build(particles.position);
   } else {
     flagged = 0;
     for (std::uint8_t f : flags_) flagged += f;
@@ -37,12 +38,14 @@ void AdaptiveNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
       grid_.build(particles.position, radius_);
       counters_.grid_seconds = watch.lap();
       builder_.rebuild_some(grid_, particles.position, radius_, flags_, lists_);
+      this->boundary_.rebuild_some(particles.position, flags_);
     }
   }
   std::fill(flags_.begin(), flags_.end(), std::uint8_t{0});  // rebuilt lists start clean
   counters_.lists_seconds = watch.lap();
   counters_.lists_rebuilt = flagged;
   counters_.pairs_stored = lists_.entry_count();
+  counters_.boundary_pairs_stored = this->boundary_.lists().entry_count();
 }
 
 template <int D, std::floating_point R>
@@ -51,6 +54,7 @@ void AdaptiveNeighbors<D, R>::save_state(StateWriter& out) const {
   out.put(static_cast<std::uint8_t>(invalid_));
   out.put(flags_);
   lists_.save(out);
+  this->boundary_.save(out);
 }
 
 template <int D, std::floating_point R>
@@ -59,6 +63,7 @@ void AdaptiveNeighbors<D, R>::load_state(StateReader& in, std::size_t particles)
   invalid_ = in.get<std::uint8_t>() != 0;
   in.get(flags_);
   lists_.load(in);
+  this->boundary_.load(in, particles);
   in.expect(updates_ >= 0 && flags_.size() == lists_.particle_count() && flags_.size() <= particles,
             "adaptive neighbor state does not match the particles");
 }

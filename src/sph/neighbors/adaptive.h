@@ -38,6 +38,7 @@ class AdaptiveNeighbors final : public NeighborStrategy<D, R> {
   void load_state(StateReader& in, std::size_t particles) override;
 
  private:
+  R list_radius() const override { return radius_; }
   R radius_;
   int period_;
   std::int64_t updates_ = 0;

@@ -16,7 +16,25 @@ ListAudit ListAuditor<D, R>::audit(std::span<const Vec<D, R>> positions, const N
   if (n == 0) return total;
   grid_.build(positions, h);
   builder_.build(grid_, positions, h, exact_);
+  return compare(positions, positions, lists, h);
+}
 
+template <int D, std::floating_point R>
+ListAudit ListAuditor<D, R>::audit_boundary(std::span<const Vec<D, R>> positions, std::span<const Vec<D, R>> samples,
+                                            const NeighborLists& lists, R h) {
+  const std::size_t n = positions.size();
+  if (samples.empty() || n == 0) return {};
+  SPH_CHECK(lists.particle_count() == n, "audited boundary lists must cover every particle");
+  sample_grid_.build(samples, h);
+  builder_.build_queries(sample_grid_, positions, h, exact_);
+  return compare(positions, samples, lists, h);
+}
+
+template <int D, std::floating_point R>
+ListAudit ListAuditor<D, R>::compare(std::span<const Vec<D, R>> positions, std::span<const Vec<D, R>> others,
+                                     const NeighborLists& lists, R h) {
+  const std::size_t n = positions.size();
+  ListAudit total;
   const std::size_t chunks = chunk_count(n);
   if (scratch_.size() < chunks) scratch_.resize(chunks);
   partial_.assign(chunks, ListAudit{});
@@ -33,7 +51,7 @@ ListAudit ListAuditor<D, R>::audit(std::span<const Vec<D, R>> positions, const N
       for (std::uint32_t j : want) {
         if (std::binary_search(have.begin(), have.end(), j)) continue;
         ++missed;
-        const double r = std::sqrt(static_cast<double>(norm2(positions[i] - positions[j])));
+        const double r = std::sqrt(static_cast<double>(norm2(positions[i] - others[j])));
         a.max_penetration = std::max(a.max_penetration, (static_cast<double>(h) - r) / static_cast<double>(h));
       }
       a.missed_pairs += missed;

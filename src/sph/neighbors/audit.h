@@ -29,9 +29,18 @@ template <int D, std::floating_point R>
 class ListAuditor {
  public:
   ListAudit audit(std::span<const Vec<D, R>> positions, const NeighborLists& lists, R h);
+  /// The same for boundary lists: the fluid-boundary pairs (particle i, sample b) closer than h
+  /// that i's boundary list misses (missed_pairs counts each once: the solver visits the pair
+  /// from the fluid side only).
+  ListAudit audit_boundary(std::span<const Vec<D, R>> positions, std::span<const Vec<D, R>> samples,
+                           const NeighborLists& lists, R h);
 
  private:
-  UniformGrid<D, R> grid_;
+  /// Counts what `lists` misses of exact_, the pairs of positions[i] and others[j] closer than h.
+  ListAudit compare(std::span<const Vec<D, R>> positions, std::span<const Vec<D, R>> others, const NeighborLists& lists,
+                    R h);
+
+  UniformGrid<D, R> grid_, sample_grid_;
   ListBuilder<D, R> builder_;
   NeighborLists exact_;
   std::vector<std::vector<std::uint32_t>> scratch_;  // per chunk: a sorted copy of one list

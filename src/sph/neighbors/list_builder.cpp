@@ -139,12 +139,57 @@ constexpr std::size_t kRoom = 16;
 
 static_assert(kRoom >= NeighborLists::kPadding);
 
+/// The grid's own points as queries: point i's cell as built, and itself left out.
+template <int D, std::floating_point R>
+struct GridPoints {
+  const UniformGrid<D, R>& grid;
+  std::span<const Vec<D, R>> positions;
+  std::uint32_t cell(std::size_t i) const { return grid.cell_of(i); }
+  const Vec<D, R>& x(std::size_t i) const { return positions[i]; }
+  static std::uint32_t self(std::size_t i) { return static_cast<std::uint32_t>(i); }
+};
+
+/// Points that are not the grid's (fluid particles against the boundary samples' grid): the
+/// cell that holds each, and nothing left out (no grid index is ~0).
+template <int D, std::floating_point R>
+struct QueryPoints {
+  const UniformGrid<D, R>& grid;
+  std::span<const Vec<D, R>> positions;
+  std::uint32_t cell(std::size_t i) const { return grid.cell_containing(positions[i]); }
+  const Vec<D, R>& x(std::size_t i) const { return positions[i]; }
+  static std::uint32_t self(std::size_t) { return ~0u; }
+};
+
 }  // namespace
 
 template <int D, std::floating_point R>
 void ListBuilder<D, R>::build(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> positions, R radius,
                               NeighborLists& out) {
-  const std::size_t n = positions.size();
+  build_with(grid, positions.size(), GridPoints<D, R>{grid, positions}, radius, out);
+}
+
+template <int D, std::floating_point R>
+void ListBuilder<D, R>::build_queries(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> queries, R radius,
+                                      NeighborLists& out) {
+  build_with(grid, queries.size(), QueryPoints<D, R>{grid, queries}, radius, out);
+}
+
+template <int D, std::floating_point R>
+void ListBuilder<D, R>::rebuild_some(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> positions, R radius,
+                                     std::span<const std::uint8_t> rebuild, NeighborLists& lists) {
+  rebuild_some_with(grid, positions.size(), GridPoints<D, R>{grid, positions}, radius, rebuild, lists);
+}
+
+template <int D, std::floating_point R>
+void ListBuilder<D, R>::rebuild_some_queries(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> queries,
+                                             R radius, std::span<const std::uint8_t> rebuild, NeighborLists& lists) {
+  rebuild_some_with(grid, queries.size(), QueryPoints<D, R>{grid, queries}, radius, rebuild, lists);
+}
+
+template <int D, std::floating_point R>
+template <class Query>
+void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n, const Query& query, R radius,
+                                   NeighborLists& out) {
   const R r2 = radius * radius;
   const std::size_t chunks = chunk_count(n);
   out.chunks_.resize(chunks);
@@ -156,10 +201,9 @@ void ListBuilder<D, R>::build(const UniformGrid<D, R>& grid, std::span<const Vec
     Stencil<D, R> st;
     std::size_t used = 0;
     for (std::size_t i = b; i < e; ++i) {
-      st.update(grid, grid.cell_of(i));
+      st.update(grid, query.cell(i));
       ensure_room(buf, used + st.candidates + kRoom);
-      const std::uint32_t m =
-          gather(vector_, grid, st, positions[i], static_cast<std::uint32_t>(i), r2, buf.data() + used);
+      const std::uint32_t m = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + used);
       used += m;
       out.end_[i] = static_cast<std::uint32_t>(used);
     }
@@ -171,9 +215,9 @@ void ListBuilder<D, R>::build(const UniformGrid<D, R>& grid, std::span<const Vec
 }
 
 template <int D, std::floating_point R>
-void ListBuilder<D, R>::rebuild_some(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> positions, R radius,
-                                     std::span<const std::uint8_t> rebuild, NeighborLists& lists) {
-  const std::size_t n = positions.size();
+template <class Query>
+void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::size_t n, const Query& query, R radius,
+                                          std::span<const std::uint8_t> rebuild, NeighborLists& lists) {
   const std::size_t old_n = lists.particle_count();
   SPH_CHECK(rebuild.size() == n && old_n <= n, "rebuild flags must cover every particle");
   const R r2 = radius * radius;
@@ -220,9 +264,9 @@ void ListBuilder<D, R>::rebuild_some(const UniformGrid<D, R>& grid, std::span<co
       const std::uint32_t old_begin = old_end;
       old_end = i < old_n ? lists.end_[i] : old_end;
       if (marked(i)) {
-        st.update(grid, grid.cell_of(i));
+        st.update(grid, query.cell(i));
         ensure_room(buf, at + st.candidates + kRoom);
-        at += gather(vector_, grid, st, positions[i], static_cast<std::uint32_t>(i), r2, buf.data() + at);
+        at += gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at);
       } else {
         const std::uint32_t len = old_end - old_begin;
         ensure_room(buf, at + len + kRoom);

@@ -31,11 +31,26 @@ class ListBuilder {
   void rebuild_some(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> positions, R radius,
                     std::span<const std::uint8_t> rebuild, NeighborLists& lists);
 
+  /// Boundary lists: for each query point i (queries[i], not a point of the grid), every grid
+  /// point strictly closer than `radius`, in the grid's cell order. The same kernels, storage and
+  /// guarantees as build(); `out` covers the queries (its indices are the grid's points).
+  void build_queries(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> queries, R radius, NeighborLists& out);
+  /// rebuild_some() for query lists: rebuilds the lists of the marked queries (and of every
+  /// query beyond `lists`), keeps the others.
+  void rebuild_some_queries(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> queries, R radius,
+                            std::span<const std::uint8_t> rebuild, NeighborLists& lists);
+
   /// Uses the vector kernel where the build has one (SPH_SIMD_AVX512, default) or the portable
   /// scalar one (tests check that both give the same lists).
   void use_vector_kernel(bool on) { vector_ = on; }
 
  private:
+  template <class Query>
+  void build_with(const UniformGrid<D, R>& grid, std::size_t n, const Query& query, R radius, NeighborLists& out);
+  template <class Query>
+  void rebuild_some_with(const UniformGrid<D, R>& grid, std::size_t n, const Query& query, R radius,
+                         std::span<const std::uint8_t> rebuild, NeighborLists& lists);
+
   bool vector_ = true;
   std::vector<std::size_t> chunk_entries_;
   std::vector<std::vector<std::uint32_t>> old_copy_;  // rebuild_some: one per thread

@@ -49,10 +49,11 @@ void NeighborLists::save(StateWriter& out) const {
   }
 }
 
-void NeighborLists::load(StateReader& in) {
+void NeighborLists::load(StateReader& in, std::size_t index_limit) {
   clear();
   in.get(end_);
   const std::size_t n = end_.size();
+  const std::size_t limit = index_limit > 0 ? index_limit : n;
   chunks_.resize(chunk_count(n));
   for (std::size_t c = 0; c < chunks_.size(); ++c) {
     const std::size_t first = c * kChunkSize, last = std::min(n, first + kChunkSize) - 1;
@@ -61,7 +62,7 @@ void NeighborLists::load(StateReader& in) {
     std::vector<std::uint32_t>& chunk = chunks_[c];
     in.get(chunk);
     in.expect(chunk.size() == end_[last], "a neighbor list chunk of the wrong length");
-    for (std::uint32_t j : chunk) in.expect(j < n, "a neighbor index out of range");
+    for (std::uint32_t j : chunk) in.expect(j < limit, "a neighbor index out of range");
     entries_ += chunk.size();
     chunk.resize(chunk.size() + kPadding, 0);
   }

@@ -55,8 +55,9 @@ class NeighborLists {
   /// Writes the lists (not the spare room) for a checkpoint.
   void save(StateWriter& out) const;
   /// Replaces the lists with what save() wrote; throws sph::Error if they are inconsistent
-  /// (an index out of range, offsets that go backwards).
-  void load(StateReader& in);
+  /// (an index out of range, offsets that go backwards). Indices are of the listed particles
+  /// themselves, or (index_limit > 0: boundary lists) below index_limit.
+  void load(StateReader& in, std::size_t index_limit = 0);
 
   /// The same lists, in the same order (storage layout and spare room do not matter).
   friend bool operator==(const NeighborLists& a, const NeighborLists& b);

@@ -18,6 +18,7 @@ class StandardNeighbors final : public NeighborStrategy<D, R> {
   void invalidate() override {}  // every update rebuilds everything anyway
 
  private:
+  R list_radius() const override { return radius_; }
   R radius_;
   UniformGrid<D, R> grid_;
   ListBuilder<D, R> builder_;
@@ -33,17 +34,24 @@ class BruteForceNeighbors final : public NeighborStrategy<D, R> {
   NeighborMode mode() const override { return NeighborMode::BruteForce; }
   void update(const ParticleSet<D, R>& particles) override;
   const NeighborLists& lists() const override { return lists_; }
+  const NeighborLists& boundary_lists() const override { return boundary_lists_; }
   const NeighborCounters& counters() const override { return counters_; }
   void invalidate() override {}  // every update rebuilds everything anyway
 
  private:
+  R list_radius() const override { return radius_; }
   R radius_;
-  NeighborLists lists_;
+  NeighborLists lists_, boundary_lists_;
   NeighborCounters counters_;
 };
 
 /// Brute-force lists of `positions` within `radius` (strictly closer), sorted by index.
 template <int D, std::floating_point R>
 NeighborLists brute_force_lists(std::span<const Vec<D, R>> positions, R radius);
+/// Every sample closer than `radius` to each query point, by testing every pair (brute-force
+/// boundary lists: the reference the grid's are tested against).
+template <int D, std::floating_point R>
+NeighborLists brute_force_query_lists(std::span<const Vec<D, R>> queries, std::span<const Vec<D, R>> samples,
+                                      R radius);
 
 }  // namespace sph

@@ -5,6 +5,7 @@
 #include <span>
 
 #include <sph/core/particle_set.h>
+#include <sph/neighbors/boundary_lists.h>
 #include <sph/neighbors/neighbor_lists.h>
 #include <sph/neighbors/neighbor_mode.h>
 
@@ -17,6 +18,7 @@ class StateReader;
 struct NeighborCounters {
   std::uint64_t lists_rebuilt = 0;  ///< particles whose list was rebuilt this step
   std::uint64_t pairs_stored = 0;   ///< directed entries stored in all lists
+  std::uint64_t boundary_pairs_stored = 0;  ///< entries stored in the boundary lists
   double grid_seconds = 0;          ///< wall time spent building the grid
   double lists_seconds = 0;         ///< wall time spent building lists
 };
@@ -42,6 +44,17 @@ class NeighborStrategy {
   /// since the last call (emitters); none are removed.
   virtual void update(const ParticleSet<D, R>& particles) = 0;
   virtual const NeighborLists& lists() const = 0;
+
+  /// Static boundary samples (boundary particles): from now on every update() also keeps
+  /// boundary_lists(), each fluid particle's samples closer than h, by the strategy's own rule:
+  /// standard rebuilds them every step; adaptive rebuilds a particle's boundary list with its
+  /// fluid list, and the Eq. 7 test flags a particle for its fluid-boundary pairs too; verlet
+  /// lists the samples within h + skin and rebuilds them with the fluid lists. Called before
+  /// the first update; the samples never move.
+  void set_boundary(std::span<const Vec<D, R>> samples) { boundary_.set_samples(samples, list_radius()); }
+  /// Each particle's boundary samples (indices into the samples); no lists without samples.
+  virtual const NeighborLists& boundary_lists() const { return boundary_.lists(); }
+  std::span<const Vec<D, R>> boundary_samples() const { return boundary_.samples(); }
   /// Counters of the last update().
   virtual const NeighborCounters& counters() const = 0;
 
@@ -66,6 +79,11 @@ class NeighborStrategy {
     (void)in;
     (void)particles;
   }
+
+ protected:
+  /// The radius the lists hold pairs within (h; verlet: h + skin).
+  virtual R list_radius() const = 0;
+  BoundaryLists<D, R> boundary_;
 };
 
 /// Creates the strategy for `mode`. Throws sph::Error for a mode this build cannot run.

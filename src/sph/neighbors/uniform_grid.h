@@ -29,6 +29,20 @@ class UniformGrid {
 
   /// Cell (linear index) of point i, as built.
   std::uint32_t cell_of(std::size_t i) const { return cell_of_[i]; }
+  /// The cell whose stencil holds every grid point within the radius of x, for a query point x
+  /// that is not one of the grid's points (boundary lists: fluid particles against the grid of
+  /// the boundary samples). A point outside the grid's box maps to the nearest cell on its edge,
+  /// whose stencil still holds every point within the radius (cells are at least the radius).
+  std::uint32_t cell_containing(const V& x) const {
+    std::array<std::int64_t, D> c;
+    for (int d = 0; d < D; ++d) {
+      // Clamped before the conversion, so that a far-away (or non-finite) x is well defined.
+      const R t = (x[d] - origin_[d]) * inv_cell_;
+      const R last = static_cast<R>(dims_[d] - 1);
+      c[d] = t >= R(0) ? static_cast<std::int64_t>(t < last ? t : last) : 0;
+    }
+    return static_cast<std::uint32_t>(linear(c));
+  }
   /// Point indices in cell-sorted order (stable within a cell), followed by kPad zeros.
   const std::uint32_t* sorted() const { return sorted_.data(); }
   /// Coordinate d of the points in cell-sorted order, followed by kPad zeros: candidates of

@@ -43,12 +43,16 @@ void VerletNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
     grid_.build(particles.position, r);
     counters_.grid_seconds = watch.lap();
     builder_.build(grid_, particles.position, r, lists_);
+    // The samples do not move: a fluid particle that moved less than the skin since this build
+    // still lists every sample within h.
+    this->boundary_.build(particles.position);
     built_at_.assign(particles.position.begin(), particles.position.end());
     max_disp_ = 0;
     counters_.lists_rebuilt = n;
   }
   counters_.lists_seconds = watch.lap();
   counters_.pairs_stored = lists_.entry_count();
+  counters_.boundary_pairs_stored = this->boundary_.lists().entry_count();
 }
 
 template <int D, std::floating_point R>
@@ -56,6 +60,7 @@ void VerletNeighbors<D, R>::save_state(StateWriter& out) const {
   out.put(max_disp_);
   out.put(built_at_);
   lists_.save(out);
+  this->boundary_.save(out);
 }
 
 template <int D, std::floating_point R>
@@ -63,6 +68,7 @@ void VerletNeighbors<D, R>::load_state(StateReader& in, std::size_t particles) {
   in.get(max_disp_);
   in.get(built_at_);
   lists_.load(in);
+  this->boundary_.load(in, particles);
   in.expect(built_at_.size() <= particles && lists_.particle_count() <= particles,
             "verlet neighbor state does not match the particles");
 }

@@ -29,6 +29,7 @@ class VerletNeighbors final : public NeighborStrategy<D, R> {
   R max_displacement() const { return max_disp_; }
 
  private:
+  R list_radius() const override { return radius_ + skin_; }
   R radius_, skin_;
   R max_disp_ = 0;
   std::vector<Vec<D, R>> built_at_;  // positions at the last build

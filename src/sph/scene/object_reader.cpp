@@ -65,6 +65,14 @@ double ObjectReader::positive(const std::string& key, const std::string& what, s
   return x;
 }
 
+bool ObjectReader::boolean(const std::string& key, const std::string& what, bool def) {
+  check_file_value(key, [&](ObjectReader& r) { r.boolean(key, what, def); });
+  const json* v = find(key);
+  if (!v) return def;
+  if (!v->is_boolean()) ctx_.fail(child(key), "expected " + what + " (true or false), got " + describe(*v));
+  return v->get<bool>();
+}
+
 std::int64_t ObjectReader::integer(const std::string& key, const std::string& what, std::int64_t min, std::int64_t max,
                                    std::optional<std::int64_t> def) {
   check_file_value(key, [&](ObjectReader& r) { r.integer(key, what, min, max, def); });

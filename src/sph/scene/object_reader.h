@@ -56,6 +56,8 @@ class ObjectReader {
   std::int64_t integer(const std::string& key, const std::string& what, std::int64_t min, std::int64_t max,
                        std::optional<std::int64_t> def = {});
   std::string string(const std::string& key, const std::string& what, std::optional<std::string> def = {});
+  /// true or false.
+  bool boolean(const std::string& key, const std::string& what, bool def);
   /// One of `choices` (strings).
   std::string choice(const std::string& key, const std::vector<std::string>& choices, const std::string& def);
   /// An optional array of distinct strings, each one of `choices`; nullopt if absent.

@@ -26,6 +26,9 @@ struct OutputDesc {
   std::vector<FrameFormat> formats{FrameFormat::Vtu};  ///< each frame in each of these formats
   std::vector<std::string> fields{std::begin(kFrameFieldNames),
                                   std::end(kFrameFieldNames)};  ///< in kFrameFieldNames order
+  /// Write the boundary particles (their positions and psi) once, as boundary.vtu in the run
+  /// directory (Configuration.outputBoundary).
+  bool boundary = false;
 
   friend bool operator==(const OutputDesc&, const OutputDesc&) = default;
 };

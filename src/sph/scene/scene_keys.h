@@ -26,10 +26,11 @@ inline const std::vector<std::string> kRootKeys{"version",     "name",          
                                                 "FluidBlocks", "Obstacles",     "Emitters"};
 inline const std::vector<std::string> kConfigurationKeys{
     "precision",   "timeStepSize",  "numberOfSteps",     "stopAt",     "particleRadius", "kernelRadius",
-    "gravitation", "neighbors",     "fullRebuildPeriod", "verletSkin", "reorderPeriod",  "outputEveryNSteps",
-    "outputFps",   "outputFormats", "outputFields"};
-inline const std::vector<std::string> kFluidKeys{
-    "density0", "stiffness", "viscosity", "negativePressure", "pressureForce", "gradientCorrection", "particleMass"};
+    "gravitation", "neighbors",     "fullRebuildPeriod", "verletSkin", "reorderPeriod",  "boundaryHandling",
+    "boundaryFriction", "kernel", "outputEveryNSteps", "outputFps", "outputFormats", "outputFields", "outputBoundary"};
+inline const std::vector<std::string> kFluidKeys{"density0",         "stiffness",      "viscosity",
+                                                 "viscosityModel",   "artificialViscosityAlpha", "negativePressure",
+                                                 "pressureForce",    "gradientCorrection",       "particleMass"};
 inline const std::vector<std::string> kContainerKeys{"start", "end", "wallStiffness", "wallDamping"};
 inline const std::vector<std::string> kFluidBlockKeys{"start", "end", "velocity"};
 inline const std::vector<std::string> kObstacleKeys{"start", "end"};
@@ -58,6 +59,12 @@ inline constexpr Named<PressureForce> kPressureForceNames[] = {{PressureForce::P
                                                                {PressureForce::Variational, "variational"}};
 inline constexpr Named<GradientCorrection> kGradientCorrectionNames[] = {
     {GradientCorrection::None, "none"}, {GradientCorrection::Renormalize, "renormalize"}};
+inline constexpr Named<BoundaryHandling> kBoundaryHandlingNames[] = {{BoundaryHandling::Penalty, "penalty"},
+                                                                     {BoundaryHandling::Particles, "particles"}};
+inline constexpr Named<KernelKind> kKernelNames[] = {
+    {KernelKind::Paper, "paper"}, {KernelKind::Cubic, "cubic"}, {KernelKind::Wendland, "wendland"}};
+inline constexpr Named<ViscosityModel> kViscosityModelNames[] = {{ViscosityModel::Paper, "paper"},
+                                                                 {ViscosityModel::Artificial, "artificial"}};
 
 /// The names of a table, in its order (the order messages list them in).
 template <class E, std::size_t N>

@@ -41,6 +41,9 @@ struct Derived {
   bool wall_damping = false;
 };
 
+/// Configuration.boundaryHandling of a scene that does not say (docs/validation.md, "Boundaries").
+constexpr const char* kDefaultBoundaryHandling = "penalty";
+
 /// The largest kernel support h accepted, in particle spacings (2 * particleRadius).
 constexpr double kMaxKernelSpacings = 10;
 
@@ -95,6 +98,7 @@ void read_output(ObjectReader& c, SceneDesc& desc) {
     for (const std::string& name : all)  // in kFrameFieldNames order, whatever the file's
       if (std::find(fields->begin(), fields->end(), name) != fields->end()) out.fields.push_back(name);
   }
+  out.boundary = c.boolean("outputBoundary", "whether to write the boundary particles as boundary.vtu", false);
 }
 
 /// The Configuration object: time step, steps, particle and kernel radii, gravity, the neighbor
@@ -132,6 +136,14 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
   sim.reorder_period = static_cast<int>(
       c.integer("reorderPeriod", "a whole number of steps, 0 or more (0: never reorder particles in memory)", 0,
                 1'000'000'000, sim.full_rebuild_period));
+  using detail::names_of, detail::value_named;
+  sim.boundary.handling =
+      value_named(detail::kBoundaryHandlingNames,
+                  c.choice("boundaryHandling", names_of(detail::kBoundaryHandlingNames), kDefaultBoundaryHandling));
+  sim.boundary.friction = c.positive(
+      "boundaryFriction", "a boundary friction sigma >= 0 (Akinci et al. 2012; 0: free slip)", sim.boundary.friction,
+      true);
+  sim.fluid.kernel = value_named(detail::kKernelNames, c.choice("kernel", names_of(detail::kKernelNames), "paper"));
   sim.verlet_skin = c.positive("verletSkin", "a positive verlet skin in metres (default 0.1 h)",
                                kDefaultSkinFraction * sim.kernel_radius);
   // Only the verlet mode uses the skin; in the other modes it is read (positive) and has no effect.
@@ -188,6 +200,11 @@ void read_fluid(ObjectReader& f, SimulationParams<D>& sim, Derived& derived) {
     sim.fluid.stiffness = f.positive("stiffness", "a positive EOS stiffness k in m^2/s^2 (p = k (rho - rho0))");
   derived.viscosity = !f.find("viscosity");
   if (!derived.viscosity) sim.fluid.viscosity = f.positive("viscosity", "a viscosity >= 0 in Pa s", 0.0, true);
+  sim.fluid.viscosity_model = value_named(
+      detail::kViscosityModelNames, f.choice("viscosityModel", names_of(detail::kViscosityModelNames), "paper"));
+  sim.fluid.alpha = f.positive("artificialViscosityAlpha",
+                               "Monaghan's artificial viscosity coefficient alpha >= 0 (typical: 0.01 to 0.1)",
+                               kArtificialViscosityAlpha, true);
   sim.fluid.negative_pressure = value_named(
       detail::kNegativePressureNames, f.choice("negativePressure", names_of(detail::kNegativePressureNames), "clamp"));
   sim.fluid.pressure_force = value_named(detail::kPressureForceNames,
@@ -200,7 +217,8 @@ void read_fluid(ObjectReader& f, SimulationParams<D>& sim, Derived& derived) {
     return;
   }
   // Extreme scales (h^9 in the kernel's normalization) can overflow to inf or NaN.
-  sim.particle_mass = lattice_mass<D>(sim.fluid.rest_density, 2.0 * sim.particle_radius, sim.kernel_radius);
+  sim.particle_mass =
+      lattice_mass<D>(sim.fluid.rest_density, 2.0 * sim.particle_radius, sim.kernel_radius, sim.fluid.kernel);
   if (!(std::isfinite(sim.particle_mass) && sim.particle_mass > 0))
     f.ctx().fail(f.child("particleMass"),
                  fmt::format("the default particle mass computed from density0 = {:g}, particleRadius = {:g} and "
@@ -355,7 +373,8 @@ void resolve_defaults(const detail::ReadContext& ctx, SceneBody<D>& body, const 
 template <int D>
 void warn_from_scales(SceneDesc& desc, const SimulationParams<D>& sim, const Derived& derived, const SceneScales& s) {
   const double r = sim.particle_radius, k = sim.fluid.stiffness, kw = sim.walls.stiffness;
-  if (!derived.wall_stiffness && kw < least_holding_wall_stiffness(s, r, k)) {
+  if (sim.boundary.handling == BoundaryHandling::Penalty && !derived.wall_stiffness &&
+      kw < least_holding_wall_stiffness(s, r, k)) {
     const double v = wall_impact_speed(s, k);
     desc.warnings.push_back(fmt::format(
         "Container.wallStiffness = {:g} is too low for this scene: the {:.3g} m head of fluid pushes the bottom "
@@ -364,7 +383,7 @@ void warn_from_scales(SceneDesc& desc, const SimulationParams<D>& sim, const Der
         "{:.3g} would hold them (the default, docs/reliability.md \"Defaults\")",
         kw, s.head, s.gravity * s.head / (2 * r * kw) / r, v, v / std::sqrt(kw) / r, default_wall_stiffness(s, r, k)));
   }
-  if (!derived.viscosity && sim.fluid.viscosity == 0)
+  if (sim.fluid.viscosity_model == ViscosityModel::Paper && !derived.viscosity && sim.fluid.viscosity == 0)
     desc.warnings.push_back(fmt::format(
         "Fluid.viscosity = 0: nothing damps the pressure waves inside the fluid (wall damping acts only at the "
         "walls), so the run may heat up and blow up; viscosity = {:.3g} (the default: Monaghan's artificial "

@@ -57,10 +57,14 @@ OrderedJson configuration_json(const SceneDesc& desc, const SimulationParams<D>&
       .put("fullRebuildPeriod", sim.full_rebuild_period)
       .put("verletSkin", sim.verlet_skin)
       .put("reorderPeriod", sim.reorder_period)
+      .put("boundaryHandling", detail::name_of(detail::kBoundaryHandlingNames, sim.boundary.handling))
+      .put("boundaryFriction", sim.boundary.friction)
+      .put("kernel", detail::name_of(detail::kKernelNames, sim.fluid.kernel))
       .put("outputEveryNSteps", out.every_steps)
       .put("outputFps", out.fps)
       .put("outputFormats", std::move(formats))
-      .put("outputFields", out.fields);
+      .put("outputFields", out.fields)
+      .put("outputBoundary", out.boundary);
   return w.take();
 }
 
@@ -71,6 +75,8 @@ OrderedJson fluid_json(const SimulationParams<D>& sim) {
   w.put("density0", f.rest_density)
       .put("stiffness", f.stiffness)
       .put("viscosity", f.viscosity)
+      .put("viscosityModel", detail::name_of(detail::kViscosityModelNames, f.viscosity_model))
+      .put("artificialViscosityAlpha", f.alpha)
       .put("negativePressure", detail::name_of(detail::kNegativePressureNames, f.negative_pressure))
       .put("pressureForce", detail::name_of(detail::kPressureForceNames, f.pressure_force))
       .put("gradientCorrection", detail::name_of(detail::kGradientCorrectionNames, f.gradient_correction))

@@ -6,6 +6,7 @@
 #include <limits>
 #include <vector>
 
+#include <sph/core/kernels.h>
 #include <sph/core/vec.h>
 #include <sph/neighbors/strategy.h>
 
@@ -52,6 +53,17 @@ enum class GradientCorrection {
   Renormalize,
 };
 
+/// How the fluid's viscosity is discretized.
+enum class ViscosityModel {
+  /// Paper Eq. 6: mu (v_j - v_i) / (rho_i rho_j) times the viscosity kernel's Laplacian (with the
+  /// cubic and Wendland kernels, Morris et al. 1997's Laplacian from the kernel gradient); default.
+  Paper,
+  /// Monaghan's (1992) artificial viscosity, Pi_ij = -alpha c0 h mu_ij / rho_ij for approaching
+  /// pairs (mu_ij = v_ij . x_ij / (|x_ij|^2 + 0.01 h^2), rho_ij the mean density, h the kernel
+  /// support), as a pressure-like pair term; FluidParams::alpha. The engineering codes' default.
+  Artificial,
+};
+
 /// Weakly compressible fluid: EOS p = k (rho - rho0).
 struct FluidParams {
   double rest_density = 1000;  ///< rho0, kg/m^D
@@ -60,6 +72,9 @@ struct FluidParams {
   NegativePressure negative_pressure = NegativePressure::Clamp;
   PressureForce pressure_force = PressureForce::Paper;
   GradientCorrection gradient_correction = GradientCorrection::None;
+  KernelKind kernel = KernelKind::Paper;  ///< the smoothing kernels of density, gradient and viscosity
+  ViscosityModel viscosity_model = ViscosityModel::Paper;
+  double alpha = 0.1;  ///< ViscosityModel::Artificial's coefficient (Monaghan 1992)
 
   friend bool operator==(const FluidParams&, const FluidParams&) = default;
 };
@@ -72,6 +87,22 @@ struct WallParams {
   double damping = 100;    ///< 1/s
 
   friend bool operator==(const WallParams&, const WallParams&) = default;
+};
+
+/// What the container's walls and the obstacles are to the fluid.
+enum class BoundaryHandling {
+  Penalty,    ///< damped penalty springs (WallParams), the paper's walls
+  Particles,  ///< boundary particles (Akinci et al. 2012): solids sampled by static particles (boundary.h)
+};
+
+/// Boundary particles' settings.
+struct BoundaryParams {
+  BoundaryHandling handling = BoundaryHandling::Penalty;
+  /// Akinci et al. 2012's boundary viscosity sigma: nu = sigma h c0 / (2 rho_i) on approaching
+  /// fluid-boundary pairs (0: free slip).
+  double friction = 0.2;
+
+  friend bool operator==(const BoundaryParams&, const BoundaryParams&) = default;
 };
 
 /// An emitter: a rectangular nozzle of width x height particles (height ignored in 2D) at
@@ -102,7 +133,8 @@ struct SimulationParams {
   double particle_mass = 0;       ///< kg (same for all particles)
   Vec<D, double> gravity{};       ///< m/s^2
   FluidParams fluid;
-  WallParams walls;
+  WallParams walls;  ///< BoundaryHandling::Penalty's springs
+  BoundaryParams boundary;
   Box<D> container;               ///< closed box holding the fluid
   std::vector<Box<D>> obstacles;  ///< static solid boxes
   std::vector<EmitterParams<D>> emitters;

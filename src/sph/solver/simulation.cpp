@@ -11,6 +11,7 @@
 #include <sph/core/state_stream.h>
 #include <sph/core/timer.h>
 #include <sph/solver/nozzle.h>
+#include <sph/solver/smoothing.h>
 #include <sph/solver/wcsph.h>
 
 namespace sph {
@@ -44,7 +45,8 @@ class HealthProbe {
         tol_(kOutsideTolerance * 2.0 * p.particle_radius),
         r_(p.particle_radius),
         w0_(w0),
-        tension_(p.fluid.negative_pressure == NegativePressure::Allow) {
+        tension_(p.fluid.negative_pressure == NegativePressure::Allow),
+        springs_(p.boundary.handling == BoundaryHandling::Penalty) {
     for (int d = 0; d < D; ++d) low_ += std::max(p.gravity[d] * p.container.lo[d], p.gravity[d] * p.container.hi[d]);
   }
 
@@ -56,7 +58,9 @@ class HealthProbe {
     double out = -kNoLimit, springs = 0;  // signed distance past the container's planes
     for (int d = 0; d < D; ++d) {
       out = std::max({out, p_.container.lo[d] - x[d], x[d] - p_.container.hi[d]});
-      springs += squared_positive(p_.container.lo[d] + r_ - x[d]) + squared_positive(x[d] - (p_.container.hi[d] - r_));
+      if (springs_)
+        springs +=
+            squared_positive(p_.container.lo[d] + r_ - x[d]) + squared_positive(x[d] - (p_.container.hi[d] - r_));
     }
     if (out > tol_) ++c.outside;
     if (out > 0 && out > c.outside_depth) c.outside_depth = out, c.outside_i = i;
@@ -68,7 +72,7 @@ class HealthProbe {
       }
       if (in > tol_) ++c.inside;
       if (in > 0 && in > c.inside_depth) c.inside_depth = in, c.inside_i = i;
-      springs += squared_positive(grown);
+      if (springs_) springs += squared_positive(grown);
     }
     const double ratio = static_cast<double>(rho) / p_.fluid.rest_density;
     if constexpr (kInternal)
@@ -89,6 +93,7 @@ class HealthProbe {
   double tol_, r_, low_ = 0;
   R w0_;
   bool tension_;
+  bool springs_;  // penalty walls: their springs' energy counts
 };
 
 }  // namespace
@@ -97,6 +102,7 @@ template <int D, std::floating_point R>
 Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> particles)
     : params_(std::move(params)),
       particles_(std::move(particles)),
+      boundary_(make_boundary<D, R>(params_)),
       emitters_(params_.emitters.size()),
       monitor_(health_scene(params_), params_.health_failures) {
   NeighborOptions opt;
@@ -105,14 +111,17 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
   opt.verlet_skin = params_.verlet_skin;
   SPH_CHECK(params_.reorder_period >= 0, "reorder period must be >= 0");
   neighbors_ = make_neighbor_strategy<D, R>(params_.neighbors, opt);
+  neighbors_->set_boundary(boundary_.position);
   if (params_.audit) auditor_ = std::make_unique<ListAuditor<D, R>>();
   reserve_for_emitters();
   // Density and pressure of the initial state, so that frame 0 shows real values. Exact lists
   // from a throwaway standard strategy: the run's own strategy starts at step 0.
   if (!particles_.empty()) {
     auto exact = make_neighbor_strategy<D, R>(NeighborMode::Standard, opt);
+    exact->set_boundary(boundary_.position);
     exact->update(particles_);
-    compute_density_pressure(particles_, exact->lists(), static_cast<R>(params_.kernel_radius), params_.fluid);
+    compute_density_pressure(particles_, exact->lists(), static_cast<R>(params_.kernel_radius), params_.fluid,
+                             boundary_view(exact->boundary_lists()));
   }
   // The initial state's energy, the reference of the energy watch (measured as each step is).
   integrate_and_check<false>(R(0));
@@ -121,6 +130,17 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
   double energy = 0, mass = 0;
   for (const detail::HealthChunk& c : health_chunks_) energy += c.energy + c.internal, mass += c.mass;
   monitor_.set_initial(energy, mass);
+}
+
+template <int D, std::floating_point R>
+BoundaryView<D, R> Simulation<D, R>::boundary_view(const NeighborLists& lists) const {
+  BoundaryView<D, R> v;
+  if (boundary_.size() == 0) return v;
+  v.position = boundary_.position;
+  v.psi = boundary_.psi;
+  v.lists = &lists;
+  v.friction = static_cast<R>(params_.boundary.friction);
+  return v;
 }
 
 template <int D, std::floating_point R>
@@ -182,18 +202,21 @@ const StepInfo& Simulation<D, R>::step() {
   info.seconds.grid = info.neighbors.grid_seconds + reorder_seconds;
   info.seconds.lists = info.neighbors.lists_seconds;
   const NeighborLists& lists = neighbors_->lists();
+  const BoundaryView<D, R> solid = boundary_view(neighbors_->boundary_lists());
   if (auditor_) {
     info.audited = true;
     info.audit = auditor_->audit(particles_.position, lists, h);
+    info.boundary_audit =
+        auditor_->audit_boundary(particles_.position, boundary_.position, neighbors_->boundary_lists(), h);
   }
 
   Stopwatch watch;
-  info.pairs_within_h = compute_density_pressure(particles_, lists, h, params_.fluid);
+  info.pairs_within_h = compute_density_pressure(particles_, lists, h, params_.fluid, solid);
   info.seconds.density = watch.lap();
   const WallContact<D, R> walls(params_.container, params_.obstacles, static_cast<R>(params_.particle_radius),
-                                params_.walls);
+                                params_.walls, params_.boundary.handling == BoundaryHandling::Penalty);
   compute_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity), walls,
-                        neighbors_->pair_exit_flags(), dt);
+                        neighbors_->pair_exit_flags(), dt, solid);
   info.seconds.forces = watch.lap();
   ++steps_;  // counted even if the checks below throw (as before the passes were fused)
   info.health = integrate_and_check<true>(dt);
@@ -211,7 +234,8 @@ template <bool kIntegrate>
 HealthStats Simulation<D, R>::integrate_and_check(R dt) {
   // Symplectic Euler (v += dt a; x += dt v), the blow-up check and the health statistics in one pass.
   const std::size_t n = particles_.size();
-  const HealthProbe<D, R> probe(params_, Poly6Kernel<D, R>(static_cast<R>(params_.kernel_radius)).w_zero());
+  const HealthProbe<D, R> probe(
+      params_, SmoothingKernels<D, R>(params_.fluid.kernel, static_cast<R>(params_.kernel_radius)).w_zero());
   health_chunks_.assign(chunk_count(n), detail::HealthChunk{});
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     detail::HealthChunk& chunk = health_chunks_[c];

@@ -8,8 +8,10 @@
 #include <sph/neighbors/audit.h>
 #include <sph/neighbors/reorder.h>
 #include <sph/neighbors/strategy.h>
+#include <sph/solver/boundary.h>
 #include <sph/solver/health.h>
 #include <sph/solver/params.h>
+#include <sph/solver/wcsph.h>
 
 namespace sph {
 
@@ -34,6 +36,7 @@ struct StepInfo {
   std::uint64_t pairs_within_h = 0;  ///< listed (directed) pairs closer than h this step
   bool audited = false;              ///< SimulationParams::audit was on: `audit` is filled
   ListAudit audit;                   ///< pairs within h that the lists missed this step
+  ListAudit boundary_audit;          ///< fluid-boundary pairs within h the boundary lists missed
   PhaseTimes seconds;                ///< (the audit's own time is in none of the phases)
   HealthStats health;                ///< measured in the integrate pass, judged by the health monitor
 };
@@ -62,8 +65,9 @@ struct EmitterState {
 ///      the end of the particle arrays,
 ///   2. the neighbor strategy updates the lists (grid + lists phases),
 ///   3. density and pressure (Eq. 4, EOS),
-///   4. pressure, viscous, gravity and wall accelerations (Eq. 5, 6), with the Eq. 7 test if
-///      the strategy asks for it (the force pass gathers every neighbor's velocity anyway),
+///   4. pressure, viscous, gravity and wall accelerations (Eq. 5, 6; penalty springs or the
+///      boundary particles' terms), with the Eq. 7 test if the strategy asks for it (the force
+///      pass gathers every neighbor's velocity anyway),
 ///   5. symplectic Euler integration, then a check that every value is finite; the same pass
 ///      measures the health statistics (StepInfo::health), which the health monitor judges.
 template <int D, std::floating_point R>
@@ -84,6 +88,8 @@ class Simulation {
   const ParticleSet<D, R>& particles() const { return particles_; }
   const SimulationParams<D>& params() const { return params_; }
   const NeighborStrategy<D, R>& neighbors() const { return *neighbors_; }
+  /// The boundary particles (empty with penalty walls).
+  const BoundarySet<D, R>& boundary() const { return boundary_; }
   std::int64_t steps_done() const { return steps_; }
   double time() const { return static_cast<double>(steps_) * params_.time_step; }
   const StepInfo& last_step() const { return info_; }
@@ -115,6 +121,8 @@ class Simulation {
  private:
   std::size_t emit();
   void reserve_for_emitters();
+  /// What the passes see of the boundary particles, with `lists` as their lists.
+  BoundaryView<D, R> boundary_view(const NeighborLists& lists) const;
   /// Integrates (symplectic Euler; none with kIntegrate false), checks every value (throws on a
   /// blow-up) and measures the health statistics, in one pass.
   template <bool kIntegrate>
@@ -124,6 +132,7 @@ class Simulation {
 
   SimulationParams<D> params_;
   ParticleSet<D, R> particles_;
+  BoundarySet<D, R> boundary_;
   std::unique_ptr<NeighborStrategy<D, R>> neighbors_;
   std::unique_ptr<ListAuditor<D, R>> auditor_;
   MortonOrder<D, R> morton_;

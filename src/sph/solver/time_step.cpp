@@ -19,12 +19,22 @@ std::vector<TimeStepLimit> time_step_limits(const SimulationParams<D>& p) {
   const double c = std::sqrt(p.fluid.stiffness);
   if (c > 0) add("acoustic CFL (dt <= 0.4 h / sqrt(stiffness))", 0.4 * h / c, 1.0 * h / c);
   const double nu = p.fluid.viscosity / p.fluid.rest_density;
-  if (nu > 0) add("viscous diffusion (dt <= 0.125 h^2 rho0 / viscosity)", 0.125 * h * h / nu, 0.5 * h * h / nu);
-  if (p.walls.stiffness > 0) {
+  if (p.fluid.viscosity_model == ViscosityModel::Paper && nu > 0)
+    add("viscous diffusion (dt <= 0.125 h^2 rho0 / viscosity)", 0.125 * h * h / nu, 0.5 * h * h / nu);
+  // Artificial viscosity's diffusion, nu = alpha h c / (2 (D + 2)) (Monaghan 2005), is below the
+  // acoustic limit's for alpha < 1; it is checked the same way.
+  const double nu_art = p.fluid.alpha * h * c / (2.0 * (D + 2));
+  if (p.fluid.viscosity_model == ViscosityModel::Artificial && nu_art > 0)
+    add("artificial viscosity's diffusion (dt <= 0.125 h^2 / nu, nu = alpha h c0 / (2 (D + 2)))",
+        0.125 * h * h / nu_art, 0.5 * h * h / nu_art);
+  // Penalty walls only: boundary particles act through the pressure (the acoustic limit).
+  const bool springs = p.boundary.handling == BoundaryHandling::Penalty;
+  if (springs && p.walls.stiffness > 0) {
     const double w = std::sqrt(p.walls.stiffness);
     add("wall spring (dt <= 0.5 / sqrt(wall stiffness))", 0.5 / w, 1.5 / w);
   }
-  if (p.walls.damping > 0) add("wall damping (dt <= 0.5 / wall damping)", 0.5 / p.walls.damping, 1.5 / p.walls.damping);
+  if (springs && p.walls.damping > 0)
+    add("wall damping (dt <= 0.5 / wall damping)", 0.5 / p.walls.damping, 1.5 / p.walls.damping);
   const double g = norm(p.gravity);
   if (g > 0) add("gravity (dt <= 0.25 sqrt(h / |g|))", 0.25 * std::sqrt(h / g), std::sqrt(h / g));
   return out;

@@ -8,6 +8,7 @@
 #include <sph/core/kernels.h>
 #include <sph/core/parallel.h>
 #include <sph/core/simd.h>
+#include <sph/solver/smoothing.h>
 
 namespace sph {
 
@@ -17,9 +18,13 @@ using simd::Mask;
 
 /// The scalars of a vector field, x0 y0 z0 x1 y1 z1 ..., so that pair loops gather lanes.
 template <int D, std::floating_point R>
-const R* flat(const std::vector<Vec<D, R>>& v) {
+const R* flat(std::span<const Vec<D, R>> v) {
   static_assert(sizeof(Vec<D, R>) == D * sizeof(R));
   return reinterpret_cast<const R*>(v.data());
+}
+template <int D, std::floating_point R>
+const R* flat(const std::vector<Vec<D, R>>& v) {
+  return flat(std::span<const Vec<D, R>>(v));
 }
 
 /// What the pair loops assume: lists for exactly these particles, and indices times D that fit
@@ -28,6 +33,15 @@ template <int D, std::floating_point R>
 void check_pass_inputs(const ParticleSet<D, R>& ps, const NeighborLists& lists) {
   SPH_CHECK(lists.particle_count() == ps.size(), "neighbor lists do not cover the particles");
   SPH_CHECK(ps.size() * D < (std::size_t{1} << 31), "too many particles for 32-bit gather offsets");
+}
+
+/// What the boundary terms assume: a boundary list per particle, indices below the samples
+/// (checked when the lists are built and loaded), and sample offsets that fit the gathers.
+template <int D, std::floating_point R>
+void check_boundary_inputs(const ParticleSet<D, R>& ps, const BoundaryView<D, R>& boundary) {
+  SPH_CHECK(boundary.lists->particle_count() == ps.size(), "boundary lists do not cover the particles");
+  SPH_CHECK(boundary.psi.size() == boundary.position.size(), "one psi per boundary sample");
+  SPH_CHECK(boundary.position.size() * D < (std::size_t{1} << 31), "too many boundary samples for 32-bit gather offsets");
 }
 
 /// rij = x_i - x_j for one register of neighbors j = idx[0..lanes), gathered from the flat
@@ -49,40 +63,112 @@ simd::Pack<R> pair_offsets(const simd::Pack<R> (&xi)[D], const R* pos, const std
 /// end. Lanes past the end of a list load some valid index (NeighborLists::kPadding) and are
 /// masked out. The result is the same for any thread count and with or without AVX-512.
 
+/// The cubic spline's and Wendland C2's W and gradient factor (dW/dr) / r on a register of
+/// distances r < h (kernels.h's formulas and constants; lanes at or beyond h are the caller's
+/// to mask). The paper's kernels are written out in the loops, which need no square root for
+/// poly6.
+template <KernelKind K, int D, std::floating_point R>
+class PackKernel {
+ public:
+  using P = simd::Pack<R>;
+  explicit PackKernel(R h) : inv_h_(P::set1(R(1) / h)) {
+    if constexpr (K == KernelKind::Cubic) {
+      const CubicSplineKernel<D, R> k(h);
+      norm_ = P::set1(k.norm());
+      grad_norm_ = P::set1(k.norm() / (h * h));
+    } else {
+      const WendlandC2Kernel<D, R> k(h);
+      norm_ = P::set1(k.norm());
+      grad_norm_ = P::set1(k.norm() / (h * h));
+    }
+  }
+  P w(const P& r) const {
+    const P one = P::set1(R(1)), q = r * inv_h_, d = one - q;
+    if constexpr (K == KernelKind::Cubic) {
+      const P inner = norm_ * (P::set1(R(6)) * (q * q * q - q * q) + one);
+      const P outer = norm_ * P::set1(R(2)) * d * d * d;
+      return select(q > P::set1(R(0.5)), outer, inner);
+    } else {
+      const P d2 = d * d;
+      return norm_ * d2 * d2 * (one + P::set1(R(4)) * q);
+    }
+  }
+  P gradient_factor(const P& r) const {
+    const P one = P::set1(R(1)), q = r * inv_h_, d = one - q;
+    if constexpr (K == KernelKind::Cubic) {
+      const Mask outer = q > P::set1(R(0.5));
+      const P inner_f = grad_norm_ * (P::set1(R(18)) * q - P::set1(R(12)));
+      const P outer_f = P::set1(R(-6)) * grad_norm_ * d * d / select(outer, q, one);
+      return select(outer, outer_f, inner_f);
+    } else {
+      return P::set1(R(-20)) * grad_norm_ * d * d * d;
+    }
+  }
+
+ private:
+  P inv_h_, norm_{}, grad_norm_{};
+};
+
+/// The paper's kernels need no object: the loops write poly6, spiky and the viscosity kernel out.
 template <int D, std::floating_point R>
-std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                           std::vector<std::uint64_t>& within) {
+class PackKernel<KernelKind::Paper, D, R> {
+ public:
+  explicit PackKernel(R) {}
+};
+
+/// The density sum of one particle over one list: sum_j mass_j W(|x_i - x_j|) by lanes, with
+/// the count of pairs closer than h added to `count`.
+template <KernelKind K, int D, std::floating_point R>
+simd::Pack<R> density_sum(const simd::Pack<R> (&xi)[D], const R* pos, const R* mass, std::span<const std::uint32_t> nb,
+                          R h, std::uint64_t& count) {
   using P = simd::Pack<R>;
   constexpr int W = simd::kLanes<R>;
-  const Poly6Kernel<D, R> poly6(h);
-  const R w0 = poly6.w_zero();
-  const R h2 = h * h;
+  const P h2v = P::set1(h * h), zero = P::set1(R(0));
+  const P normv = P::set1(Poly6Kernel<D, R>(h).norm());
+  const std::uint32_t* idx = nb.data();
+  P sum = zero;
+  [[maybe_unused]] const PackKernel<K, D, R> kernel(h);
+  for (std::size_t k0 = 0; k0 < nb.size(); k0 += W) {
+    const Mask valid = simd::first_lanes<R>(nb.size() - k0);
+    P rij[D];
+    const P r2 = pair_offsets<D>(xi, pos, idx + k0, rij);
+    const Mask in = valid & (r2 < h2v);
+    if constexpr (K == KernelKind::Paper) {
+      const P dd = h2v - r2;
+      // Paper Eq. 4: m_j W_poly6 = m_j C (h^2 - r^2)^3 inside the support.
+      sum = sum + select(in, P::template gather<1>(mass, idx + k0, 0) * (normv * dd * dd * dd), zero);
+    } else {
+      const P r = sqrt(select(in, r2, zero));
+      sum = sum + select(in, P::template gather<1>(mass, idx + k0, 0) * kernel.w(r), zero);
+    }
+    count += static_cast<std::uint64_t>(__builtin_popcount(in));
+  }
+  return sum;
+}
+
+template <KernelKind K, int D, std::floating_point R>
+std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
+                           const BoundaryView<D, R>& boundary, std::vector<std::uint64_t>& within) {
+  using P = simd::Pack<R>;
+  const R w0 = SmoothingKernels<D, R>(fluid.kernel, h).w_zero();
   const R rho0 = static_cast<R>(fluid.rest_density);
   const R k = static_cast<R>(fluid.stiffness);
   const bool clamp = fluid.negative_pressure == NegativePressure::Clamp;
   const R* pos = flat(ps.position);
   const R* mass = ps.mass.data();
-  const P h2v = P::set1(h2), normv = P::set1(poly6.norm()), zero = P::set1(R(0));
+  const bool walls = boundary.active();
+  const R* bpos = walls ? flat(boundary.position) : nullptr;
+  const R* psi = boundary.psi.data();
   within.assign(chunk_count(ps.size()), 0);
   parallel_chunks(ps.size(), [&](std::size_t c, std::size_t b, std::size_t e) {
-    std::uint64_t count = 0;
+    std::uint64_t count = 0, boundary_count = 0;
     for (std::size_t i = b; i < e; ++i) {
       P xi[D];
       for (int d = 0; d < D; ++d) xi[d] = P::set1(ps.position[i][d]);
-      const auto nb = lists.of(i);
-      const std::uint32_t* idx = nb.data();
-      P sum = zero;
-      for (std::size_t k0 = 0; k0 < nb.size(); k0 += W) {
-        const Mask valid = simd::first_lanes<R>(nb.size() - k0);
-        P rij[D];
-        const P r2 = pair_offsets<D>(xi, pos, idx + k0, rij);
-        const Mask in = valid & (r2 < h2v);
-        const P dd = h2v - r2;
-        // Paper Eq. 4: m_j W_poly6 = m_j C (h^2 - r^2)^3 inside the support.
-        sum = sum + select(in, P::template gather<1>(mass, idx + k0, 0) * (normv * dd * dd * dd), zero);
-        count += static_cast<std::uint64_t>(__builtin_popcount(in));
-      }
-      const R rho = mass[i] * w0 + simd::sum_lanes(sum);
+      const P sum = density_sum<K, D>(xi, pos, mass, lists.of(i), h, count);
+      R rho = mass[i] * w0 + simd::sum_lanes(sum);
+      // Akinci et al. 2012 eq. 6: the samples' psi_b W_ib, psi in place of the mass.
+      if (walls) rho += simd::sum_lanes(density_sum<K, D>(xi, bpos, psi, boundary.lists->of(i), h, boundary_count));
       ps.density[i] = rho;
       const R p = k * (rho - rho0);
       ps.pressure[i] = clamp ? std::max(p, R(0)) : p;
@@ -94,26 +180,72 @@ std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
   return total;
 }
 
-/// The force pass: viscosity, the Eq. 7 test when kExitTest, gravity, the walls, and the pressure
-/// term of form kForm when kPressure (false with a gradient correction, whose pressure term
-/// corrected_pressure_pass adds).
-template <PressureForce kForm, bool kPressure, bool kExitTest, int D, std::floating_point R>
+/// The force pass's per-run constants.
+template <int D, std::floating_point R>
+struct ForceConstants {
+  ForceConstants(R h, const FluidParams& fluid, const BoundaryView<D, R>& boundary)
+      : h(h),
+        mu(static_cast<R>(fluid.viscosity)),
+        c0(static_cast<R>(std::sqrt(std::max(fluid.stiffness, 0.0)))),
+        artificial(fluid.viscosity_model == ViscosityModel::Artificial),
+        alpha(static_cast<R>(fluid.alpha)),
+        friction(boundary.friction) {}
+  R h, mu, c0;
+  bool artificial;
+  R alpha, friction;
+};
+
+/// The gradient factor f (grad_i W_ij = f rij) of the pressure force's kernel on a register:
+/// the spiky kernel's (poly6's for kVariational) with the paper's kernels, the density kernel's
+/// own otherwise; zero outside `near` (and, for spiky, at r = 0).
+template <KernelKind K, bool kVariational, int D, std::floating_point R>
+simd::Pack<R> gradient_factor(const PackKernel<K, D, R>* kernel, const simd::Pack<R>& r2, const simd::Pack<R>& r,
+                              Mask near, R h) {
+  using P = simd::Pack<R>;
+  const P zero = P::set1(R(0)), one = P::set1(R(1));
+  if constexpr (K == KernelKind::Paper) {
+    if constexpr (kVariational) {
+      const P d2 = P::set1(h * h) - r2;
+      return select(near, P::set1(R(-6) * Poly6Kernel<D, R>(h).norm()) * d2 * d2, zero);
+    } else {
+      const Mask apart = near & (r2 > zero);
+      const P dh = P::set1(h) - r;
+      return select(apart, P::set1(R(-3) * SpikyKernel<D, R>(h).norm()) * dh * dh / select(apart, r, one), zero);
+    }
+  } else {
+    return select(near, kernel->gradient_factor(r), zero);
+  }
+}
+
+/// The force pass: viscosity, the Eq. 7 test when kExitTest, gravity, the walls, the boundary
+/// samples, and the pressure term of form kForm when kPressure (false with a gradient
+/// correction, whose pressure term corrected_pressure_pass adds).
+template <KernelKind K, PressureForce kForm, bool kPressure, bool kExitTest, int D, std::floating_point R>
 void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                const Vec<D, R>& gravity, const WallContact<D, R>& walls, std::span<std::uint8_t> flags, R dt) {
+                const Vec<D, R>& gravity, const WallContact<D, R>& walls, std::span<std::uint8_t> flags, R dt,
+                const BoundaryView<D, R>& boundary) {
   using P = simd::Pack<R>;
   constexpr int W = simd::kLanes<R>;
+  constexpr bool kVariational = kForm == PressureForce::Variational;
   const P hv = P::set1(h), h2v = P::set1(h * h), zero = P::set1(R(0)), one = P::set1(R(1)), minus_one = P::set1(R(-1)),
           half = P::set1(R(0.5));
   const P grad_c = P::set1(R(-3) * SpikyKernel<D, R>(h).norm());
   const P grad6_c = P::set1(R(-6) * Poly6Kernel<D, R>(h).norm());
   const R lap_c = ViscosityKernel<D, R>(h).laplacian_norm();
-  const R mu = static_cast<R>(fluid.viscosity);
+  const ForceConstants<D, R> fc(h, fluid, boundary);
+  const R mu = fc.mu;
+  const P eps_h2 = P::set1(R(0.01) * h * h);  // Monaghan's and Morris's 0.01 h^2 in |x_ij|^2 + 0.01 h^2
   const R* pos = flat(ps.position);
   const R* vel = flat(ps.velocity);
   const R* rho = ps.density.data();
   const R* prs = ps.pressure.data();
   const R* mass = ps.mass.data();
+  const bool solid = boundary.active();
+  const R* bpos = solid ? flat(boundary.position) : nullptr;
+  const R* psi = boundary.psi.data();
   const P dtv = P::set1(dt);
+  const PackKernel<K, D, R> kernel_value(h);
+  const PackKernel<K, D, R>* kernel = &kernel_value;
   const auto set_flag = [&](std::size_t q) {
     std::atomic_ref<std::uint8_t>(flags[q]).store(1, std::memory_order_relaxed);
   };
@@ -128,6 +260,10 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
     const P pi_sym = P::set1(prs[i] * inv_rhoi * inv_rhoi);
     const P inv_rhoi_v = P::set1(inv_rhoi);
     const P visc_i = P::set1(mu * inv_rhoi * lap_c);
+    const P morris_i = P::set1(R(-2) * mu * inv_rhoi);
+    // Monaghan's Pi_ij = -alpha c0 h mu_ij / rho_ij, rho_ij = (rho_i + rho_j) / 2.
+    const P art_i = P::set1(R(-2) * fc.alpha * fc.c0 * h);
+    const P rhoi_v = P::set1(rho[i]);
     const auto nb = lists.of(i);
     const std::uint32_t* idx = nb.data();
     for (std::size_t k0 = 0; k0 < nb.size(); k0 += W) {
@@ -137,12 +273,15 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
       const Mask near = valid & (r2 < h2v);  // inside the support
       const P r = sqrt(select(near, r2, h2v));
       const P dh = hv - r;
-      const P inv_rhoj = one / P::template gather<1>(rho, idx + k0, 0);
+      const P rhoj = P::template gather<1>(rho, idx + k0, 0);
+      const P inv_rhoj = one / rhoj;
       const P mj = P::template gather<1>(mass, idx + k0, 0);
+      P vj[D];
+      for (int d = 0; d < D; ++d) vj[d] = P::template gather<D>(vel, idx + k0, d);
       // -m_j P_ij times the spiky gradient -3 C (h - r)^2 rij / r (Eq. 5), and the viscosity
       // term mu m_j (v_j - v_i) C_lap (h - r) / (rho_i rho_j) (Eq. 6).
       // Variational: the density kernel's gradient -6 C6 (h^2 - r^2)^2 rij instead.
-      P fp = zero;
+      P fp = zero, fv = zero;
       if constexpr (kPressure) {
         const P pj = P::template gather<1>(prs, idx + k0, 0);
         P pij;
@@ -150,7 +289,9 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
           pij = (pi_half + half * pj * inv_rhoi_v) * inv_rhoj;
         else
           pij = pi_sym + pj * inv_rhoj * inv_rhoj;
-        if constexpr (kForm == PressureForce::Variational) {
+        if constexpr (K != KernelKind::Paper) {
+          fp = gradient_factor<K, false, D>(kernel, r2, r, near, h) * (minus_one * mj * pij);
+        } else if constexpr (kVariational) {
           const P d2 = h2v - r2;
           fp = select(near, grad6_c * d2 * d2 * (minus_one * mj * pij), zero);
         } else {
@@ -158,16 +299,31 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
           fp = select(apart, (grad_c * dh * dh / select(apart, r, one)) * (minus_one * mj * pij), zero);
         }
       }
-      const P fv = select(near, visc_i * mj * inv_rhoj * dh, zero);
+      if (fc.artificial) {
+        // -m_j Pi_ij grad W_ij for approaching pairs (v_ij . x_ij < 0).
+        P vr = zero;
+        for (int d = 0; d < D; ++d) vr = vr + (vi[d] - vj[d]) * rij[d];
+        const Mask approaching = near & (vr < zero);
+        const P f = gradient_factor<K, kVariational && K == KernelKind::Paper, D>(kernel, r2, r, near, h);
+        const P pi_ij = art_i * (vr / (r2 + eps_h2)) / (rhoi_v + rhoj);
+        fp = fp + select(approaching, minus_one * mj * pi_ij * f, zero);
+      } else if constexpr (K == KernelKind::Paper) {
+        fv = select(near, visc_i * mj * inv_rhoj * dh, zero);
+      } else {
+        // Morris et al. 1997: 2 mu m_j / (rho_i rho_j) (x_ij . grad W) / (r^2 + 0.01 h^2) (v_i - v_j).
+        const P f = gradient_factor<K, false, D>(kernel, r2, r, near, h);
+        fv = select(near, morris_i * mj * inv_rhoj * (f * r2) / (r2 + eps_h2), zero);
+      }
       P q2 = zero;  // Eq. 7: squared pair distance after the step, predicted with today's velocities
       for (int d = 0; d < D; ++d) {
-        const P vj = P::template gather<D>(vel, idx + k0, d);
-        if constexpr (kPressure)
-          acc[d] = acc[d] + (rij[d] * fp + (vj - vi[d]) * fv);
-        else
-          acc[d] = acc[d] + (vj - vi[d]) * fv;
+        if constexpr (kPressure) {
+          acc[d] = acc[d] + (rij[d] * fp + (vj[d] - vi[d]) * fv);
+        } else {
+          acc[d] = acc[d] + (vj[d] - vi[d]) * fv;
+          if (fc.artificial) acc[d] = acc[d] + rij[d] * fp;
+        }
         if constexpr (kExitTest) {
-          const P t = rij[d] + (vi[d] - vj) * dtv;
+          const P t = rij[d] + (vi[d] - vj[d]) * dtv;
           q2 = q2 + t * t;
         }
       }
@@ -176,6 +332,39 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
           flag_i = true;
           set_flag(idx[k0 + static_cast<std::size_t>(__builtin_ctz(out))]);
         }
+    }
+    if (solid) {
+      // Boundary samples: the pair's pressure term with p_b = p_i, rho_b = rho_i (the paper's
+      // form: p_i / rho_i^2; the symmetric ones: 2 p_i / rho_i^2), psi_b for the mass, and
+      // Akinci's friction, nu = sigma h c0 / (2 rho_i).
+      const R pii = kForm == PressureForce::Paper ? prs[i] * inv_rhoi * inv_rhoi : R(2) * prs[i] * inv_rhoi * inv_rhoi;
+      const P pii_v = P::set1(kPressure ? pii : R(0));
+      const P nu_i = P::set1(fc.friction * h * fc.c0 * R(0.5) * inv_rhoi);
+      const auto bnb = boundary.lists->of(i);
+      const std::uint32_t* bidx = bnb.data();
+      for (std::size_t k0 = 0; k0 < bnb.size(); k0 += W) {
+        const Mask valid = simd::first_lanes<R>(bnb.size() - k0);
+        P rib[D];
+        const P r2 = pair_offsets<D>(xi, bpos, bidx + k0, rib);
+        const Mask near = valid & (r2 < h2v);
+        const P r = sqrt(select(near, r2, h2v));
+        const P f = gradient_factor<K, kVariational && K == KernelKind::Paper, D>(kernel, r2, r, near, h);
+        const P psib = P::template gather<1>(psi, bidx + k0, 0);
+        P vr = zero;
+        for (int d = 0; d < D; ++d) vr = vr + vi[d] * rib[d];
+        const P pi_ib = minus_one * nu_i * select(vr < zero, vr, zero) / (r2 + eps_h2);
+        const P fb = minus_one * psib * (pii_v + pi_ib) * f;
+        P q2 = zero;
+        for (int d = 0; d < D; ++d) {
+          acc[d] = acc[d] + rib[d] * fb;
+          if constexpr (kExitTest) {
+            const P t = rib[d] + vi[d] * dtv;
+            q2 = q2 + t * t;
+          }
+        }
+        if constexpr (kExitTest)
+          if ((valid & (q2 > h2v)) != 0) flag_i = true;
+      }
     }
     if constexpr (kExitTest)
       if (flag_i) set_flag(i);
@@ -186,39 +375,26 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
   });
 }
 
-/// The kernel gradient grad_i W(x_i - x_j) the pressure force uses, for rij = x_i - x_j: the
-/// spiky kernel's, or poly6's for PressureForce::Variational; zero outside (0, h).
-template <int D, std::floating_point R>
-class PressureGradient {
- public:
-  PressureGradient(R h, PressureForce form) : poly6_(h), spiky_(h), variational_(form == PressureForce::Variational) {}
-  Vec<D, R> operator()(const Vec<D, R>& rij) const {
-    const R r2 = norm2(rij);
-    if (variational_) return poly6_.gradient(rij, r2);
-    return spiky_.gradient(rij, std::sqrt(r2));
-  }
-
- private:
-  Poly6Kernel<D, R> poly6_;
-  SpikyKernel<D, R> spiky_;
-  bool variational_;
-};
-
-/// L_i = A_i^-1 with A_i = sum_j V_j grad_i W_ij (x_j - x_i)^T (row-major D x D per particle),
-/// or the identity where det A_i < 1/2 (see GradientCorrection::Renormalize).
+/// L_i = A_i^-1 with A_i = sum_j V_j grad_i W_ij (x_j - x_i)^T (row-major D x D per particle;
+/// the boundary samples' V_b = psi_b / rho0 included), or the identity where det A_i < 1/2
+/// (see GradientCorrection::Renormalize).
 template <int D, std::floating_point R>
 std::vector<R> gradient_corrections(const ParticleSet<D, R>& ps, const NeighborLists& lists,
-                                    const PressureGradient<D, R>& gradient) {
+                                    const SmoothingKernels<D, R>& kernels, const BoundaryView<D, R>& boundary,
+                                    R rest_density) {
   std::vector<R> L(ps.size() * D * D);
+  const bool solid = boundary.active();
   parallel_for(ps.size(), [&](std::size_t i) {
     R a[D][D] = {};
-    for (const std::uint32_t j : lists.of(i)) {
-      const Vec<D, R> rij = ps.position[i] - ps.position[j];
-      const Vec<D, R> g = gradient(rij);
-      const R v = ps.mass[j] / ps.density[j];
+    const auto add = [&](const Vec<D, R>& rij, R v) {
+      const Vec<D, R> g = kernels.gradient(rij);
       for (int r = 0; r < D; ++r)
         for (int c = 0; c < D; ++c) a[r][c] -= v * g[r] * rij[c];  // x_j - x_i = -rij
-    }
+    };
+    for (const std::uint32_t j : lists.of(i)) add(ps.position[i] - ps.position[j], ps.mass[j] / ps.density[j]);
+    if (solid)
+      for (const std::uint32_t b : boundary.lists->of(i))
+        add(ps.position[i] - boundary.position[b], boundary.psi[b] / rest_density);
     R* out = &L[i * D * D];
     R det;
     if constexpr (D == 2)
@@ -246,18 +422,22 @@ std::vector<R> gradient_corrections(const ParticleSet<D, R>& ps, const NeighborL
 }
 
 /// Adds the pressure accelerations with corrected gradients: each pair's term of the plain
-/// force (in its form) with grad W_ij replaced by (L_i + L_j) / 2 grad W_ij.
+/// force (in its form) with grad W_ij replaced by (L_i + L_j) / 2 grad W_ij; a boundary sample's
+/// (pressure mirrored) by L_i grad W_ib.
 template <int D, std::floating_point R>
-void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid) {
-  const PressureGradient<D, R> gradient(h, fluid.pressure_force);
-  const std::vector<R> L = gradient_corrections(ps, lists, gradient);
+void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
+                             const BoundaryView<D, R>& boundary) {
+  const SmoothingKernels<D, R> kernels(fluid, h);
+  const R rho0 = static_cast<R>(fluid.rest_density);
+  const std::vector<R> L = gradient_corrections(ps, lists, kernels, boundary, rho0);
   const bool paper = fluid.pressure_force == PressureForce::Paper;
+  const bool solid = boundary.active();
   parallel_for(ps.size(), [&](std::size_t i) {
     const R* li = &L[i * D * D];
     const R inv_rhoi = R(1) / ps.density[i];
     Vec<D, R> acc{};
     for (const std::uint32_t j : lists.of(i)) {
-      const Vec<D, R> g = gradient(ps.position[i] - ps.position[j]);
+      const Vec<D, R> g = kernels.gradient(ps.position[i] - ps.position[j]);
       const R inv_rhoj = R(1) / ps.density[j];
       const R pij = paper ? (R(0.5) * ps.pressure[i] + R(0.5) * ps.pressure[j]) * inv_rhoi * inv_rhoj
                           : ps.pressure[i] * inv_rhoi * inv_rhoi + ps.pressure[j] * inv_rhoj * inv_rhoj;
@@ -268,6 +448,17 @@ void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, 
         acc[r] -= ps.mass[j] * pij * gc;
       }
     }
+    if (solid) {
+      const R pii = (paper ? R(1) : R(2)) * ps.pressure[i] * inv_rhoi * inv_rhoi;
+      for (const std::uint32_t b : boundary.lists->of(i)) {
+        const Vec<D, R> g = kernels.gradient(ps.position[i] - boundary.position[b]);
+        for (int r = 0; r < D; ++r) {
+          R gc = 0;
+          for (int c = 0; c < D; ++c) gc += li[r * D + c] * g[c];
+          acc[r] -= boundary.psi[b] * pii * gc;
+        }
+      }
+    }
     ps.acceleration[i] += acc;
   });
 }
@@ -276,71 +467,102 @@ void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, 
 
 template <int D, std::floating_point R>
 std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h,
-                                       const FluidParams& fluid) {
+                                       const FluidParams& fluid, const BoundaryView<D, R>& boundary) {
   check_pass_inputs(ps, lists);
+  if (boundary.active()) check_boundary_inputs(ps, boundary);
   thread_local std::vector<std::uint64_t> within;  // per-chunk counts, kept between steps
-  return density_pass(ps, lists, h, fluid, within);
+  switch (fluid.kernel) {
+    case KernelKind::Cubic:
+      return density_pass<KernelKind::Cubic>(ps, lists, h, fluid, boundary, within);
+    case KernelKind::Wendland:
+      return density_pass<KernelKind::Wendland>(ps, lists, h, fluid, boundary, within);
+    case KernelKind::Paper:
+      break;
+  }
+  return density_pass<KernelKind::Paper>(ps, lists, h, fluid, boundary, within);
 }
 
 template <int D, std::floating_point R>
 void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                            const Vec<D, R>& gravity, const WallContact<D, R>& walls, std::span<std::uint8_t> exit_flags,
-                           R dt) {
+                           R dt, const BoundaryView<D, R>& boundary) {
   SPH_CHECK(exit_flags.empty() || exit_flags.size() == ps.size(), "one exit flag per particle");
   check_pass_inputs(ps, lists);
-  const auto run = [&]<PressureForce kForm, bool kPressure>() {
+  if (boundary.active()) check_boundary_inputs(ps, boundary);
+  const auto run = [&]<KernelKind kKernel, PressureForce kForm, bool kPressure>() {
     if (exit_flags.empty())
-      force_pass<kForm, kPressure, false>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
+      force_pass<kKernel, kForm, kPressure, false>(ps, lists, h, fluid, gravity, walls, exit_flags, dt, boundary);
     else
-      force_pass<kForm, kPressure, true>(ps, lists, h, fluid, gravity, walls, exit_flags, dt);
+      force_pass<kKernel, kForm, kPressure, true>(ps, lists, h, fluid, gravity, walls, exit_flags, dt, boundary);
   };
-  if (fluid.gradient_correction == GradientCorrection::Renormalize) {
-    run.template operator()<PressureForce::Paper, false>();  // the form only matters to the pressure term
-    corrected_pressure_pass(ps, lists, h, fluid);
-    return;
-  }
-  switch (fluid.pressure_force) {
-    case PressureForce::Paper:
-      run.template operator()<PressureForce::Paper, true>();
-      break;
-    case PressureForce::Symmetric:
-      run.template operator()<PressureForce::Symmetric, true>();
-      break;
-    case PressureForce::Variational:
-      run.template operator()<PressureForce::Variational, true>();
-      break;
+  // The kernel's pass for each form; with the cubic spline and Wendland C2 the variational
+  // form is the symmetric one (the pressure gradient is the density kernel's anyway).
+  const auto run_kernel = [&]<KernelKind kKernel>() {
+    if (fluid.gradient_correction == GradientCorrection::Renormalize) {
+      // The form only matters to the pressure terms, which the corrected pass adds.
+      run.template operator()<kKernel, PressureForce::Paper, false>();
+      corrected_pressure_pass(ps, lists, h, fluid, boundary);
+      return;
+    }
+    switch (fluid.pressure_force) {
+      case PressureForce::Paper:
+        run.template operator()<kKernel, PressureForce::Paper, true>();
+        return;
+      case PressureForce::Symmetric:
+        run.template operator()<kKernel, PressureForce::Symmetric, true>();
+        return;
+      case PressureForce::Variational:
+        if constexpr (kKernel == KernelKind::Paper)
+          run.template operator()<kKernel, PressureForce::Variational, true>();
+        else
+          run.template operator()<kKernel, PressureForce::Symmetric, true>();
+        return;
+    }
+  };
+  switch (fluid.kernel) {
+    case KernelKind::Paper:
+      run_kernel.template operator()<KernelKind::Paper>();
+      return;
+    case KernelKind::Cubic:
+      run_kernel.template operator()<KernelKind::Cubic>();
+      return;
+    case KernelKind::Wendland:
+      run_kernel.template operator()<KernelKind::Wendland>();
+      return;
   }
 }
 
 template <int D>
-double lattice_mass(double rest_density, double spacing, double h) {
+double lattice_mass(double rest_density, double spacing, double h, KernelKind kernel) {
   // The scene reader keeps h within 10 spacings; the sum costs (2 h / spacing)^D terms.
   SPH_CHECK(spacing > 0 && h > 0 && h / spacing <= 1000, "lattice_mass: h / spacing out of range");
-  const Poly6Kernel<D, double> poly6(h);
+  const SmoothingKernels<D, double> kernels(kernel, h);
+  const auto w = [&](double r) { return kernels.w_r2(r * r); };
   const int n = static_cast<int>(std::ceil(h / spacing)) + 1;
   double sum = 0;
   if constexpr (D == 2) {
     for (int a = -n; a <= n; ++a)
-      for (int b = -n; b <= n; ++b) sum += poly6.w(spacing * std::sqrt(double(a * a + b * b)));
+      for (int b = -n; b <= n; ++b) sum += w(spacing * std::sqrt(double(a * a + b * b)));
   } else {
     for (int a = -n; a <= n; ++a)
       for (int b = -n; b <= n; ++b)
-        for (int c = -n; c <= n; ++c) sum += poly6.w(spacing * std::sqrt(double(a * a + b * b + c * c)));
+        for (int c = -n; c <= n; ++c) sum += w(spacing * std::sqrt(double(a * a + b * b + c * c)));
   }
   return rest_density / sum;
 }
 
 #define SPH_INSTANTIATE(D, R)                                                                                \
   template std::uint64_t compute_density_pressure<D, R>(ParticleSet<D, R>&, const NeighborLists&, R,         \
-                                                        const FluidParams&);                                 \
+                                                        const FluidParams&, const BoundaryView<D, R>&);      \
   template void compute_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&, \
-                                            const Vec<D, R>&, const WallContact<D, R>&, std::span<std::uint8_t>, R);
+                                            const Vec<D, R>&, const WallContact<D, R>&, std::span<std::uint8_t>, R, \
+                                            const BoundaryView<D, R>&);
 SPH_INSTANTIATE(2, float)
 SPH_INSTANTIATE(2, double)
 SPH_INSTANTIATE(3, float)
 SPH_INSTANTIATE(3, double)
 #undef SPH_INSTANTIATE
-template double lattice_mass<2>(double, double, double);
-template double lattice_mass<3>(double, double, double);
+template double lattice_mass<2>(double, double, double, KernelKind);
+template double lattice_mass<3>(double, double, double, KernelKind);
 
 }  // namespace sph

@@ -11,14 +11,28 @@
 
 namespace sph {
 
-/// Paper Eq. 4 and the EOS: rho_i = m_i W(0) + sum_j m_j W_poly6(|x_i - x_j|), then
-/// p_i = k (rho_i - rho0), clamped at 0 when negative pressure is NegativePressure::Clamp.
-/// Listed pairs at or beyond h contribute nothing.
+/// The boundary particles a pass sees (boundary.h): the samples, their psi, each fluid
+/// particle's list of samples and Akinci's friction sigma. Without lists (penalty walls) the
+/// passes have no boundary terms.
+template <int D, std::floating_point R>
+struct BoundaryView {
+  std::span<const Vec<D, R>> position;
+  std::span<const R> psi;
+  const NeighborLists* lists = nullptr;
+  R friction = 0;
+  bool active() const { return lists != nullptr && lists->particle_count() > 0 && !position.empty(); }
+};
+
+/// Paper Eq. 4 and the EOS: rho_i = m_i W(0) + sum_j m_j W(|x_i - x_j|) (+ sum_b psi_b W(|x_i -
+/// x_b|) over the boundary samples, Akinci et al. 2012 eq. 6), then p_i = k (rho_i - rho0),
+/// clamped at 0 when negative pressure is NegativePressure::Clamp. W is the density kernel of
+/// FluidParams::kernel: poly6 for the paper's, else the cubic spline or Wendland C2. Listed pairs
+/// at or beyond h contribute nothing.
 ///
-/// Returns the number of listed (directed) pairs closer than h.
+/// Returns the number of listed (directed) fluid pairs closer than h.
 template <int D, std::floating_point R>
 std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h,
-                                       const FluidParams& fluid);
+                                       const FluidParams& fluid, const BoundaryView<D, R>& boundary = {});
 
 /// The damped penalty acceleration of the container walls and the obstacles on one particle.
 /// A particle interacts with a wall plane when closer than `particle_radius` to it; the contact
@@ -26,8 +40,11 @@ std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborList
 template <int D, std::floating_point R>
 class WallContact {
  public:
-  WallContact(const Box<D>& container, const std::vector<Box<D>>& obstacles, R particle_radius, const WallParams& walls)
-      : lo_(vec_cast<R>(container.lo)),
+  /// `enabled` false (boundary particles): no wall acceleration at all.
+  WallContact(const Box<D>& container, const std::vector<Box<D>>& obstacles, R particle_radius, const WallParams& walls,
+              bool enabled = true)
+      : enabled_(enabled),
+        lo_(vec_cast<R>(container.lo)),
         hi_(vec_cast<R>(container.hi)),
         obstacles_(&obstacles),
         radius_(particle_radius),
@@ -36,6 +53,7 @@ class WallContact {
 
   Vec<D, R> operator()(const Vec<D, R>& x, const Vec<D, R>& v) const {
     Vec<D, R> a{};
+    if (!enabled_) return a;
     // Container: particles inside the box, pushed back from each of its 2D faces.
     for (int d = 0; d < D; ++d) {
       const R pen_lo = lo_[d] + radius_ - x[d];
@@ -72,13 +90,15 @@ class WallContact {
     return std::max(R(0), ks_ * penetration - kd_ * normal_velocity);
   }
 
+  bool enabled_;
   Vec<D, R> lo_, hi_;
   const std::vector<Box<D>>* obstacles_;
   R radius_, ks_, kd_;
 };
 
 /// Accelerations from pressure (Eq. 5, spiky gradient), viscosity (Eq. 6 with (v_j - v_i),
-/// viscosity-kernel Laplacian), gravity and the walls (`walls`), in one pass over the particles:
+/// viscosity-kernel Laplacian), gravity, the walls (`walls`) and the boundary particles
+/// (`boundary`), in one pass over the particles:
 ///   a_i = g + sum_j m_j [ -P_ij grad W_spiky(x_i - x_j) + mu (v_j - v_i) / (rho_i rho_j) lap W_visc ]
 ///         + walls(x_i, v_i)
 /// with P_ij = (p_i + p_j) / (2 rho_i rho_j) (PressureForce::Paper: Eq. 5's force density
@@ -88,6 +108,17 @@ class WallContact {
 /// (a second pass over the pairs). Every pair term is antisymmetric (m_i a_i = -m_j a_j), so
 /// total momentum is conserved when lists are symmetric.
 ///
+/// Other kernels (FluidParams::kernel): the cubic spline's or Wendland C2's gradient replaces the
+/// spiky one (and poly6's: Variational is then Symmetric), and the viscosity term is Morris et
+/// al. 1997's, 2 mu m_j / (rho_i rho_j) (x_ij . grad W_ij) / (|x_ij|^2 + 0.01 h^2) (v_i - v_j).
+/// ViscosityModel::Artificial replaces Eq. 6 by Monaghan's -m_j Pi_ij grad W_ij (params.h).
+///
+/// Boundary samples b (Akinci et al. 2012): the pressure term of the pair with the pressure
+/// mirrored (p_b = p_i, rho_b = rho_i, psi_b for m_j: -psi_b P_ii grad W_ib), and the boundary
+/// friction -psi_b Pi_ib grad W_ib with Pi_ib = -nu min(v_i . x_ib, 0) / (|x_ib|^2 + 0.01 h^2),
+/// nu = sigma h c0 / (2 rho_i). The Eq. 7 test covers fluid-boundary pairs (the samples do not
+/// move: |x_i - x_b + dt u_i| > h flags i).
+///
 /// If `exit_flags` is not empty (one per particle), the same pass also evaluates paper Eq. 7
 /// for every listed pair, |x_i - x_j + dt (u_i - u_j)|^2 > h^2, and sets exit_flags[i] and
 /// exit_flags[j] to 1 when it holds (flags are only ever set, never cleared, so concurrent
@@ -96,11 +127,12 @@ class WallContact {
 template <int D, std::floating_point R>
 void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                            const Vec<D, R>& gravity, const WallContact<D, R>& walls,
-                           std::span<std::uint8_t> exit_flags = {}, R dt = 0);
+                           std::span<std::uint8_t> exit_flags = {}, R dt = 0, const BoundaryView<D, R>& boundary = {});
 
 /// Particle mass such that a particle inside a lattice of spacing dx (square in 2D, cubic in
-/// 3D) has exactly density rho0 under the poly6 sum of Eq. 4 with support h.
+/// 3D) has exactly density rho0 under the density kernel's sum of Eq. 4 with support h (poly6
+/// for the paper's kernels).
 template <int D>
-double lattice_mass(double rest_density, double spacing, double h);
+double lattice_mass(double rest_density, double spacing, double h, KernelKind kernel = KernelKind::Paper);
 
 }  // namespace sph

@@ -1,0 +1,131 @@
+#include <sph/solver/boundary.h>
+
+#include <cmath>
+
+#include <sph/core/error.h>
+#include <sph/core/parallel.h>
+#include <sph/neighbors/list_builder.h>
+#include <sph/neighbors/uniform_grid.h>
+#include <sph/solver/smoothing.h>
+
+namespace sph {
+
+namespace {
+
+/// The sites along one axis of a box [lo, hi]: `inner` evenly spaced sites (spacing at most
+/// dx) half a step inside, and `layers` sites at dx, dx / 2 beyond each end.
+struct AxisSites {
+  std::vector<double> x;  // low outer layers (outermost first), inner sites, high outer layers
+  int layers = 0, inner = 0;
+};
+
+AxisSites axis_sites(double lo, double hi, double dx, int layers, bool outer) {
+  AxisSites a;
+  a.layers = outer ? layers : 0;
+  a.inner = std::max(1, static_cast<int>(std::ceil((hi - lo) / dx - 1e-9)));
+  const double step = (hi - lo) / a.inner;
+  for (int k = a.layers - 1; k >= 0; --k) a.x.push_back(lo - (k + 0.5) * dx);
+  for (int i = 0; i < a.inner; ++i) a.x.push_back(lo + (i + 0.5) * step);
+  for (int k = 0; k < a.layers; ++k) a.x.push_back(hi + (k + 0.5) * dx);
+  return a;
+}
+
+/// Visits every lattice site of the axes' product, in order (x fastest), with per axis the
+/// site's index.
+template <int D, class F>
+void for_each_site(const std::array<AxisSites, D>& axes, F&& f) {
+  std::array<int, D> idx{};
+  for (;;) {
+    f(idx);
+    int d = 0;
+    while (d < D && ++idx[d] == static_cast<int>(axes[d].x.size())) idx[d++] = 0;
+    if (d == D) return;
+  }
+}
+
+}  // namespace
+
+int boundary_layers(double spacing, double h) {
+  SPH_CHECK(spacing > 0 && h > 0 && h / spacing <= 1000, "boundary_layers: h / spacing out of range");
+  return std::max(1, static_cast<int>(std::ceil(h / spacing - 1e-9)));
+}
+
+template <int D>
+std::vector<Vec<D, double>> sample_boundary(const Box<D>& container, const std::vector<Box<D>>& obstacles,
+                                            double spacing, double h) {
+  const int layers = boundary_layers(spacing, h);
+  std::vector<Vec<D, double>> out;
+  // The container's shell: sites outside the box on at least one axis.
+  std::array<AxisSites, D> axes;
+  for (int d = 0; d < D; ++d) axes[d] = axis_sites(container.lo[d], container.hi[d], spacing, layers, true);
+  for_each_site<D>(axes, [&](const std::array<int, D>& idx) {
+    bool outside = false;
+    Vec<D, double> x;
+    for (int d = 0; d < D; ++d) {
+      const int i = idx[d];
+      outside = outside || i < axes[d].layers || i >= axes[d].layers + axes[d].inner;
+      x[d] = axes[d].x[static_cast<std::size_t>(i)];
+    }
+    if (outside) out.push_back(x);
+  });
+  // Each obstacle: its sites within `layers` of a face, inside the container.
+  for (const Box<D>& b : obstacles) {
+    for (int d = 0; d < D; ++d) axes[d] = axis_sites(b.lo[d], b.hi[d], spacing, layers, false);
+    for_each_site<D>(axes, [&](const std::array<int, D>& idx) {
+      bool near_face = false, in_container = true;
+      Vec<D, double> x;
+      for (int d = 0; d < D; ++d) {
+        const int i = idx[d];
+        near_face = near_face || i < layers || i >= axes[d].inner - layers;
+        x[d] = axes[d].x[static_cast<std::size_t>(i)];
+        in_container = in_container && x[d] >= container.lo[d] && x[d] <= container.hi[d];
+      }
+      if (near_face && in_container) out.push_back(x);
+    });
+  }
+  return out;
+}
+
+template <int D, std::floating_point R>
+std::vector<R> boundary_psi(std::span<const Vec<D, R>> samples, const FluidParams& fluid, R h) {
+  std::vector<R> psi(samples.size());
+  if (samples.empty()) return psi;
+  UniformGrid<D, R> grid;
+  grid.build(samples, h);
+  ListBuilder<D, R> builder;
+  NeighborLists lists;
+  builder.build(grid, samples, h, lists);
+  const SmoothingKernels<D, R> kernels(fluid, h);
+  const R rho0 = static_cast<R>(fluid.rest_density);
+  parallel_for(samples.size(), [&](std::size_t b) {
+    R delta = kernels.w_zero();
+    for (const std::uint32_t k : lists.of(b)) delta += kernels.w_r2(norm2(samples[b] - samples[k]));
+    psi[b] = rho0 / delta;
+  });
+  return psi;
+}
+
+template <int D, std::floating_point R>
+BoundarySet<D, R> make_boundary(const SimulationParams<D>& params) {
+  BoundarySet<D, R> set;
+  if (params.boundary.handling != BoundaryHandling::Particles) return set;
+  for (const auto& x : sample_boundary<D>(params.container, params.obstacles, 2.0 * params.particle_radius,
+                                          params.kernel_radius))
+    set.position.push_back(vec_cast<R>(x));
+  SPH_CHECK(set.position.size() < (std::size_t{1} << 31) / D, "too many boundary samples for 32-bit gather offsets");
+  set.psi = boundary_psi<D, R>(set.position, params.fluid, static_cast<R>(params.kernel_radius));
+  return set;
+}
+
+template std::vector<Vec<2, double>> sample_boundary<2>(const Box<2>&, const std::vector<Box<2>>&, double, double);
+template std::vector<Vec<3, double>> sample_boundary<3>(const Box<3>&, const std::vector<Box<3>>&, double, double);
+#define SPH_INSTANTIATE(D, R)                                                                          \
+  template std::vector<R> boundary_psi<D, R>(std::span<const Vec<D, R>>, const FluidParams&, R); \
+  template BoundarySet<D, R> make_boundary<D, R>(const SimulationParams<D>&);
+SPH_INSTANTIATE(2, float)
+SPH_INSTANTIATE(2, double)
+SPH_INSTANTIATE(3, float)
+SPH_INSTANTIATE(3, double)
+#undef SPH_INSTANTIATE
+
+}  // namespace sph

@@ -1,0 +1,52 @@
+#pragma once
+/// \file Boundary particles (Akinci, Ihmsen, Akinci, Solenthaler and Teschner, "Versatile
+/// rigid-fluid coupling for incompressible SPH", SIGGRAPH 2012): the container's walls and the
+/// obstacles sampled by static particles that take part in the fluid's density and pressure.
+///
+/// Sampling (docs/physics.md, "Boundary particles"): each solid is filled, from its surface
+/// inwards, with boundary_layers() layers of samples on a lattice of spacing at most the fluid's
+/// particle spacing dx, the first layer dx / 2 behind the surface, so that the samples continue
+/// the fluid's lattice and a fluid particle at the wall finds its whole kernel support filled.
+/// The container's shell is sampled outside the box (faces, edges and corners: every lattice
+/// site within the layers' depth of the box on some axis); each obstacle inside its box, in
+/// from each face, samples outside the container dropped.
+///
+/// Each sample b carries psi_b = rho0 V_b with V_b = 1 / sum_k W(x_b - x_k), the sum over the
+/// samples within h, b included (Akinci's eq. 4-5): where samples are dense each counts less.
+
+#include <span>
+#include <vector>
+
+#include <sph/core/vec.h>
+#include <sph/solver/params.h>
+
+namespace sph {
+
+/// Layers of samples behind a surface: ceil(h / spacing), at least 1 (2 at h = 2 spacings).
+int boundary_layers(double spacing, double h);
+
+/// The sample positions of the container's shell and the obstacles (in that order, each in a
+/// fixed lattice order), m.
+template <int D>
+std::vector<Vec<D, double>> sample_boundary(const Box<D>& container, const std::vector<Box<D>>& obstacles,
+                                            double spacing, double h);
+
+/// The static boundary of a run: sample positions and each sample's psi, kg (kg/m in 2D).
+template <int D, std::floating_point R>
+struct BoundarySet {
+  std::vector<Vec<D, R>> position;
+  std::vector<R> psi;
+  std::size_t size() const { return position.size(); }
+};
+
+/// psi_b = rho0 / sum_k W(x_b - x_k) over the samples within h (b included), W the run's density
+/// kernel (FluidParams::kernel). Deterministic for any thread count.
+template <int D, std::floating_point R>
+std::vector<R> boundary_psi(std::span<const Vec<D, R>> samples, const FluidParams& fluid, R h);
+
+/// The boundary of `params`: its samples and their psi under BoundaryHandling::Particles, empty
+/// otherwise.
+template <int D, std::floating_point R>
+BoundarySet<D, R> make_boundary(const SimulationParams<D>& params);
+
+}  // namespace sph

@@ -1,0 +1,62 @@
+#pragma once
+/// \file SmoothingKernels: the run's choice of kernels (FluidParams::kernel, pressure_force) as
+/// scalar functions, for the code outside the vector pair loops: the gradient correction, the
+/// boundary samples' volumes, the lattice mass and the health monitor's own-density test. The
+/// vector loops of wcsph.cpp evaluate the same formulas with the same constants.
+
+#include <cmath>
+
+#include <sph/core/kernels.h>
+#include <sph/solver/params.h>
+
+namespace sph {
+
+template <int D, std::floating_point R>
+class SmoothingKernels {
+ public:
+  SmoothingKernels(KernelKind kind, R h, bool variational = false)
+      : kind_(kind), variational_(variational), poly6_(h), spiky_(h), cubic_(h), wendland_(h) {}
+  SmoothingKernels(const FluidParams& fluid, R h)
+      : SmoothingKernels(fluid.kernel, h, fluid.pressure_force == PressureForce::Variational) {}
+
+  KernelKind kind() const { return kind_; }
+  /// The density kernel W (poly6 for the paper's kernels) from the squared distance.
+  R w_r2(R r2) const {
+    switch (kind_) {
+      case KernelKind::Cubic:
+        return cubic_.w_r2(r2);
+      case KernelKind::Wendland:
+        return wendland_.w_r2(r2);
+      case KernelKind::Paper:
+        break;
+    }
+    return poly6_.w_r2(r2);
+  }
+  R w_zero() const { return w_r2(R(0)); }
+  /// The gradient grad_i W(x_i - x_j) the pressure force uses, for rij = x_i - x_j: the spiky
+  /// kernel's (poly6's for PressureForce::Variational) with the paper's kernels, the density
+  /// kernel's own otherwise; zero outside [0, h) and, for spiky, at r = 0.
+  Vec<D, R> gradient(const Vec<D, R>& rij) const {
+    const R r2 = norm2(rij);
+    switch (kind_) {
+      case KernelKind::Cubic:
+        return cubic_.gradient(rij, std::sqrt(r2));
+      case KernelKind::Wendland:
+        return wendland_.gradient(rij, std::sqrt(r2));
+      case KernelKind::Paper:
+        break;
+    }
+    if (variational_) return poly6_.gradient(rij, r2);
+    return spiky_.gradient(rij, std::sqrt(r2));
+  }
+
+ private:
+  KernelKind kind_;
+  bool variational_;
+  Poly6Kernel<D, R> poly6_;
+  SpikyKernel<D, R> spiky_;
+  CubicSplineKernel<D, R> cubic_;
+  WendlandC2Kernel<D, R> wendland_;
+};
+
+}  // namespace sph

@@ -6,6 +6,7 @@
 #include <concepts>
 #include <limits>
 #include <numbers>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -331,6 +332,43 @@ void check_lattice_densities(const char* name) {
 }
 TEST(Kernels, CubicSplineLatticeDensityNearOne) { check_lattice_densities<CubicSplineKernel>("cubic"); }
 TEST(Kernels, WendlandC2LatticeDensityNearOne) { check_lattice_densities<WendlandC2Kernel>("Wendland"); }
+
+/// The viscosity the solver pairs with these kernels (Morris, Fox and Zhu 1997; docs/physics.md):
+/// 2 sum_j V_j (x_ij . grad_i W_ij) / (|x_ij|^2 + epsilon h^2) (A_i - A_j) approximates the
+/// Laplacian of A. For A = |x|^2 (Laplacian 2 D) on a lattice of spacing dx with h = 2 dx, x_i at
+/// the origin. The solver's epsilon = 0.01 lowers every term by r^2 / (r^2 + 0.01 h^2), which is
+/// 0.96 for the nearest neighbors (r = h / 2), hence the wider tolerance with it.
+template <template <int, std::floating_point> class K, int D>
+void check_lattice_laplacian(double dx, double epsilon, double tolerance, const char* name) {
+  const double h = 2 * dx;
+  const K<D, double> k(h);
+  const int n = 3;  // > h / dx
+  double sum = 0;
+  for (int a = -n; a <= n; ++a)
+    for (int b = -n; b <= n; ++b)
+      for (int c = (D == 3 ? -n : 0); c <= (D == 3 ? n : 0); ++c) {
+        Vec<D, double> xij{};  // x_i - x_j
+        xij[0] = -a * dx;
+        xij[1] = -b * dx;
+        if constexpr (D == 3) xij[2] = -c * dx;
+        const double r2 = norm2(xij);
+        if (r2 == 0) continue;           // j = i adds nothing (A_i - A_j = 0); 0 / 0 without epsilon
+        const double a_i = 0, a_j = r2;  // A = |x|^2
+        sum += 2 * dot(xij, k.gradient(xij, std::sqrt(r2))) / (r2 + epsilon * h * h) * (a_i - a_j);
+      }
+  const double laplacian = sum * std::pow(dx, D);
+  EXPECT_NEAR(laplacian / (2 * D), 1.0, tolerance)
+      << D << "D " << name << " epsilon=" << epsilon << ": lattice Laplacian of |x|^2 = " << laplacian << ", exact "
+      << 2 * D;
+}
+TEST(Kernels, MorrisLaplacianOfQuadraticOnLattice) {
+  for (const auto& [epsilon, tolerance] : {std::pair{0.0, 0.03}, std::pair{0.01, 0.07}}) {
+    check_lattice_laplacian<CubicSplineKernel, 2>(0.01, epsilon, tolerance, "cubic");
+    check_lattice_laplacian<CubicSplineKernel, 3>(0.02, epsilon, tolerance, "cubic");
+    check_lattice_laplacian<WendlandC2Kernel, 2>(0.01, epsilon, tolerance, "Wendland");
+    check_lattice_laplacian<WendlandC2Kernel, 3>(0.02, epsilon, tolerance, "Wendland");
+  }
+}
 
 template <template <int, std::floating_point> class K, int D>
 void check_new_float_matches_double(double h, const char* name) {

@@ -1,11 +1,15 @@
 // `sph render` as a user meets it: images of every frame with one color scale for the whole
-// run, a movie checked by ffprobe, compare directories side by side, and clear refusals.
+// run, the scene's obstacles drawn solid, a movie checked by ffprobe, compare directories side by
+// side, and clear refusals.
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include <sph/render/particles.h>
 
 #include "support/expect.h"
 #include "support/png_decode.h"
@@ -85,6 +89,45 @@ TEST_F(Render, EveryFrameBecomesAnImageWithOneColorScaleForTheRun) {
   const CommandResult again = sph({"render", "db", "--frames", "last", "--no-progress"});
   ASSERT_EQ(again.code, 0) << again.err;
   EXPECT_EQ(pngs_in(out), (std::vector<std::string>{"frame_000004.png"}));
+}
+
+TEST_F(Render, ObstaclesAreDrawnAsSolidBoxes) {
+  // A column collapsing onto a block standing on the floor of a 0.6 x 0.4 m tank.
+  sph::test::spit(tmp_.path() / "obstacle.json", R"({
+    "version": 1, "name": "obstacle", "dimension": 2,
+    "Configuration": { "particleRadius": 0.0075 },
+    "Container": { "start": [0, 0], "end": [0.6, 0.4] },
+    "Obstacles": [ { "start": [0.35, 0], "end": [0.45, 0.12] } ],
+    "FluidBlocks": [ { "start": [0, 0], "end": [0.15, 0.3] } ]
+  })");
+  run((tmp_.path() / "obstacle.json").string(), "ob");
+  ASSERT_EQ(sph({"render", "ob", "--frames", "last", "--no-progress"}).code, 0);
+  const auto img = load_png(tmp_.path() / "ob" / "render" / "frame_000004.png");
+  const auto at = [&](int x, int y) {
+    const std::uint8_t* p = &img.rgb[3 * (static_cast<std::size_t>(y) * img.width + x)];
+    return sph::Rgb{p[0], p[1], p[2]};
+  };
+  // The obstacle's fill: where it is, its projected size (the 1280 x 720 panel is the image's
+  // left part, under the caption row).
+  int x0 = img.width, x1 = -1, y0 = img.height, y1 = -1;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      if (at(x, y) == sph::kSolidColor)
+        x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+  ASSERT_GE(x1, 0) << "no pixel has the obstacle's color";
+  sph::ParticleView view = sph::default_particle_view(2, 1280, 720);
+  const sph::ParticleCamera cam(2, {0, 0, 0}, {0.6, 0.4, 0}, 0.0075, view);
+  const double s = cam.pixels_per_unit();
+  EXPECT_NEAR(0.5 * (x0 + x1 + 1), cam.project({0.4, 0.06, 0})[0], 2.0);
+  EXPECT_NEAR(x1 + 1 - x0, 0.1 * s, 6.0);  // less the outline
+  EXPECT_NEAR(y1 + 1 - y0, 0.12 * s, 6.0);
+  const int cx = (x0 + x1) / 2, cy = (y0 + y1) / 2;
+  EXPECT_EQ(at(cx, cy), sph::kSolidColor);
+  // Bounded by its outline, with no obstacle beyond it.
+  EXPECT_EQ(at(x0 - 1, cy), sph::kSolidEdgeColor);
+  EXPECT_EQ(at(x1 + 1, cy), sph::kSolidEdgeColor);
+  EXPECT_NE(at(x0 - 4, cy), sph::kSolidColor);
+  EXPECT_NE(at(x1 + 4, cy), sph::kSolidEdgeColor);
 }
 
 TEST_F(Render, TheChosenFieldCameraAndSizeAreUsed) {

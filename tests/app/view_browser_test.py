@@ -8,7 +8,8 @@ with `sph view`, loads each from file:// and checks, through the page's own cont
 keyboard, selects), that it draws particles in the colors of the chosen map (not a blank canvas),
 that scrubbing, stepping, play and pause change or keep the frame as they should, that choosing
 another color field recolors the particles and the legend, that dragging orbits the 3D view (all
-panels of a comparison together). Saves a screenshot of each page to $SPH_TEST_OUTPUT, or to
+panels of a comparison together), and that a scene's obstacles are in the page's data and drawn
+as solid gray boxes (2D and 3D). Saves a screenshot of each page to $SPH_TEST_OUTPUT, or to
 view_browser/ in the current directory (ctest's binary directory). Fails, never skips, when
 Chromium, ChromeDriver or Selenium is missing: `bash scripts/setup.sh` installs them.
 """
@@ -56,6 +57,25 @@ OUT = os.environ.get("SPH_TEST_OUTPUT") or os.path.join(os.getcwd(), "view_brows
 os.makedirs(OUT, exist_ok=True)
 WORK = tempfile.mkdtemp(prefix="sph_view_test_")
 BACKGROUND = (247, 248, 250)  # the panels' background (viewer.css, viewer.js BG)
+OBSTACLE = (196, 196, 196)  # an obstacle's fill in 2D, its faces' base color in 3D (viewer.js SOLID_RGB)
+
+# Small scenes with an obstacle: a column collapsing onto a block (2D), a pool beside a pillar (3D).
+OBSTACLE_SCENES = {
+    "obstacle_2d": {
+        "version": 1, "name": "obstacle_2d", "dimension": 2,
+        "Configuration": {"particleRadius": 0.0075},
+        "Container": {"start": [0, 0], "end": [0.6, 0.4]},
+        "Obstacles": [{"start": [0.35, 0], "end": [0.45, 0.12]}],
+        "FluidBlocks": [{"start": [0, 0], "end": [0.15, 0.3]}],
+    },
+    "obstacle_3d": {
+        "version": 1, "name": "obstacle_3d", "dimension": 3,
+        "Configuration": {"particleRadius": 0.01},
+        "Container": {"start": [0, 0, 0], "end": [0.3, 0.3, 0.3]},
+        "Obstacles": [{"start": [0.12, 0, 0.12], "end": [0.2, 0.2, 0.2]}],
+        "FluidBlocks": [{"start": [0, 0, 0], "end": [0.1, 0.1, 0.3]}],
+    },
+}
 
 
 def sph(*args, expect=0):
@@ -117,6 +137,57 @@ for (let i = 0; i < d.length; i += 4) {
 }
 return [d.length / 4, drawn, mapped, sum];
 """
+
+
+# Runs in the page: the RGB of pixel (x, y) of panel k's canvas, and the canvas size.
+PIXEL_JS = """
+const [k, x, y] = arguments;
+const c = document.querySelectorAll('.panel canvas')[k];
+return [Array.from(c.getContext('2d').getImageData(x, y, 1, 1).data.slice(0, 3)), c.width, c.height];
+"""
+
+# Runs in the page: how many pixels of panel k are the obstacle's gray, or a shade of it
+# (r = g = b between [lo, hi]).
+GRAYS_JS = """
+const [k, lo, hi] = arguments;
+const c = document.querySelectorAll('.panel canvas')[k];
+const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+let n = 0;
+for (let i = 0; i < d.length; i += 4)
+  if (d[i] === d[i + 1] && d[i + 1] === d[i + 2] && d[i] >= lo && d[i] <= hi) n++;
+return [n, d.length / 4];
+"""
+
+
+def check_obstacles(page, scene):
+    """The page's data holds the scene's obstacles, and the canvas shows them in gray."""
+    dim = scene["dimension"]
+    want = [{"lo": o["start"] + [0] * (3 - dim), "hi": o["end"] + [0] * (3 - dim)} for o in scene["Obstacles"]]
+    got = page.data.get("obstacles")
+    if got != want:
+        fail(f"{page.name}: the page's data holds the obstacles {got!r}, expected {want!r}")
+    if dim == 2:
+        # The 2D camera (viewer.js projector): the container fills 92 % of the panel, centered.
+        _, w, h = page.d.execute_script(PIXEL_JS, 0, 0, 0)
+        lo, hi = page.data["box"]["lo"], page.data["box"]["hi"]
+        s = 0.92 * min(w / (hi[0] - lo[0]), h / (hi[1] - lo[1]))
+        o = want[0]
+        ox, oy = 0.5 * (o["lo"][0] + o["hi"][0]), 0.5 * (o["lo"][1] + o["hi"][1])
+        x = int(w / 2 + (ox - 0.5 * (lo[0] + hi[0])) * s)
+        y = int(h / 2 - (oy - 0.5 * (lo[1] + hi[1])) * s)
+        rgb = tuple(page.d.execute_script(PIXEL_JS, 0, x, y)[0])
+        if rgb != OBSTACLE:
+            fail(f"{page.name}: the obstacle's center ({x}, {y}) is {rgb}, expected its gray {OBSTACLE}")
+        gray, total = page.d.execute_script(GRAYS_JS, 0, OBSTACLE[0], OBSTACLE[0])
+        area = (o["hi"][0] - o["lo"][0]) * (o["hi"][1] - o["lo"][1]) * s * s
+        if not 0.6 * area < gray < 1.1 * area:
+            fail(f"{page.name}: {gray} pixels have the obstacle's gray, expected about {area:.0f}")
+    else:
+        # Its faces turned to the camera: shades of the gray, flat per face.
+        gray, total = page.d.execute_script(GRAYS_JS, 0, int(0.5 * OBSTACLE[0]), OBSTACLE[0])
+        if gray < 0.01 * total:
+            fail(f"{page.name}: only {gray} of {total} pixels are in the obstacle's grays")
+    print(f"  {page.name}: the obstacles are in the data and drawn ({gray} gray pixels)")
 
 
 def make_driver():
@@ -304,6 +375,12 @@ def main():
             f.write("standard\nadaptive\n")
     with open(os.path.join(cmp_dir, "runs.txt")) as f:
         labels = [line.strip() for line in f if line.strip()]
+    for name, scene in OBSTACLE_SCENES.items():
+        with open(os.path.join(WORK, f"{name}.json"), "w") as f:
+            json.dump(scene, f)
+        sph("run", os.path.join(WORK, f"{name}.json"), "-o", os.path.join(WORK, name), "--steps", "300", "--set",
+            "Configuration.outputEveryNSteps=100", "--no-progress")
+        sph("view", os.path.join(WORK, name))
     sph("view", dam)
     sph("view", block, "-o", os.path.join(WORK, "block.html"))
     sph("view", cmp_dir)
@@ -351,6 +428,12 @@ def main():
         time.sleep(0.2)
         page.screenshot("view_compare.png")
         print(f"  comparison: {len(panels)} panels ({', '.join(labels)}), orbiting together")
+
+        # Obstacles: in the data, drawn solid.
+        for name, scene in OBSTACLE_SCENES.items():
+            page = Page(driver, os.path.join(WORK, name, "view.html"), name)
+            check_obstacles(page, scene)
+            page.screenshot(f"view_{name}.png")
     finally:
         driver.quit()
         shutil.rmtree(WORK, ignore_errors=True)

@@ -1,6 +1,8 @@
-// Particle images: placement in the fitted view, the box outline, depth order, and the edge cases
-// (no particles, NaN positions, bad arguments).
+// Particle images: placement in the fitted view, the box outline, depth order, solid obstacles
+// (filled in 2D, shaded faces that hide what is behind them in 3D), and the edge cases (no
+// particles, NaN positions, bad arguments).
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -231,6 +233,179 @@ TEST(Particles, BadArgumentsThrow) {
   EXPECT_THROW(render_particles(xyz, 3, {}, 0.1, lo, hi, flat_view()), std::logic_error);
   const std::vector<Rgb> three = {kRed, kRed, kRed};
   EXPECT_THROW(render_particles(xyz, 2, three, 0.1, lo, hi, flat_view()), std::logic_error);
+}
+
+/// The pixel under a world point.
+std::array<int, 2> pixel_of(const ParticleCamera& cam, const A3& p) {
+  const A3 s = cam.project(p);
+  return {static_cast<int>(std::floor(s[0])), static_cast<int>(std::floor(s[1]))};
+}
+
+TEST(ParticlesSolids, A2DObstacleIsAFilledRectangleWithADarkerOutlineOverTheParticles) {
+  const A3 lo{0, 0, 0}, hi{1, 1, 0};
+  const std::vector<SolidBox> solids = {{A3{0.4, 0, 0}, A3{0.6, 0.3, 0}}};
+  // A particle leaked into the obstacle's middle and one well outside it.
+  const std::vector<double> xyz = {0.5, 0.15, 0.2, 0.5};
+  const std::vector<Rgb> colors = {kRed};
+  const ParticleView view = flat_view();
+  const Image img = render_particles(xyz, 2, colors, 0.03, lo, hi, view, solids);
+  const ParticleCamera cam(2, lo, hi, 0.03, view);
+  const auto center = pixel_of(cam, A3{0.5, 0.15, 0});
+  EXPECT_EQ(img.at(center[0], center[1]), kSolidColor);  // over the leaked particle
+  const auto outside = pixel_of(cam, A3{0.5, 0.6, 0});   // above it: background
+  EXPECT_EQ(img.at(outside[0], outside[1]), kWhite);
+  const auto beside = pixel_of(cam, A3{0.7, 0.15, 0});
+  EXPECT_EQ(img.at(beside[0], beside[1]), kWhite);
+  const auto particle = pixel_of(cam, A3{0.2, 0.5, 0});
+  EXPECT_EQ(img.at(particle[0], particle[1]), kRed);
+  // Along the row through the center: background, then the outline, the fill, the outline.
+  const int left = static_cast<int>(std::ceil(cam.project(A3{0.4, 0.15, 0})[0] - 0.5));
+  const int right = static_cast<int>(std::floor(cam.project(A3{0.6, 0.15, 0})[0] - 0.5));
+  EXPECT_EQ(img.at(left - 1, center[1]), kWhite);
+  EXPECT_EQ(img.at(left, center[1]), kSolidEdgeColor);
+  EXPECT_EQ(img.at(left + 3, center[1]), kSolidColor);
+  EXPECT_EQ(img.at(right, center[1]), kSolidEdgeColor);
+  EXPECT_EQ(img.at(right + 1, center[1]), kWhite);
+  // Its pixels are exactly those whose centers lie in the projected rectangle (outline included).
+  const Box solid = bbox(img, [](Rgb c) { return c == kSolidColor || c == kSolidEdgeColor; });
+  EXPECT_EQ(solid.x0, left);
+  EXPECT_EQ(solid.x1, right);
+  EXPECT_EQ(solid.y0, static_cast<int>(std::ceil(cam.project(A3{0.5, 0.3, 0})[1] - 0.5)));
+  EXPECT_EQ(solid.y1, static_cast<int>(std::floor(cam.project(A3{0.5, 0.0, 0})[1] - 0.5)));
+}
+
+TEST(ParticlesSolids, A3DObstacleShowsItsThreeFacesTurnedToTheCameraInDistinctGrays) {
+  const A3 lo{-1, -1, -1}, hi{1, 1, 1};
+  const std::vector<SolidBox> solids = {{A3{-0.3, -0.3, -0.3}, A3{0.3, 0.3, 0.3}}};
+  ParticleView view = default_particle_view(3, 400, 300);  // from +x, +y, +z
+  view.shaded = false;
+  const Image img = render_particles({}, 3, {}, 0.05, lo, hi, view, solids);
+  const ParticleCamera cam(3, lo, hi, 0.05, view);
+  const auto center = pixel_of(cam, A3{0, 0, 0});
+  const Rgb c = img.at(center[0], center[1]);
+  EXPECT_NE(c, kWhite);
+  EXPECT_TRUE(is_gray(c));
+  std::vector<Rgb> faces;
+  for (const A3& p : {A3{0.3, 0, 0}, A3{0, 0.3, 0}, A3{0, 0, 0.3}}) {  // the face centers
+    const auto px = pixel_of(cam, p);
+    const Rgb f = img.at(px[0], px[1]);
+    EXPECT_TRUE(is_gray(f));
+    EXPECT_LE(f.r, kSolidColor.r);
+    EXPECT_GT(f.r, kSolidEdgeColor.r);
+    faces.push_back(f);
+  }
+  EXPECT_NE(faces[0], faces[1]);
+  EXPECT_NE(faces[1], faces[2]);
+  EXPECT_NE(faces[0], faces[2]);
+  // Outside the obstacle's projection (left of its leftmost corner) is background.
+  double xmin = 1e9;
+  for (int k = 0; k < 8; ++k)
+    xmin = std::min(xmin, cam.project(A3{k & 1 ? 0.3 : -0.3, k & 2 ? 0.3 : -0.3, k & 4 ? 0.3 : -0.3})[0]);
+  EXPECT_EQ(img.at(static_cast<int>(xmin) - 3, center[1]), kWhite);
+  // The outline: along the row through the center, the first pixel darker than the container's
+  // outline (gray 150, lighter where anti-aliased) is the obstacle's edge, at its silhouette.
+  int first = 0;
+  while (first < center[0] && img.at(first, center[1]).r >= 150) ++first;
+  EXPECT_EQ(img.at(first, center[1]), kSolidEdgeColor);
+  EXPECT_NEAR(first, xmin, 2.0);
+}
+
+TEST(ParticlesSolids, A3DObstacleHidesTheParticlesBehindItAndNotThoseInFront) {
+  const A3 lo{-1, -1, -1}, hi{1, 1, 1};
+  const std::vector<SolidBox> solids = {{A3{-0.3, -0.3, -0.3}, A3{0.3, 0.3, 0.3}}};
+  for (const double azimuth : {0.0, 30.0}) {
+    ParticleView view = flat_view();  // azimuth 0: looking along -z
+    view.azimuth_deg = azimuth;
+    view.elevation_deg = azimuth > 0 ? 20.0 : 0.0;
+    const ParticleCamera cam(3, lo, hi, 0.1, view);
+    const A3& towards_viewer = cam.axes()[2];
+    const auto along = [&](double t) {
+      return A3{t * towards_viewer[0], t * towards_viewer[1], t * towards_viewer[2]};
+    };
+    const auto center = pixel_of(cam, A3{0, 0, 0});
+    for (const double radius : {0.1, 1e-6}) {  // a disc, and a particle smaller than a pixel
+      // Behind the obstacle (farther from the camera): hidden, whatever the index order.
+      const A3 b = along(-0.8), f = along(0.8);
+      const std::vector<double> behind = {b[0], b[1], b[2]};
+      const std::vector<Rgb> red = {kRed};
+      const Image hidden = render_particles(behind, 3, red, radius, lo, hi, view, solids);
+      EXPECT_NE(hidden.at(center[0], center[1]), kRed) << azimuth << " " << radius;
+      EXPECT_EQ(bbox(hidden, [](Rgb c) { return c == kRed; }).x1, -1) << azimuth << " " << radius;
+      EXPECT_EQ(hidden, render_particles({}, 3, {}, radius, lo, hi, view, solids));
+      // In front: seen.
+      const std::vector<double> front = {f[0], f[1], f[2], b[0], b[1], b[2]};
+      const std::vector<Rgb> colors = {kBlue, kRed};
+      const Image seen = render_particles(front, 3, colors, radius, lo, hi, view, solids);
+      EXPECT_EQ(seen.at(center[0], center[1]), kBlue) << azimuth << " " << radius;
+    }
+  }
+  // Behind the obstacle but sticking out past its side: only the part outside its silhouette shows.
+  const ParticleView view = flat_view();
+  const ParticleCamera cam(3, lo, hi, 0.1, view);
+  const std::vector<double> peeking = {0.35, 0, -0.7};
+  const std::vector<Rgb> red = {kRed};
+  const Image img = render_particles(peeking, 3, red, 0.1, lo, hi, view, solids);
+  const Box seen = bbox(img, [](Rgb c) { return c == kRed; });
+  ASSERT_GE(seen.x1, 0);
+  EXPECT_GE(seen.x0, cam.project(A3{0.3, 0, 0})[0] - 0.5);
+  EXPECT_GT(seen.x1, cam.project(A3{0.4, 0, 0})[0]);
+}
+
+TEST(ParticlesSolids, ParticlesTouchingAFaceFromOutsideAreWhole) {
+  // A particle resting on the obstacle's top and one against its front face, from the default
+  // camera: nothing of them is hidden, as without the obstacle.
+  const A3 lo{-1, -1, -1}, hi{1, 1, 1};
+  const double r = 0.1;
+  const std::vector<SolidBox> solids = {{A3{-0.3, -0.3, -0.3}, A3{0.3, 0.3, 0.3}}};
+  ParticleView view = default_particle_view(3, 400, 300);
+  view.shaded = false;
+  for (const A3& p : {A3{0, 0.3 + r, 0}, A3{0, 0, 0.3 + r}, A3{0.3 + r, 0, 0}}) {
+    const std::vector<double> xyz = {p[0], p[1], p[2]};
+    const std::vector<Rgb> red = {kRed};
+    const auto count = [&](std::span<const SolidBox> s) {
+      const Image img = render_particles(xyz, 3, red, r, lo, hi, view, s);
+      return static_cast<int>(std::count(img.pixels().begin(), img.pixels().end(), kRed));
+    };
+    const int alone = count({});
+    EXPECT_GT(alone, 100);
+    EXPECT_EQ(count(solids), alone) << p[0] << " " << p[1] << " " << p[2];
+  }
+}
+
+TEST(ParticlesSolids, WithoutObstaclesTheImageIsUnchanged) {
+  std::vector<double> xyz2, xyz3;
+  for (int i = 0; i < 50; ++i) {
+    const double t = i / 50.0;
+    xyz2.insert(xyz2.end(), {t, 0.5 + 0.4 * std::sin(6 * t)});
+    xyz3.insert(xyz3.end(), {t, 0.5 + 0.4 * std::sin(6 * t), 0.5 + 0.4 * std::cos(5 * t)});
+  }
+  const std::vector<Rgb> colors = {kRed};
+  const A3 lo{0, 0, 0}, hi{1, 1, 1};
+  const std::vector<SolidBox> none;
+  // An obstacle far off the image goes through the solids' code and must change nothing either.
+  const std::vector<SolidBox> off_image = {{A3{5, 5, 5}, A3{6, 6, 6}}};
+  for (const bool shaded : {false, true}) {
+    ParticleView v2 = default_particle_view(2, 320, 240), v3 = default_particle_view(3, 320, 240);
+    v2.shaded = v3.shaded = shaded;
+    const Image img2 = render_particles(xyz2, 2, colors, 0.03, lo, hi, v2);
+    EXPECT_EQ(render_particles(xyz2, 2, colors, 0.03, lo, hi, v2, none), img2);
+    EXPECT_EQ(render_particles(xyz2, 2, colors, 0.03, lo, hi, v2, off_image), img2);
+    const Image img3 = render_particles(xyz3, 3, colors, 0.03, lo, hi, v3);
+    EXPECT_EQ(render_particles(xyz3, 3, colors, 0.03, lo, hi, v3, none), img3);
+    EXPECT_EQ(render_particles(xyz3, 3, colors, 0.03, lo, hi, v3, off_image), img3);
+    EXPECT_NE(std::count(img3.pixels().begin(), img3.pixels().end(), kWhite), 320 * 240);
+  }
+}
+
+TEST(ParticlesSolids, BadObstaclesThrow) {
+  const A3 lo{0, 0, 0}, hi{1, 1, 1};
+  const std::vector<SolidBox> flipped = {{A3{0.6, 0, 0}, A3{0.4, 1, 1}}};
+  const std::vector<SolidBox> nan = {{A3{0, std::nan(""), 0}, A3{1, 1, 1}}};
+  EXPECT_THROW(render_particles({}, 2, {}, 0.1, lo, hi, flat_view(), flipped), Error);
+  EXPECT_THROW(render_particles({}, 3, {}, 0.1, lo, hi, flat_view(), nan), Error);
+  // z does not matter in 2D.
+  const std::vector<SolidBox> flat = {{A3{0.2, 0.2, 5}, A3{0.4, 0.4, -5}}};
+  EXPECT_NO_THROW(render_particles({}, 2, {}, 0.1, lo, hi, flat_view(), flat));
 }
 
 }  // namespace

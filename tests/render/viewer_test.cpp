@@ -118,6 +118,7 @@ TEST(ViewerPage, DataRoundTripsTheFrames) {
   const auto data = nlohmann::json::parse(view_page_data(page.html));
   EXPECT_EQ(data["dimension"], 2);
   EXPECT_EQ(data["title"], "dam_break_2d");
+  EXPECT_EQ(data["obstacles"], nlohmann::json::array());  // the dam break has none
   std::vector<std::string> names;
   for (const auto& c : data["colors"]) names.push_back(c["name"]);
   EXPECT_EQ(names, (std::vector<std::string>{"speed", "kinetic_energy", "density", "pressure", "initial_position"}));
@@ -160,6 +161,28 @@ TEST(ViewerPage, DataRoundTripsTheFrames) {
   // Initial-position colors: one per particle, shared by the frames (ids 0..n-1 throughout).
   EXPECT_EQ(base64_decode(data["runs"][0]["rgb"].get<std::string>()).size(), 3 * frames[0]["n"].get<std::size_t>());
   EXPECT_FALSE(frames[0].contains("rgb"));
+}
+
+TEST(ViewerPage, TheDataListsTheScenesObstacles) {
+  test::TempDir dir;
+  test::spit(dir.path() / "scene.json", R"({
+    "version": 1, "name": "obstacles", "dimension": 2,
+    "Configuration": { "particleRadius": 0.01 },
+    "Container": { "start": [0, 0], "end": [0.6, 0.4] },
+    "Obstacles": [ { "start": [0.35, 0], "end": [0.45, 0.12] }, { "start": [0.5, 0.2], "end": [0.55, 0.25] } ],
+    "FluidBlocks": [ { "start": [0, 0], "end": [0.1, 0.2] } ]
+  })");
+  const fs::path out = dir.path() / "run";
+  const auto r = test::run_sph({"run", (dir.path() / "scene.json").string(), "-o", out.string(), "--steps", "20",
+                                "--set", "Configuration.outputEveryNSteps=10", "--no-progress"},
+                               dir.path(), dir.path() / "err.txt");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto data = nlohmann::json::parse(view_page_data(build_view_page(out, ViewOptions{}).html));
+  const auto box = [](std::vector<double> lo, std::vector<double> hi) {
+    return nlohmann::json{{"lo", lo}, {"hi", hi}};
+  };
+  EXPECT_EQ(data["obstacles"],
+            nlohmann::json::array({box({0.35, 0, 0}, {0.45, 0.12, 0}), box({0.5, 0.2, 0}, {0.55, 0.25, 0})}));
 }
 
 TEST(ViewerPage, ChosenQuantitiesOnlyAndInOrder) {

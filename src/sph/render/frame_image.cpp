@@ -30,6 +30,21 @@ std::vector<double> xy_of(const FrameData& frame) {
 
 }  // namespace
 
+std::vector<SolidBox> run_obstacles(const RunDirectory& run) {
+  return run.scene.visit_body([](const auto& body) {
+    std::vector<SolidBox> out;
+    for (const auto& box : body.sim.obstacles) {
+      SolidBox s;
+      for (std::size_t a = 0; a < box.lo.c.size(); ++a) {
+        s.lo[a] = box.lo.c[a];
+        s.hi[a] = box.hi.c[a];
+      }
+      out.push_back(s);
+    }
+    return out;
+  });
+}
+
 std::pair<double, double> run_color_range(std::span<const RunDirectory> runs, ColorBy by, std::size_t max_frames,
                                           std::size_t max_values) {
   SPH_CHECK(max_frames >= 2 && max_values >= 1, "sample sizes");
@@ -59,8 +74,9 @@ Image render_frame(std::span<const RunDirectory> runs, std::span<const FrameData
     const std::vector<Rgb> colors = particle_colors(frame, style.color, run);
     const std::vector<double> xy = run.dimension == 2 ? xy_of(frame) : std::vector<double>();
     const std::span<const double> xyz = run.dimension == 2 ? std::span<const double>(xy) : frame.position;
-    panels.push_back(
-        render_particles(xyz, run.dimension, colors, run.particle_radius, run.box_lo, run.box_hi, style.view));
+    const std::vector<SolidBox> obstacles = run_obstacles(run);
+    panels.push_back(render_particles(xyz, run.dimension, colors, run.particle_radius, run.box_lo, run.box_hi,
+                                      style.view, obstacles));
     // The time in a caption row above the panel, where it never covers particles or the box.
     captions.push_back(runs.size() > 1 ? fmt::format("{}, {}", run.label, time_label(frame.time))
                                        : time_label(frame.time));

@@ -1,9 +1,11 @@
 #pragma once
 /// \file Pictures of a run's frames for `sph render`: the particles colored by a quantity, the
-/// simulated time, a color bar, and for a compare directory every mode side by side.
+/// scene's obstacles as solid boxes, the simulated time, a color bar, and for a compare directory every mode side by
+/// side.
 
 #include <span>
 #include <string>
+#include <vector>
 
 #include <sph/io/frames.h>
 #include <sph/render/color_by.h>
@@ -18,6 +20,10 @@ struct FrameStyle {
   ColorSpec color;
   bool legend = true;  ///< a color bar for scalar quantities, a key for initial position
 };
+
+/// The scene's obstacles (its Obstacles, static solid boxes) as render_particles draws them, in
+/// the scene's order; z is 0 in 2D.
+std::vector<SolidBox> run_obstacles(const RunDirectory& run);
 
 /// The color range for `by` over whole runs (color_range of every run's values together), from
 /// at most `max_frames` evenly spaced frames of each run (first and last included) and at most

@@ -83,6 +83,137 @@ struct Drawn {
   std::size_t index;
 };
 
+/// Unit vector towards the light that shades the faces of solids, in camera space: mostly from
+/// above, so that a box's top, its side turned to the light and its other side come out in three
+/// distinct tones at the usual cameras (the particles' light would give the top and the front
+/// nearly the same tone).
+const Vec3 kFaceLight = [] {
+  const Vec3 l{-0.35, 0.85, 0.4};
+  const double n = std::sqrt(dot(l, l));
+  return Vec3{l[0] / n, l[1] / n, l[2] / n};
+}();
+constexpr double kFaceAmbient = 0.55;  // kSolidColor * 0.55 is still lighter than kSolidEdgeColor
+constexpr double kFaceDiffuse = 0.45;
+
+/// A face of a solid in pixel coordinates: a convex quadrilateral (corners in order around it)
+/// with its depth, affine over the face: depth(x, y) = w0 + gx (x - q[0].x) + gy (y - q[0].y).
+struct Face {
+  std::array<std::array<double, 2>, 4> q{};
+  double w0 = 0, gx = 0, gy = 0;
+  Rgb color;
+};
+
+/// Pixel bounds of what fill_face painted: [x0, x1] x [y0, y1] (empty while x0 > x1).
+struct PixelBounds {
+  int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;
+};
+
+/// Paints the pixels whose centers lie inside the face: kSolidEdgeColor within `edge` pixels of
+/// its sides (the outline stays inside the face, so it is hidden exactly as the face is),
+/// f.color elsewhere. With `depth` (3D, one value per pixel, larger nearer): only where the face
+/// is nearer than `depth` holds, which it then updates. A face of no area paints nothing.
+void fill_face(Image& img, const Face& f, double edge, std::vector<float>* depth, PixelBounds& painted) {
+  double area2 = 0;  // twice the signed area: its sign tells which side of each edge is inside
+  for (int k = 0; k < 4; ++k) {
+    const auto& a = f.q[k];
+    const auto& b = f.q[(k + 1) % 4];
+    area2 += a[0] * b[1] - a[1] * b[0];
+  }
+  if (!(std::abs(area2) > 1e-9)) return;
+  // Inward unit normals of the four sides (nx, ny) and offsets: distance = nx x + ny y - off.
+  std::array<std::array<double, 3>, 4> side{};
+  for (int k = 0; k < 4; ++k) {
+    const auto& a = f.q[k];
+    const auto& b = f.q[(k + 1) % 4];
+    const double ex = b[0] - a[0], ey = b[1] - a[1], len = std::hypot(ex, ey);
+    if (!(len > 0)) return;
+    const double sign = area2 > 0 ? 1.0 : -1.0;
+    const double nx = -ey * sign / len, ny = ex * sign / len;
+    side[k] = {nx, ny, nx * a[0] + ny * a[1]};
+  }
+  double lo_x = f.q[0][0], hi_x = lo_x, lo_y = f.q[0][1], hi_y = lo_y;
+  for (const auto& c : f.q) {
+    lo_x = std::min(lo_x, c[0]);
+    hi_x = std::max(hi_x, c[0]);
+    lo_y = std::min(lo_y, c[1]);
+    hi_y = std::max(hi_y, c[1]);
+  }
+  const int xa = detail::floor_clamped(lo_x, 0, img.width()), xb = detail::ceil_clamped(hi_x, -1, img.width() - 1);
+  const int ya = detail::floor_clamped(lo_y, 0, img.height()), yb = detail::ceil_clamped(hi_y, -1, img.height() - 1);
+  for (int y = ya; y <= yb; ++y) {
+    const double py = y + 0.5;
+    const std::span<Rgb> row = img.row(y);
+    for (int x = xa; x <= xb; ++x) {
+      const double px = x + 0.5;
+      double inside = HUGE_VAL;  // distance to the nearest side, negative outside
+      for (const auto& s : side) inside = std::min(inside, s[0] * px + s[1] * py - s[2]);
+      if (inside < 0.0) continue;
+      if (depth != nullptr) {
+        const float w = static_cast<float>(f.w0 + f.gx * (px - f.q[0][0]) + f.gy * (py - f.q[0][1]));
+        float& held = (*depth)[static_cast<std::size_t>(y) * img.width() + x];
+        if (!(w > held)) continue;
+        held = w;
+      }
+      row[x] = inside < edge ? kSolidEdgeColor : f.color;
+      painted.x0 = std::min(painted.x0, x);
+      painted.x1 = std::max(painted.x1, x);
+      painted.y0 = std::min(painted.y0, y);
+      painted.y1 = std::max(painted.y1, y);
+    }
+  }
+}
+
+/// The outline width of solids, in pixels: about 1.5 at 800 x 600, wider in larger images.
+double solid_edge_width(const Image& img) { return 0.75 + std::min(img.width(), img.height()) / 800.0; }
+
+/// The faces of a solid box turned to the camera, flat-shaded by facing: one rectangle in 2D, up
+/// to three faces in 3D.
+std::vector<Face> solid_faces(const SolidBox& box, int dim, const ParticleCamera& cam) {
+  std::vector<Face> faces;
+  if (dim == 2) {
+    Face f;
+    const Vec3 corners[4] = {
+        {box.lo[0], box.lo[1], 0}, {box.hi[0], box.lo[1], 0}, {box.hi[0], box.hi[1], 0}, {box.lo[0], box.hi[1], 0}};
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 s = cam.project(corners[k]);
+      f.q[k] = {s[0], s[1]};
+    }
+    f.color = kSolidColor;
+    faces.push_back(f);
+    return faces;
+  }
+  const auto& axes = cam.axes();
+  for (int a = 0; a < 3; ++a)
+    for (int side = 0; side < 2; ++side) {
+      const double sign = side ? 1.0 : -1.0;
+      if (!(sign * axes[2][a] > 1e-9)) continue;  // turned away from the camera, or edge-on
+      const int b = (a + 1) % 3, c = (a + 2) % 3;
+      Face f;
+      std::array<double, 4> w{};
+      for (int k = 0; k < 4; ++k) {
+        Vec3 p{};
+        p[a] = side ? box.hi[a] : box.lo[a];
+        p[b] = k == 1 || k == 2 ? box.hi[b] : box.lo[b];
+        p[c] = k >= 2 ? box.hi[c] : box.lo[c];
+        const Vec3 s = cam.project(p);
+        f.q[k] = {s[0], s[1]};
+        w[k] = s[2];
+      }
+      // Depth gradient from the sides q0 -> q1 and q0 -> q3 (a parallelogram: orthographic).
+      const double ax = f.q[1][0] - f.q[0][0], ay = f.q[1][1] - f.q[0][1];
+      const double bx = f.q[3][0] - f.q[0][0], by = f.q[3][1] - f.q[0][1];
+      const double det = ax * by - ay * bx;
+      if (!(std::abs(det) > 1e-12)) continue;
+      f.w0 = w[0];
+      f.gx = ((w[1] - w[0]) * by - (w[3] - w[0]) * ay) / det;
+      f.gy = ((w[3] - w[0]) * ax - (w[1] - w[0]) * bx) / det;
+      const Vec3 n_cam{sign * axes[0][a], sign * axes[1][a], sign * axes[2][a]};
+      f.color = scaled(kSolidColor, kFaceAmbient + kFaceDiffuse * std::max(0.0, dot(n_cam, kFaceLight)));
+      faces.push_back(f);
+    }
+  return faces;
+}
+
 }  // namespace
 
 ParticleView default_particle_view(int dim, int width, int height) {
@@ -146,12 +277,18 @@ std::array<double, 3> ParticleCamera::project(const Vec3& p) const {
 }
 
 Image render_particles(std::span<const double> xyz, int dim, std::span<const Rgb> colors, double radius,
-                       const Vec3& box_lo, const Vec3& box_hi, const ParticleView& view) {
+                       const Vec3& box_lo, const Vec3& box_hi, const ParticleView& view,
+                       std::span<const SolidBox> solids) {
   SPH_CHECK(dim == 2 || dim == 3, "dimension must be 2 or 3");
   SPH_CHECK(xyz.size() % static_cast<std::size_t>(dim) == 0, "xyz must hold dim coordinates per particle");
   const std::size_t n = xyz.size() / static_cast<std::size_t>(dim);
   SPH_CHECK(colors.size() <= 1 || colors.size() == n, "colors must hold 0, 1 or one color per particle");
   const ParticleCamera cam(dim, box_lo, box_hi, radius, view);
+  for (std::size_t k = 0; k < solids.size(); ++k)
+    for (int a = 0; a < dim; ++a)
+      if (!std::isfinite(solids[k].lo[a]) || !std::isfinite(solids[k].hi[a]) || solids[k].lo[a] > solids[k].hi[a])
+        throw Error(fmt::format("obstacle {} must have finite corners with lo <= hi (axis {}: {} .. {})", k + 1,
+                                "xyz"[a], solids[k].lo[a], solids[k].hi[a]));
   Image img(view.width, view.height, view.background);
 
   // Box edges: corners k and k ^ (1 << a) differ along axis a.
@@ -189,6 +326,36 @@ Image render_particles(std::span<const double> xyz, int dim, std::span<const Rgb
   };
   draw_edges(false);
 
+  // 3D solids go under the particles, behind the nearer ones: their faces are painted now, per
+  // pixel nearest first (solid_depth), and after each particle the pixels where a face is nearer
+  // than the particle's center get the face back (`layer`). Painting far to near, every earlier
+  // particle at such a pixel was behind the face too, so this is exact per pixel. The particle's
+  // center depth suffices: a sphere touching a face from outside is in front of the face's plane
+  // over its whole disc, so only particles that reach into a solid lose pixels.
+  std::vector<float> solid_depth;
+  Image layer;
+  PixelBounds solid_pixels;
+  if (dim == 3 && !solids.empty()) {
+    solid_depth.assign(static_cast<std::size_t>(img.width()) * img.height(), -HUGE_VALF);
+    for (const SolidBox& s : solids)
+      for (const Face& f : solid_faces(s, dim, cam))
+        fill_face(img, f, solid_edge_width(img), &solid_depth, solid_pixels);
+    layer = img;
+  }
+  const auto hidden_by_solid = [&](int x, int y, double depth) {
+    return solid_depth[static_cast<std::size_t>(y) * img.width() + x] > static_cast<float>(depth);
+  };
+  const auto restore_solids = [&](double cx, double cy, double r, double depth) {
+    const double reach = r + 0.5;
+    const int xa = std::max(detail::floor_clamped(cx - reach, 0, img.width()), solid_pixels.x0);
+    const int xb = std::min(detail::ceil_clamped(cx + reach, -1, img.width() - 1), solid_pixels.x1);
+    const int ya = std::max(detail::floor_clamped(cy - reach, 0, img.height()), solid_pixels.y0);
+    const int yb = std::min(detail::ceil_clamped(cy + reach, -1, img.height() - 1), solid_pixels.y1);
+    for (int y = ya; y <= yb; ++y)
+      for (int x = xa; x <= xb; ++x)
+        if (hidden_by_solid(x, y, depth)) img.set(x, y, layer.at(x, y));
+  };
+
   // Project, skip non-finite positions, order far to near (3D).
   std::vector<Drawn> drawn;
   drawn.reserve(n);
@@ -211,16 +378,29 @@ Image render_particles(std::span<const double> xyz, int dim, std::span<const Rgb
   const double r = radius * cam.pixels_per_unit();
   for (const Drawn& d : drawn) {
     const Rgb c = colors.empty() ? kDefaultParticle : colors.size() == 1 ? colors[0] : colors[d.index];
-    if (r < 1.0)  // smaller than a pixel: still one whole pixel, shaded as a sphere's center
-      img.set(detail::floor_clamped(d.x, -1, img.width()), detail::floor_clamped(d.y, -1, img.height()),
-              view.shaded ? scaled(c, kAmbient + kDiffuse * kLight[2]) : c);
-    else if (view.shaded)
+    if (r < 1.0) {  // smaller than a pixel: still one whole pixel, shaded as a sphere's center
+      const int px = detail::floor_clamped(d.x, -1, img.width()), py = detail::floor_clamped(d.y, -1, img.height());
+      if (!solid_depth.empty() && img.contains(px, py) && hidden_by_solid(px, py, d.depth)) continue;
+      img.set(px, py, view.shaded ? scaled(c, kAmbient + kDiffuse * kLight[2]) : c);
+      continue;
+    }
+    if (view.shaded)
       shaded_disc(img, d.x, d.y, r, c);
     else
       img.fill_disc(d.x, d.y, r, c);
+    if (!solid_depth.empty()) restore_solids(d.x, d.y, r, d.depth);
   }
 
   draw_edges(true);
+  // 2D solids go over the particles and the container outline: in a healthy run no particle is
+  // inside one, so this hides nothing but the rims of particles pressed into a soft wall, and the
+  // obstacle keeps its true shape however the fluid leaks or penetrates (the run's health
+  // monitor, not the picture, is what reports a leak).
+  if (dim == 2) {
+    PixelBounds painted;
+    for (const SolidBox& s : solids)
+      for (const Face& f : solid_faces(s, dim, cam)) fill_face(img, f, solid_edge_width(img), nullptr, painted);
+  }
   return img;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 /// \file Images of particles: each particle a disc (optionally shaded as a sphere) seen by an
-/// orthographic camera fitted to the container box, which is drawn as a thin outline.
+/// orthographic camera fitted to the container box, which is drawn as a thin outline, and the
+/// scene's obstacles drawn as solid boxes.
 
 #include <array>
 #include <span>
@@ -19,6 +20,18 @@ struct ParticleView {
   Rgb background{255, 255, 255};
   bool shaded = true;  ///< sphere shading (Lambert, light from the upper left, plus ambient)
 };
+
+/// A solid axis-aligned box to draw (an obstacle of the scene): corners in world units, z
+/// ignored in 2D.
+struct SolidBox {
+  std::array<double, 3> lo{}, hi{};
+};
+
+/// The fill of a solid box in 2D, and the base color of its faces in 3D (each face scaled by
+/// its flat shading): a neutral gray between the white background and the container outline.
+inline constexpr Rgb kSolidColor{196, 196, 196};
+/// The outline of a solid box (its edges in 3D): darker than any shade of its faces.
+inline constexpr Rgb kSolidEdgeColor{72, 72, 72};
 
 /// A 3D camera that shows depth well (azimuth 30, elevation 20) for dim 3, the plain view for
 /// dim 2; width x height pixels.
@@ -56,10 +69,20 @@ class ParticleCamera {
 /// rectangle in 2D, its 12 projected edges in 3D (edges of faces turned to the camera are drawn
 /// over the particles, the others behind them). In 3D particles are drawn far to near (painter's
 /// algorithm; equal depths in index order), in 2D in index order. Particles with a non-finite
-/// coordinate are skipped. Throws sph::Error as ParticleCamera does. Preconditions: dim is 2 or 3,
-/// xyz.size() is a multiple of dim, colors.size() is 0, 1 or the particle count.
+/// coordinate are skipped.
+///
+/// Each of `solids` is drawn as a solid box with a kSolidEdgeColor outline: in 2D a rectangle
+/// filled with kSolidColor, drawn over the particles and the container outline; in 3D its faces
+/// turned to the camera, flat-shaded by facing, hidden per pixel behind nearer faces and by
+/// particles nearer than the face (depth of the particle's center), and hiding the particles
+/// behind them. Either way a particle inside a solid (a leak) is not seen: the solid always reads
+/// as the solid the fluid meets. Without solids the image is the same as before they existed.
+///
+/// Throws sph::Error as ParticleCamera does, and for a solid with non-finite corners or lo > hi.
+/// Preconditions: dim is 2 or 3, xyz.size() is a multiple of dim, colors.size() is 0, 1 or the
+/// particle count.
 Image render_particles(std::span<const double> xyz, int dim, std::span<const Rgb> colors, double radius,
                        const std::array<double, 3>& box_lo, const std::array<double, 3>& box_hi,
-                       const ParticleView& view);
+                       const ParticleView& view, std::span<const SolidBox> solids = {});
 
 }  // namespace sph

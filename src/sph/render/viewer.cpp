@@ -10,6 +10,7 @@
 #include <sph/core/error.h>
 #include <sph/io/frames.h>
 #include <sph/render/colormap.h>
+#include <sph/render/frame_image.h>
 
 namespace sph {
 
@@ -393,7 +394,17 @@ std::string json_vec3(const std::array<double, 3>& v) {
   return fmt::format("[{},{},{}]", json_number(v[0]), json_number(v[1]), json_number(v[2]));
 }
 
-/// The data block: the header (scene, boxes, colorings, notes) around the runs, which are freed.
+/// The scene's obstacles as [{"lo": [x, y, z], "hi": [x, y, z]}, ...] (z = 0 in 2D).
+std::string obstacles_json(const RunDirectory& run) {
+  std::string out = "[";
+  for (const SolidBox& b : run_obstacles(run))
+    out += fmt::format("{}{{\"lo\":{},\"hi\":{}}}", out.size() > 1 ? "," : "", json_vec3(b.lo), json_vec3(b.hi));
+  out += ']';
+  return out;
+}
+
+/// The data block: the header (scene, boxes, obstacles, colorings, notes) around the runs, which
+/// are freed.
 std::string data_json(const RunDirectory& run0, const QuantBox& qb, const std::string& colors,
                       const std::string& default_color, const std::vector<std::string>& page_notes, std::string& runs) {
   std::string notes = "[";
@@ -401,11 +412,11 @@ std::string data_json(const RunDirectory& run0, const QuantBox& qb, const std::s
   notes += ']';
   std::string data = fmt::format(
       "{{\"format\":\"sph-view\",\"version\":1,\"title\":{},\"description\":{},\"dimension\":{},"
-      "\"box\":{{\"lo\":{},\"hi\":{}}},\"qbox\":{{\"lo\":{},\"hi\":{}}},\"radius\":{},\"colors\":{},"
-      "\"defaultColor\":\"{}\",\"notes\":{},\"runs\":",
+      "\"box\":{{\"lo\":{},\"hi\":{}}},\"obstacles\":{},\"qbox\":{{\"lo\":{},\"hi\":{}}},\"radius\":{},"
+      "\"colors\":{},\"defaultColor\":\"{}\",\"notes\":{},\"runs\":",
       json_string(run0.scene.name), json_string(run0.scene.description), run0.dimension, json_vec3(run0.box_lo),
-      json_vec3(run0.box_hi), json_vec3(qb.lo), json_vec3(qb.hi), json_number(run0.particle_radius), colors,
-      default_color, notes);
+      json_vec3(run0.box_hi), obstacles_json(run0), json_vec3(qb.lo), json_vec3(qb.hi),
+      json_number(run0.particle_radius), colors, default_color, notes);
   data += runs;
   runs.clear();
   runs.shrink_to_fit();

@@ -3,7 +3,8 @@
 // work offline, from file://, and in browsers without WebGL (headless, remote desktops).
 //
 // Data (the JSON in #sph-data, written by src/sph/render/viewer.cpp):
-//   dimension, box {lo, hi} (the container), qbox {lo, hi} (what positions are quantized over),
+//   dimension, box {lo, hi} (the container), obstacles [{lo, hi}] (static solid boxes; z = 0 in
+//   2D), qbox {lo, hi} (what positions are quantized over),
 //   radius (particle radius, m), colors [{name, label, scalar, lo, hi, lut (base64, 256 RGB)}],
 //   defaultColor, notes [text], runs [{label, rgb?, frames [{t, n, pos, f {name: base64}, rgb?}]}].
 //   pos: n * dimension uint16 (little endian) over qbox; scalar fields: one byte per particle,
@@ -251,11 +252,12 @@
   let order = new Uint32Array(0), keys = new Uint16Array(0);
   const DEPTH_BINS = 4096;
   const binCount = new Uint32Array(DEPTH_BINS + 1);
+  let hid = new Uint8Array(0);  // 1 where a particle is behind (or inside) an obstacle, 3D
   function ensure(n) {
     if (sx.length >= n) return;
     const m = Math.max(n, 2 * sx.length);
     sx = new Float32Array(m); sy = new Float32Array(m); sr = new Float32Array(m); sz = new Float32Array(m);
-    order = new Uint32Array(m); keys = new Uint16Array(m);
+    order = new Uint32Array(m); keys = new Uint16Array(m); hid = new Uint8Array(m);
   }
   const dq = [0, 1, 2].map((k) => (hi[k] - lo[k]) / 65535);
 
@@ -309,6 +311,88 @@
     ctx.stroke();
   }
 
+  // ---- obstacles: solid boxes, as sph render draws them (src/sph/render/particles.h) ----------
+  // 2D: gray rectangles with a darker outline, over the particles. 3D: each box's faces turned to
+  // the camera, flat-shaded by facing, with their edges; particles whose center is behind (or
+  // inside) an obstacle are drawn before the faces, the others after them.
+  const OBSTACLES = DATA.obstacles || [];
+  const SOLID_RGB = [196, 196, 196], SOLID_EDGE = 'rgb(72, 72, 72)';
+  const FACE_LIGHT = (() => {  // camera space (right, up, back): mostly from above
+    const l = [-0.35, 0.85, 0.4], n = Math.hypot(...l);
+    return l.map((v) => v / n);
+  })();
+  function solidRgb(shade) { return `rgb(${SOLID_RGB.map((c) => Math.round(c * shade)).join(', ')})`; }
+
+  // True if the segment from the world point towards the eye (orthographic: the ray towards the
+  // viewer) meets an obstacle, the point itself included (slab test).
+  function hiddenBySolid(x, y, z, b, persp) {
+    const p = [x, y, z];
+    const d = persp ? [b.eye[0] - x, b.eye[1] - y, b.eye[2] - z] : b.back;
+    for (const o of OBSTACLES) {
+      let t0 = 0, t1 = persp ? 1 : Infinity;
+      for (let k = 0; k < 3 && t0 <= t1; k++) {
+        if (Math.abs(d[k]) < 1e-12) {
+          if (p[k] < o.lo[k] || p[k] > o.hi[k]) t0 = Infinity;
+          continue;
+        }
+        let ta = (o.lo[k] - p[k]) / d[k], tb = (o.hi[k] - p[k]) / d[k];
+        if (ta > tb) { const t = ta; ta = tb; tb = t; }
+        if (ta > t0) t0 = ta;
+        if (tb < t1) t1 = tb;
+      }
+      if (t0 <= t1) return true;
+    }
+    return false;
+  }
+
+  function drawSolids(ctx, proj, dpr) {
+    if (!OBSTACLES.length) return;
+    ctx.lineWidth = Math.max(1, 1.25 * dpr);
+    ctx.lineJoin = 'round';
+    ctx.strokeStyle = SOLID_EDGE;
+    if (DIM === 2) {
+      ctx.fillStyle = solidRgb(1);
+      for (const o of OBSTACLES) {
+        const a = proj.fn(o.lo[0], o.lo[1], 0), c = proj.fn(o.hi[0], o.hi[1], 0);
+        const x = Math.min(a[0], c[0]), y = Math.min(a[1], c[1]), w = Math.abs(c[0] - a[0]), h = Math.abs(c[1] - a[1]);
+        ctx.fillRect(x, y, w, h);
+        const e = ctx.lineWidth / 2;  // the outline inside the rectangle, as sph render draws it
+        if (w > 2 * e && h > 2 * e) ctx.strokeRect(x + e, y + e, w - 2 * e, h - 2 * e);
+      }
+      return;
+    }
+    const b = basis(state.cam), persp = $('perspective').checked;
+    const boxes = OBSTACLES.map((o) => {
+      const c = [0, 1, 2].map((k) => 0.5 * (o.lo[k] + o.hi[k]));
+      return { o, depth: proj.fn(c[0], c[1], c[2])[2] };
+    });
+    boxes.sort((u, v) => v.depth - u.depth);  // far to near
+    for (const { o } of boxes)
+      for (let a = 0; a < 3; a++)
+        for (const side of [0, 1]) {
+          const sign = side ? 1 : -1, at = side ? o.hi[a] : o.lo[a];
+          // Turned to the camera: towards the eye (perspective) or the viewer (orthographic).
+          const facing = persp ? sign * (b.eye[a] - at) : sign * b.back[a];
+          if (!(facing > 1e-9)) continue;
+          const u = (a + 1) % 3, v = (a + 2) % 3, pts = [];
+          for (const [ku, kv] of [[0, 0], [1, 0], [1, 1], [0, 1]]) {
+            const w = [0, 0, 0];
+            w[a] = at; w[u] = ku ? o.hi[u] : o.lo[u]; w[v] = kv ? o.hi[v] : o.lo[v];
+            pts.push(proj.fn(w[0], w[1], w[2]));
+          }
+          if (persp && pts.some((q) => q[2] <= 0)) continue;  // reaches behind the eye
+          const n = [sign * b.right[a], sign * b.up[a], sign * b.back[a]];
+          const shade = 0.55 + 0.45 * Math.max(0, n[0] * FACE_LIGHT[0] + n[1] * FACE_LIGHT[1] + n[2] * FACE_LIGHT[2]);
+          ctx.fillStyle = solidRgb(shade);
+          ctx.beginPath();
+          ctx.moveTo(pts[0][0], pts[0][1]);
+          for (let k = 1; k < 4; k++) ctx.lineTo(pts[k][0], pts[k][1]);
+          ctx.closePath();
+          ctx.fill();
+          ctx.stroke();
+        }
+  }
+
   function drawAxes(ctx, p, dpr) {
     if (DIM !== 3) return;
     const b = basis(state.cam), L = 22 * dpr, ox = 34 * dpr, oy = p.h - 30 * dpr;
@@ -341,6 +425,7 @@
     const proj = projector(p);
     ensure(n);
     const persp = DIM === 3 && $('perspective').checked;
+    const occluding = DIM === 3 && OBSTACLES.length > 0, b3 = occluding ? basis(state.cam) : null;
     let zmin = Infinity, zmax = -Infinity, rmax = 0, count = 0;
     for (let i = 0; i < n; i++) {
       const x = lo[0] + pos[DIM * i] * dq[0], y = lo[1] + pos[DIM * i + 1] * dq[1];
@@ -350,6 +435,7 @@
       const r = Math.max(0.6, DATA.radius * q[3]);
       if (q[0] < -r || q[1] < -r || q[0] > p.w + r || q[1] > p.h + r) continue;
       sx[count] = q[0]; sy[count] = q[1]; sz[count] = q[2]; sr[count] = r; order[count] = i;
+      hid[count] = occluding && hiddenBySolid(x, y, z, b3, persp) ? 1 : 0;
       count++;
       if (q[2] < zmin) zmin = q[2];
       if (q[2] > zmax) zmax = q[2];
@@ -372,10 +458,18 @@
       for (let j = 0; j < count; j++) idx[j] = j;
     }
     const cols = sp.cols, img = sp.canvas;
-    for (let m = 0; m < count; m++) {
-      const j = idx[m], b = bk[order[j]], r = sr[j];
-      ctx.drawImage(img, (b % cols) * S, ((b / cols) | 0) * S, S, S, sx[j] - r, sy[j] - r, 2 * r, 2 * r);
+    // 3D with obstacles: the particles behind them, the obstacles, the particles in front.
+    // 2D: every particle, then the obstacles over them.
+    for (const pass of occluding ? [1, 0] : [-1]) {
+      if (pass === 0) drawSolids(ctx, proj, dpr);
+      for (let m = 0; m < count; m++) {
+        const j = idx[m];
+        if (pass >= 0 && hid[j] !== pass) continue;
+        const b = bk[order[j]], r = sr[j];
+        ctx.drawImage(img, (b % cols) * S, ((b / cols) | 0) * S, S, S, sx[j] - r, sy[j] - r, 2 * r, 2 * r);
+      }
     }
+    if (DIM === 2) drawSolids(ctx, proj, dpr);
     drawEdges(ctx, proj, 'front', dpr);
     drawAxes(ctx, p, dpr);
   }

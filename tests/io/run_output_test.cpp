@@ -1,5 +1,6 @@
 // prepare_output_directory and RunOutput: the output directory of a run.
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 #include <string>
@@ -11,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <sph/core/error.h>
+#include <sph/io/frames.h>
 #include <sph/io/run_output.h>
 #include <sph/scene/builders.h>
 #include <sph/scene/scene_reader.h>
@@ -160,6 +162,62 @@ TEST(RunOutput, UnfinishedRunStillLeavesItsStats) {
   EXPECT_FALSE(fs::exists(dir / "summary.json"));
   EXPECT_FALSE(fs::exists(dir / "frames.pvd"));
   EXPECT_EQ(entries(dir.path()), (std::vector<std::string>{"frames", "run.json", "scene.json", "stats.csv"}));
+}
+
+}  // namespace
+}  // namespace sph
+
+namespace sph {
+namespace {
+
+// With boundary particles and Configuration.outputBoundary, the run directory holds boundary.vtu
+// (every sample once, its id and psi), summary.json counts the samples and stats.csv the
+// entries of their lists; with penalty walls there is no boundary.vtu.
+TEST(RunOutput, WritesTheBoundaryParticlesOnce) {
+  for (const char* handling : {"particles", "penalty"}) {
+    TempDir dir;
+    const SceneDesc desc = read_scene_file(
+        SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json",
+        {"Configuration.numberOfSteps=3", "Configuration.outputEveryNSteps=0", "Configuration.outputBoundary=true",
+         std::string("Configuration.boundaryHandling=") + handling});
+    auto sim = make_simulation<2, double>(desc);
+    prepare_output_directory(dir.path());
+    RunOutput<2, double> out(dir.path(), desc, RunInfo{"standard", 1});
+    out.begin(sim);
+    for (int s = 0; s < 3; ++s) out.after_step(sim, sim.step(), s == 2);
+    out.finish(sim, "completed", 0.1);
+    const auto j = nlohmann::json::parse(slurp(dir / "summary.json"));
+    EXPECT_EQ(j["boundary_samples"], sim.boundary().size());
+    const auto rows = lines(slurp(dir / "stats.csv"));
+    if (std::string(handling) == "penalty") {
+      EXPECT_FALSE(fs::exists(dir / "boundary.vtu"));
+      EXPECT_EQ(sim.boundary().size(), 0u);
+      continue;
+    }
+    ASSERT_GT(sim.boundary().size(), 1000u);
+    const FieldSpec psi{"psi", FieldKind::Real, "kg/m", "kg", ""};
+    const FrameData b = read_frame(dir / "boundary.vtu", std::span<const FieldSpec>(&psi, 1));
+    ASSERT_EQ(b.size, sim.boundary().size());
+    ASSERT_NE(b.field("psi"), nullptr);
+    ASSERT_NE(b.field("id"), nullptr);
+    for (std::size_t k = 0; k < b.size; k += 97) {
+      EXPECT_EQ(b.position[3 * k], sim.boundary().position[k][0]);
+      EXPECT_EQ(b.position[3 * k + 1], sim.boundary().position[k][1]);
+      EXPECT_EQ(b.field("psi")->values[k], sim.boundary().psi[k]);
+    }
+    // The step's boundary list entries (before the empty audit column).
+    const auto cells = [](const std::string& row) {
+      std::vector<std::string> c;
+      std::stringstream in(row);
+      for (std::string x; std::getline(in, x, ',');) c.push_back(x);
+      return c;
+    };
+    const auto head = cells(rows[0]);
+    const auto values = cells(rows.back());
+    const auto at = std::find(head.begin(), head.end(), "boundary_pairs_stored") - head.begin();
+    EXPECT_EQ(std::stoull(values[static_cast<std::size_t>(at)]), sim.last_step().neighbors.boundary_pairs_stored);
+    EXPECT_GT(sim.last_step().neighbors.boundary_pairs_stored, 0u);
+  }
 }
 
 }  // namespace

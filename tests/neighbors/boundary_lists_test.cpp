@@ -113,8 +113,8 @@ TEST(BoundaryLists, EveryStrategyListsThePairsWithinH) {
   const auto samples = wall_samples<double>();
   auto ps = random_particles<double>(3000, 0.0, 1.0, 11);
   const NeighborLists exact = brute_force_query_lists<3, double>(ps.position, samples, kH);
-  for (NeighborMode mode : {NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet,
-                            NeighborMode::BruteForce}) {
+  for (NeighborMode mode :
+       {NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet, NeighborMode::BruteForce}) {
     NeighborOptions opt;
     opt.radius = kH;
     auto s = make_neighbor_strategy<3, double>(mode, opt);

@@ -143,7 +143,10 @@ struct HydrostaticModel {
   std::array<double, 3> box_lo{}, box_hi{};
   double gravity = 9.81, rest_density = 1000, spacing = 0, h = 0;
   double skip_layers = 2;  ///< particles less deep than this many spacings are not compared
-  double bin_layers = 2;   ///< depth bin width, spacings
+  /// Particles closer than this to a side wall or the floor are not compared (< 0: h, where the
+  /// kernel is cut by penalty walls; boundary particles fill it, so 0 compares the whole tank).
+  double wall_margin = -1;
+  double bin_layers = 2;  ///< depth bin width, spacings
 };
 
 /// Pressure against depth after settling. Only interior particles are compared: deeper than
@@ -166,7 +169,7 @@ double lattice_gradient_consistency(int dimension, double spacing, double h, boo
 // ---- Running the cases ----------------------------------------------------------------------
 
 /// The cases of `sph validate`.
-inline constexpr std::array<const char*, 4> kValidationCases{"martin_moyce", "resolution", "hydrostatic",
+inline constexpr std::array<const char*, 5> kValidationCases{"martin_moyce", "resolution", "hydrostatic", "boundaries",
                                                              "conservation"};
 
 struct ValidationOptions {
@@ -221,6 +224,11 @@ struct HydrostaticRun {
   std::vector<EnergyParts> energy;             ///< at the same samples
   double initial_surface = 0, settling_time = 0, surface_drift = 0, predicted_ratio = 0;
   HydrostaticProfile profile;
+  /// The boundaries case: the boundary handling and kernel (scene names), the profile over the
+  /// whole tank (wall_margin 0), and the most particles outside the container in any step.
+  std::string boundary, kernel;
+  HydrostaticProfile whole;
+  std::uint64_t max_outside = 0;
   /// Interior particles' (depth, pressure) at the end, for the plot.
   std::vector<std::array<double, 2>> scatter;
 };
@@ -242,6 +250,7 @@ struct ValidationResult {
   std::vector<std::string> cases;
   std::vector<FrontRun> front_runs;  ///< martin_moyce (per mode) and resolution runs
   std::vector<HydrostaticRun> hydrostatic;
+  std::vector<HydrostaticRun> boundaries;  ///< hydrostatic tanks per (boundary handling, kernel)
   std::vector<MomentumRun> momentum;
   std::vector<ValidationCheck> checks;
 

@@ -16,6 +16,7 @@
 #include <sph/io/frames.h>
 #include <sph/run/driver.h>
 #include <sph/scene/dispatch.h>
+#include <sph/scene/scene_keys.h>
 #include <sph/scene/scene_reader.h>
 #include <sph/solver/wcsph.h>
 
@@ -90,7 +91,7 @@ class RunProgress {
 /// kept). Returns the wall seconds of the run.
 template <int D, std::floating_point R, class Sample>
 double run_sampled(RunDriver<D, R>& run, std::int64_t every, Sample&& sample, const ValidationProgress& progress,
-                   std::string label, std::string& failure) {
+                   std::string label, std::string& failure, const std::function<void()>& each_step = {}) {
   const std::int64_t steps = run.scene().steps;
   RunProgress rp(progress, std::move(label), steps);
   Stopwatch watch;
@@ -99,6 +100,7 @@ double run_sampled(RunDriver<D, R>& run, std::int64_t every, Sample&& sample, co
   callbacks.progress = [&](std::int64_t k, std::size_t) { rp.at(k); };
   const RunResult result = run.run(callbacks, [&](Simulation<D, R>& sim, const StepInfo&) {
     const std::int64_t k = sim.steps_done();
+    if (each_step) each_step();
     if (k % every == 0 || k == steps) sample();
   });
   failure = result.error;
@@ -113,6 +115,7 @@ double run_sampled(RunDriver<D, R>& run, std::int64_t every, Sample&& sample, co
 /// resolution) by scaling the spacing, h and dt with the spacing, the number of steps inversely
 /// (same end time), and the wall stiffness with 1 / spacing^2 (the same penetration in
 /// spacings under the same load).
+/// A `mode` of the form "MODE+particles" runs MODE with boundary particles (the boundaries case).
 SceneDesc martin_moyce_scene(const std::filesystem::path& dir, int resolution, const std::string& mode) {
   const std::string path = (dir / "martin_moyce_2d.json").string();
   const SceneDesc base = read_scene_file(path);
@@ -120,7 +123,9 @@ SceneDesc martin_moyce_scene(const std::filesystem::path& dir, int resolution, c
   const SimulationParams<2>& p = base.body<2>().sim;
   const double base_res = kMartinMoyceA / (2.0 * p.particle_radius);
   const double f = base_res / resolution;
-  std::vector<std::string> sets{"Configuration.neighbors=" + mode};
+  const std::size_t plus = mode.find('+');
+  std::vector<std::string> sets{"Configuration.neighbors=" + mode.substr(0, plus)};
+  if (plus != std::string::npos) sets.push_back("Configuration.boundaryHandling=" + mode.substr(plus + 1));
   if (std::abs(f - 1.0) > 1e-12) {
     sets.push_back("Configuration.particleRadius=" + num(p.particle_radius * f));
     sets.push_back("Configuration.kernelRadius=" + num(p.kernel_radius * f));
@@ -180,8 +185,11 @@ FrontRun run_front(const SceneDesc& desc, int resolution, const std::string& mod
 
 // ---- Hydrostatic runs --------------------------------------------------------------------------
 
+/// A hydrostatic tank; `extra` are --set overrides (the boundaries case's boundary handling and
+/// kernel), `label` names the run ("2D" if empty).
 HydrostaticRun run_hydrostatic(const std::filesystem::path& dir, int dimension, bool quick,
-                               const ValidationProgress& progress) {
+                               const ValidationProgress& progress, const std::vector<std::string>& extra = {},
+                               const std::string& label = "") {
   const std::string path = (dir / fmt::format("hydrostatic_{}d.json", dimension)).string();
   std::vector<std::string> sets;
   if (quick) {
@@ -199,11 +207,12 @@ HydrostaticRun run_hydrostatic(const std::filesystem::path& dir, int dimension, 
       sets.push_back("Container.wallStiffness=" + num(p.walls.stiffness / 4));
     });
   }
+  sets.insert(sets.end(), extra.begin(), extra.end());
   const SceneDesc desc = read_scene_file(path, sets);
   if (desc.dimension != dimension) throw Error(fmt::format("expected \"dimension\": {}", dimension), path);
   HydrostaticRun run;
   run.dimension = dimension;
-  run.label = fmt::format("{}D", dimension);
+  run.label = label.empty() ? fmt::format("{}D", dimension) : label;
   dispatch(desc, [&]<int D, std::floating_point R>() {
     RunDriver<D, R> driver(desc, RunSettings{});
     const Simulation<D, R>& sim = driver.simulation();
@@ -227,7 +236,12 @@ HydrostaticRun run_hydrostatic(const std::filesystem::path& dir, int dimension, 
       run.surface.push_back(free_surface_height(s, run.spacing));
       run.energy.push_back(energy(s, model));
     };
-    run.seconds = run_sampled(driver, every, sample, progress, "hydrostatic: " + run.label, run.failure);
+    const auto sample_all = [&]() {
+      run.max_outside = std::max<std::uint64_t>(run.max_outside, sim.last_step().health.outside);
+    };
+    run.seconds = run_sampled(driver, every, sample, progress, "hydrostatic: " + run.label, run.failure, sample_all);
+    run.boundary = detail::name_of(detail::kBoundaryHandlingNames, p.boundary.handling);
+    run.kernel = detail::name_of(detail::kKernelNames, p.fluid.kernel);
     HydrostaticModel m;
     for (int d = 0; d < D; ++d) m.box_lo[d] = p.container.lo[d], m.box_hi[d] = p.container.hi[d];
     m.gravity = run.gravity;
@@ -236,6 +250,8 @@ HydrostaticRun run_hydrostatic(const std::filesystem::path& dir, int dimension, 
     m.h = run.h;
     const FluidState s = state_of(sim);
     run.profile = hydrostatic_profile(s, m);
+    m.wall_margin = 0;
+    run.whole = hydrostatic_profile(s, m);
     for (std::size_t i = 0; i < s.position.size(); ++i) {
       const auto& x = s.position[i];
       bool interior = x[1] - m.box_lo[1] > m.h;
@@ -336,7 +352,9 @@ std::vector<std::string> selected_cases(const std::vector<std::string>& cases) {
   for (const std::string& c : cases) {
     if (std::find(kValidationCases.begin(), kValidationCases.end(), c) == kValidationCases.end())
       throw Error(
-          fmt::format("unknown case \"{}\"; expected martin_moyce, resolution, hydrostatic, conservation or all", c),
+          fmt::format(
+              "unknown case \"{}\"; expected martin_moyce, resolution, hydrostatic, boundaries, conservation or all",
+              c),
           "--cases");
     if (std::find(out.begin(), out.end(), c) == out.end()) out.push_back(c);
   }
@@ -418,6 +436,64 @@ void check_hydrostatic(ValidationResult& res, const HydrostaticRun& h) {
             ok && h.settling_time < settle_bound, q);
 }
 
+/// The (boundary handling, kernel) pairs of the boundaries case (docs/validation.md,
+/// "Boundaries"), the first being the one its checks hold to 2 %: boundary particles with the
+/// cubic spline. Quick: boundary particles with the cubic spline and the paper's kernels, 2D.
+std::vector<std::pair<std::string, std::string>> boundary_combinations(bool quick) {
+  if (quick) return {{"particles", "cubic"}, {"particles", "paper"}};
+  return {{"particles", "cubic"}, {"particles", "wendland"}, {"particles", "paper"},
+          {"penalty", "cubic"},   {"penalty", "wendland"},   {"penalty", "paper"}};
+}
+
+/// The hydrostatic tanks again for every (boundary handling, kernel) pair; checks on boundary
+/// particles: pressure within 2 % of rho0 g d below the second layer (over the whole tank, the
+/// walls included), no particle ever outside, the kinetic energy decaying to rest.
+void run_boundaries(ValidationResult& res, FrontRuns& fronts, const ValidationOptions& opt,
+                    const ValidationProgress& progress) {
+  const bool q = res.quick;
+  const std::string c = "boundaries";
+  // The dam break with boundary particles: the front at a/40 against the experiment, and the
+  // a/20 -> a/40 -> a/80 study (full runs only).
+  if (!q) {
+    const std::string mode = "standard+particles";
+    const std::vector<int> levels{20, 40, 80};
+    for (int n : levels) fronts.get(n, mode, c);
+    const FrontRun& base = fronts.get(40, mode, c);
+    add_check(res, c, fmt::format("max |dZ|, {}", base.label), base.error.max, "<= 0.1",
+              base.failure.empty() && base.error.complete && base.error.max <= 0.1, false);
+    FrontRun& mid = fronts.get(40, mode, c);
+    mid.change = front_change(mid.T, mid.Z, fronts.get(20, mode, c).T, fronts.get(20, mode, c).Z, mid.error);
+    FrontRun& fine = fronts.get(80, mode, c);
+    fine.change = front_change(fine.T, fine.Z, mid.T, mid.Z, fine.error);
+    add_check(res, c, fmt::format("max |Z(a/80) - Z(a/40)| (a/20 to a/40: {:.3f}), boundary particles", mid.change.max),
+              fine.change.max, fmt::format("<= {:.3f} (shrinks)", mid.change.max),
+              fine.failure.empty() && mid.change.complete && fine.change.complete && fine.change.max <= mid.change.max,
+              false);
+  }
+  for (int d : q ? std::vector<int>{2} : std::vector<int>{2, 3})
+    for (const auto& [boundary, kernel] : boundary_combinations(q)) {
+      res.boundaries.push_back(
+          run_hydrostatic(opt.scene_dir, d, q, progress,
+                          {"Configuration.boundaryHandling=" + boundary, "Configuration.kernel=" + kernel},
+                          fmt::format("{}D {} {}", d, boundary, kernel)));
+      const HydrostaticRun& h = res.boundaries.back();
+      if (boundary != "particles") continue;
+      const bool ok = h.failure.empty();
+      const bool held = boundary == "particles" && kernel == "cubic";  // the combination held to 2 %
+      if (held || q) {
+        const double bound = q ? 0.1 : 0.02;
+        add_check(res, c,
+                  fmt::format("{}: max |p / (rho0 g d) - 1| over depth bins below 2 layers, whole tank", h.label),
+                  h.whole.max_bin_error, fmt::format("<= {:g}", bound), ok && h.whole.max_bin_error <= bound, q);
+      }
+      add_check(res, c, fmt::format("{}: most particles outside the container in a step", h.label),
+                static_cast<double>(h.max_outside), "0", ok && h.max_outside == 0, q);
+      const double run_time = h.dt * static_cast<double>(h.steps);
+      add_check(res, c, fmt::format("{}: settling time (KE < 1 % of peak), s", h.label), h.settling_time,
+                fmt::format("< {:g} (the run's end)", run_time), ok && h.settling_time < run_time, q);
+    }
+}
+
 void run_conservation(ValidationResult& res, FrontRuns& fronts, const ValidationOptions& opt,
                       const ValidationProgress& progress) {
   const bool q = res.quick;
@@ -455,7 +531,7 @@ ValidationResult run_validation(const ValidationOptions& opt, const ValidationPr
   // Read every scene first: a missing or invalid one is refused before hours of running.
   if (wants("martin_moyce") || wants("resolution") || wants("conservation"))
     (void)martin_moyce_scene(opt.scene_dir, 40, "standard");
-  if (wants("hydrostatic")) {
+  if (wants("hydrostatic") || wants("boundaries")) {
     (void)read_scene_file((opt.scene_dir / "hydrostatic_2d.json").string());
     (void)read_scene_file((opt.scene_dir / "hydrostatic_3d.json").string());
   }
@@ -470,6 +546,7 @@ ValidationResult run_validation(const ValidationOptions& opt, const ValidationPr
       res.hydrostatic.push_back(run_hydrostatic(opt.scene_dir, d, res.quick, progress));
       check_hydrostatic(res, res.hydrostatic.back());
     }
+  if (wants("boundaries")) run_boundaries(res, fronts, opt, progress);
   if (wants("conservation")) run_conservation(res, fronts, opt, progress);
   res.seconds = wall.elapsed();
   return res;

@@ -206,9 +206,10 @@ HydrostaticProfile hydrostatic_profile(const FluidState& s, const HydrostaticMod
     p.max_compression = std::max(p.max_compression, rel);
     const double depth = p.surface - x[1];
     if (!(depth > top)) continue;
-    bool interior = x[1] - m.box_lo[1] > m.h;
+    const double margin = m.wall_margin < 0 ? m.h : m.wall_margin;
+    bool interior = x[1] - m.box_lo[1] > margin;
     for (int d = 0; d < s.dimension; ++d)
-      if (d != 1) interior = interior && x[d] - m.box_lo[d] > m.h && m.box_hi[d] - x[d] > m.h;
+      if (d != 1) interior = interior && x[d] - m.box_lo[d] > margin && m.box_hi[d] - x[d] > margin;
     if (!interior) continue;
     ++p.particles;
     ratio_sum += s.pressure[i] / (rho_g * depth);

@@ -137,6 +137,39 @@ std::string report_resolution(const ValidationResult& res) {
   return md;
 }
 
+/// report.md's section on the boundaries case: one row per (dimension, boundary, kernel).
+std::string report_boundaries(const ValidationResult& res) {
+  std::string md = "## Boundaries: hydrostatic tanks per boundary handling and kernel\n\n";
+  md +=
+      "The hydrostatic tanks again, for each Configuration.boundaryHandling and Configuration.kernel. The\n"
+      "interior error compares particles more than h from the walls (as the hydrostatic case does); the\n"
+      "whole-tank error compares every particle deeper than 2 spacings, next to the walls too. Outside:\n"
+      "the most particles outside the container in any step.\n\n";
+  md +=
+      "| tank | boundary | kernel | wall s | mean p/(rho0 g d) | max bin error, interior | max bin error, whole tank "
+      "| max compression | outside | settling |\n";
+  md += "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  for (const HydrostaticRun& h : res.boundaries)
+    md += fmt::format("| {}D{} | {} | {} | {:.1f} | {:.3f} | {:.3f} | {:.3f} | {:.2f} % | {} | {} s |\n", h.dimension,
+                      h.failure.empty() ? "" : " (failed)", h.boundary, h.kernel, h.seconds, h.whole.mean_ratio,
+                      h.profile.max_bin_error, h.whole.max_bin_error, 100 * h.whole.max_compression, h.max_outside,
+                      g(h.settling_time));
+  md += "\n" + checks_table(res, "boundaries");
+  return md;
+}
+
+/// boundaries.csv: the table of report_boundaries.
+void write_boundaries_csv(const std::filesystem::path& dir, const ValidationResult& res) {
+  std::string csv =
+      "dimension,boundary,kernel,failed,wall_seconds,mean_ratio,max_bin_error_interior,max_bin_error_whole,"
+      "max_compression,max_outside,settling_time\n";
+  for (const HydrostaticRun& h : res.boundaries)
+    csv += fmt::format("{},{},{},{},{:.3f},{:.6g},{:.6g},{:.6g},{:.6g},{},{:.6g}\n", h.dimension, h.boundary, h.kernel,
+                       h.failure.empty() ? 0 : 1, h.seconds, h.whole.mean_ratio, h.profile.max_bin_error,
+                       h.whole.max_bin_error, h.whole.max_compression, h.max_outside, h.settling_time);
+  write_file_atomic(dir / "boundaries.csv", csv);
+}
+
 /// report.md's section on the hydrostatic tanks.
 std::string report_hydrostatic(const ValidationResult& res) {
   std::string md = "## Hydrostatic tanks\n\n";
@@ -213,6 +246,7 @@ std::string report_md(const ValidationResult& res, const std::vector<std::string
   if (has(res, "martin_moyce")) md += report_martin_moyce(res);
   if (has(res, "resolution")) md += report_resolution(res);
   if (has(res, "hydrostatic")) md += report_hydrostatic(res);
+  if (has(res, "boundaries")) md += report_boundaries(res);
   if (has(res, "conservation")) md += report_conservation(res);
   md += "## Files\n\n";
   for (const auto& f : files) md += "- `" + f + "`\n";
@@ -231,6 +265,7 @@ std::vector<std::string> validation_files(const ValidationResult& res) {
                        "hydrostatic_settling.png"});
     for (const HydrostaticRun& h : res.hydrostatic) f.push_back(fmt::format("hydrostatic_{}d.png", h.dimension));
   }
+  if (has(res, "boundaries")) f.push_back("boundaries.csv");
   if (has(res, "conservation"))
     f.insert(f.end(), {"momentum.csv", "energy.csv", "momentum.png", "energy.png", "energy_parts.png"});
   return f;
@@ -453,6 +488,7 @@ void write_validation(const std::filesystem::path& dir, const ValidationResult& 
               front_plot(mode_runs(res), "Dam break front: neighbor modes against Martin & Moyce (1952)"));
   if (has(res, "resolution")) write_resolution_plots(dir, res);
   if (has(res, "hydrostatic")) write_hydrostatic_files(dir, res);
+  if (has(res, "boundaries")) write_boundaries_csv(dir, res);
   if (has(res, "conservation")) write_conservation_files(dir, res);
   write_file_atomic(dir / "report.md", report_md(res, validation_files(res)));
 }

@@ -11,8 +11,8 @@
 #include <sph/core/state_stream.h>
 #include <sph/core/timer.h>
 #include <sph/core/version.h>
-#include <sph/io/vtk.h>
 #include <sph/io/atomic_file.h>
+#include <sph/io/vtk.h>
 #include <sph/scene/scene_writer.h>
 
 namespace sph {
@@ -127,7 +127,8 @@ void RunOutput<D, R>::write_boundary(const Simulation<D, R>& sim) const {
   if (b.size() == 0) return;
   ParticleSet<D, R> samples;
   samples.reserve(b.size());
-  const std::size_t psi = samples.add_field({"psi", FieldKind::Real, "kg/m", "kg", "a boundary sample's psi = rho0 V_b"});
+  const std::size_t psi =
+      samples.add_field({"psi", FieldKind::Real, "kg/m", "kg", "a boundary sample's psi = rho0 V_b"});
   for (std::size_t k = 0; k < b.size(); ++k) samples.add(b.position[k], Vec<D, R>{}, b.psi[k]);
   samples.real_field(psi) = b.psi;
   write_vtu(dir_ / "boundary.vtu", samples, 0.0, FrameFields::only({"id", "psi"}));
@@ -280,6 +281,7 @@ void RunOutput<D, R>::finish(const Simulation<D, R>& sim, const std::string& sta
   s["simulated_time"] = sim.time();
   s["time_step"] = sim.params().time_step;
   s["particles"] = sim.particles().size();
+  s["boundary_samples"] = sim.boundary().size();
   s["frames"] = frames_.frames_written();
   nlohmann::ordered_json formats = nlohmann::ordered_json::array();
   for (FrameFormat f : desc_.output.formats) formats.push_back(frame_format_name(f));

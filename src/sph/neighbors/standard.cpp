@@ -63,9 +63,9 @@ void BruteForceNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
   counters_.boundary_pairs_stored = boundary_lists_.entry_count();
 }
 
-#define SPH_INSTANTIATE(D, R)               \
-  template class StandardNeighbors<D, R>;   \
-  template class BruteForceNeighbors<D, R>; \
+#define SPH_INSTANTIATE(D, R)                                                    \
+  template class StandardNeighbors<D, R>;                                        \
+  template class BruteForceNeighbors<D, R>;                                      \
   template NeighborLists brute_force_lists<D, R>(std::span<const Vec<D, R>>, R); \
   template NeighborLists brute_force_query_lists<D, R>(std::span<const Vec<D, R>>, std::span<const Vec<D, R>>, R);
 SPH_INSTANTIATE(2, float)

@@ -51,7 +51,6 @@ NeighborLists brute_force_lists(std::span<const Vec<D, R>> positions, R radius);
 /// Every sample closer than `radius` to each query point, by testing every pair (brute-force
 /// boundary lists: the reference the grid's are tested against).
 template <int D, std::floating_point R>
-NeighborLists brute_force_query_lists(std::span<const Vec<D, R>> queries, std::span<const Vec<D, R>> samples,
-                                      R radius);
+NeighborLists brute_force_query_lists(std::span<const Vec<D, R>> queries, std::span<const Vec<D, R>> samples, R radius);
 
 }  // namespace sph

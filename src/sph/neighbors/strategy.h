@@ -16,11 +16,11 @@ class StateReader;
 
 /// What one update() did.
 struct NeighborCounters {
-  std::uint64_t lists_rebuilt = 0;  ///< particles whose list was rebuilt this step
-  std::uint64_t pairs_stored = 0;   ///< directed entries stored in all lists
+  std::uint64_t lists_rebuilt = 0;          ///< particles whose list was rebuilt this step
+  std::uint64_t pairs_stored = 0;           ///< directed entries stored in all lists
   std::uint64_t boundary_pairs_stored = 0;  ///< entries stored in the boundary lists
-  double grid_seconds = 0;          ///< wall time spent building the grid
-  double lists_seconds = 0;         ///< wall time spent building lists
+  double grid_seconds = 0;                  ///< wall time spent building the grid
+  double lists_seconds = 0;                 ///< wall time spent building lists
 };
 
 /// Options shared by the strategies (those a strategy does not use are ignored by it).

@@ -190,7 +190,8 @@ void check_blocks_clear_of_obstacles(const ReadContext& ctx, const SceneBody<D>&
 /// Fluid.particleMass far from the lattice mass: the initial density is that many times rho0.
 template <int D>
 void check_mass(const ReadContext& ctx, SceneDesc& desc, const SimulationParams<D>& sim) {
-  const double lattice = lattice_mass<D>(sim.fluid.rest_density, 2.0 * sim.particle_radius, sim.kernel_radius, sim.fluid.kernel);
+  const double lattice =
+      lattice_mass<D>(sim.fluid.rest_density, 2.0 * sim.particle_radius, sim.kernel_radius, sim.fluid.kernel);
   if (!(std::isfinite(lattice) && lattice > 0)) return;  // the reader refuses a default mass like that
   const double ratio = sim.particle_mass / lattice;
   const double factor = std::max(ratio, 1 / ratio);

@@ -25,12 +25,13 @@ inline const std::vector<std::string> kRootKeys{"version",     "name",          
                                                 "dimension",   "Configuration", "Fluid",       "Container",
                                                 "FluidBlocks", "Obstacles",     "Emitters"};
 inline const std::vector<std::string> kConfigurationKeys{
-    "precision",   "timeStepSize",  "numberOfSteps",     "stopAt",     "particleRadius", "kernelRadius",
-    "gravitation", "neighbors",     "fullRebuildPeriod", "verletSkin", "reorderPeriod",  "boundaryHandling",
-    "boundaryFriction", "kernel", "outputEveryNSteps", "outputFps", "outputFormats", "outputFields", "outputBoundary"};
-inline const std::vector<std::string> kFluidKeys{"density0",         "stiffness",      "viscosity",
-                                                 "viscosityModel",   "artificialViscosityAlpha", "negativePressure",
-                                                 "pressureForce",    "gradientCorrection",       "particleMass"};
+    "precision",        "timeStepSize", "numberOfSteps",     "stopAt",     "particleRadius", "kernelRadius",
+    "gravitation",      "neighbors",    "fullRebuildPeriod", "verletSkin", "reorderPeriod",  "boundaryHandling",
+    "boundaryFriction", "kernel",       "outputEveryNSteps", "outputFps",  "outputFormats",  "outputFields",
+    "outputBoundary"};
+inline const std::vector<std::string> kFluidKeys{
+    "density0",         "stiffness",     "viscosity",          "viscosityModel", "artificialViscosityAlpha",
+    "negativePressure", "pressureForce", "gradientCorrection", "particleMass"};
 inline const std::vector<std::string> kContainerKeys{"start", "end", "wallStiffness", "wallDamping"};
 inline const std::vector<std::string> kFluidBlockKeys{"start", "end", "velocity"};
 inline const std::vector<std::string> kObstacleKeys{"start", "end"};

@@ -140,9 +140,9 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
   sim.boundary.handling =
       value_named(detail::kBoundaryHandlingNames,
                   c.choice("boundaryHandling", names_of(detail::kBoundaryHandlingNames), kDefaultBoundaryHandling));
-  sim.boundary.friction = c.positive(
-      "boundaryFriction", "a boundary friction sigma >= 0 (Akinci et al. 2012; 0: free slip)", sim.boundary.friction,
-      true);
+  sim.boundary.friction =
+      c.positive("boundaryFriction", "a boundary friction sigma >= 0 (Akinci et al. 2012; 0: free slip)",
+                 sim.boundary.friction, true);
   sim.fluid.kernel = value_named(detail::kKernelNames, c.choice("kernel", names_of(detail::kKernelNames), "paper"));
   sim.verlet_skin = c.positive("verletSkin", "a positive verlet skin in metres (default 0.1 h)",
                                kDefaultSkinFraction * sim.kernel_radius);
@@ -200,8 +200,8 @@ void read_fluid(ObjectReader& f, SimulationParams<D>& sim, Derived& derived) {
     sim.fluid.stiffness = f.positive("stiffness", "a positive EOS stiffness k in m^2/s^2 (p = k (rho - rho0))");
   derived.viscosity = !f.find("viscosity");
   if (!derived.viscosity) sim.fluid.viscosity = f.positive("viscosity", "a viscosity >= 0 in Pa s", 0.0, true);
-  sim.fluid.viscosity_model = value_named(
-      detail::kViscosityModelNames, f.choice("viscosityModel", names_of(detail::kViscosityModelNames), "paper"));
+  sim.fluid.viscosity_model = value_named(detail::kViscosityModelNames,
+                                          f.choice("viscosityModel", names_of(detail::kViscosityModelNames), "paper"));
   sim.fluid.alpha = f.positive("artificialViscosityAlpha",
                                "Monaghan's artificial viscosity coefficient alpha >= 0 (typical: 0.01 to 0.1)",
                                kArtificialViscosityAlpha, true);

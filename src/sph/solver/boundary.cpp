@@ -109,8 +109,8 @@ template <int D, std::floating_point R>
 BoundarySet<D, R> make_boundary(const SimulationParams<D>& params) {
   BoundarySet<D, R> set;
   if (params.boundary.handling != BoundaryHandling::Particles) return set;
-  for (const auto& x : sample_boundary<D>(params.container, params.obstacles, 2.0 * params.particle_radius,
-                                          params.kernel_radius))
+  for (const auto& x :
+       sample_boundary<D>(params.container, params.obstacles, 2.0 * params.particle_radius, params.kernel_radius))
     set.position.push_back(vec_cast<R>(x));
   SPH_CHECK(set.position.size() < (std::size_t{1} << 31) / D, "too many boundary samples for 32-bit gather offsets");
   set.psi = boundary_psi<D, R>(set.position, params.fluid, static_cast<R>(params.kernel_radius));
@@ -119,7 +119,7 @@ BoundarySet<D, R> make_boundary(const SimulationParams<D>& params) {
 
 template std::vector<Vec<2, double>> sample_boundary<2>(const Box<2>&, const std::vector<Box<2>>&, double, double);
 template std::vector<Vec<3, double>> sample_boundary<3>(const Box<3>&, const std::vector<Box<3>>&, double, double);
-#define SPH_INSTANTIATE(D, R)                                                                          \
+#define SPH_INSTANTIATE(D, R)                                                                    \
   template std::vector<R> boundary_psi<D, R>(std::span<const Vec<D, R>>, const FluidParams&, R); \
   template BoundarySet<D, R> make_boundary<D, R>(const SimulationParams<D>&);
 SPH_INSTANTIATE(2, float)

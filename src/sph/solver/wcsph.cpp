@@ -41,7 +41,8 @@ template <int D, std::floating_point R>
 void check_boundary_inputs(const ParticleSet<D, R>& ps, const BoundaryView<D, R>& boundary) {
   SPH_CHECK(boundary.lists->particle_count() == ps.size(), "boundary lists do not cover the particles");
   SPH_CHECK(boundary.psi.size() == boundary.position.size(), "one psi per boundary sample");
-  SPH_CHECK(boundary.position.size() * D < (std::size_t{1} << 31), "too many boundary samples for 32-bit gather offsets");
+  SPH_CHECK(boundary.position.size() * D < (std::size_t{1} << 31),
+            "too many boundary samples for 32-bit gather offsets");
 }
 
 /// rij = x_i - x_j for one register of neighbors j = idx[0..lanes), gathered from the flat
@@ -304,7 +305,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
         P vr = zero;
         for (int d = 0; d < D; ++d) vr = vr + (vi[d] - vj[d]) * rij[d];
         const Mask approaching = near & (vr < zero);
-        const P f = gradient_factor<K, kVariational && K == KernelKind::Paper, D>(kernel, r2, r, near, h);
+        const P f = gradient_factor < K, kVariational && K == KernelKind::Paper, D > (kernel, r2, r, near, h);
         const P pi_ij = art_i * (vr / (r2 + eps_h2)) / (rhoi_v + rhoj);
         fp = fp + select(approaching, minus_one * mj * pi_ij * f, zero);
       } else if constexpr (K == KernelKind::Paper) {
@@ -348,7 +349,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
         const P r2 = pair_offsets<D>(xi, bpos, bidx + k0, rib);
         const Mask near = valid & (r2 < h2v);
         const P r = sqrt(select(near, r2, h2v));
-        const P f = gradient_factor<K, kVariational && K == KernelKind::Paper, D>(kernel, r2, r, near, h);
+        const P f = gradient_factor < K, kVariational && K == KernelKind::Paper, D > (kernel, r2, r, near, h);
         const P psib = P::template gather<1>(psi, bidx + k0, 0);
         P vr = zero;
         for (int d = 0; d < D; ++d) vr = vr + vi[d] * rib[d];
@@ -466,8 +467,8 @@ void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, 
 }  // namespace
 
 template <int D, std::floating_point R>
-std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h,
-                                       const FluidParams& fluid, const BoundaryView<D, R>& boundary) {
+std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
+                                       const BoundaryView<D, R>& boundary) {
   check_pass_inputs(ps, lists);
   if (boundary.active()) check_boundary_inputs(ps, boundary);
   thread_local std::vector<std::uint64_t> within;  // per-chunk counts, kept between steps
@@ -551,10 +552,10 @@ double lattice_mass(double rest_density, double spacing, double h, KernelKind ke
   return rest_density / sum;
 }
 
-#define SPH_INSTANTIATE(D, R)                                                                                \
-  template std::uint64_t compute_density_pressure<D, R>(ParticleSet<D, R>&, const NeighborLists&, R,         \
-                                                        const FluidParams&, const BoundaryView<D, R>&);      \
-  template void compute_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&, \
+#define SPH_INSTANTIATE(D, R)                                                                                       \
+  template std::uint64_t compute_density_pressure<D, R>(ParticleSet<D, R>&, const NeighborLists&, R,                \
+                                                        const FluidParams&, const BoundaryView<D, R>&);             \
+  template void compute_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&,        \
                                             const Vec<D, R>&, const WallContact<D, R>&, std::span<std::uint8_t>, R, \
                                             const BoundaryView<D, R>&);
 SPH_INSTANTIATE(2, float)

@@ -31,8 +31,8 @@ struct BoundaryView {
 ///
 /// Returns the number of listed (directed) fluid pairs closer than h.
 template <int D, std::floating_point R>
-std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h,
-                                       const FluidParams& fluid, const BoundaryView<D, R>& boundary = {});
+std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
+                                       const BoundaryView<D, R>& boundary = {});
 
 /// The damped penalty acceleration of the container walls and the obstacles on one particle.
 /// A particle interacts with a wall plane when closer than `particle_radius` to it; the contact

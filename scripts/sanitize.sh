@@ -128,7 +128,7 @@ stage_asan() {
 unit_layers=(core neighbors solver scene)
 unit_targets=("${unit_layers[@]/#/test_}")
 unit_label="^($(IFS='|'; echo "${unit_layers[*]}"))\$"
-long_physics='^(Hydrostatic|Conservation|Settling)\.'
+long_physics='^(Hydrostatic|Conservation|Settling|BoundarySettling)\.'
 
 
 stage_asan-units() {

@@ -177,6 +177,11 @@ CompareResult run_all(const SceneDesc& desc, const CompareOptions& opt, const Co
   res.particle_mass = p.particle_mass;
   res.perturbation = opt.perturbation;
   for (int d = 0; d < D; ++d) res.box_lo[d] = p.container.lo[d], res.box_hi[d] = p.container.hi[d];
+  for (const Box<D>& b : p.obstacles) {
+    SolidBox s;
+    for (int d = 0; d < D; ++d) s.lo[d] = b.lo[d], s.hi[d] = b.hi[d];
+    res.obstacles.push_back(s);
+  }
   res.has_emitters = !p.emitters.empty();
   res.audited = opt.audit;
   res.steps = opt.steps > 0 ? opt.steps : desc.steps;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <sph/neighbors/strategy.h>
+#include <sph/render/particles.h>
 #include <sph/scene/scene_desc.h>
 #include <sph/solver/simulation.h>
 
@@ -86,6 +87,7 @@ struct CompareResult {
   int threads = 1;
   double h = 0, dt = 0, particle_radius = 0, particle_mass = 0, perturbation = 0;
   std::array<double, 3> box_lo{}, box_hi{};
+  std::vector<SolidBox> obstacles;  ///< the scene's obstacles, drawn in the report's pictures
   bool has_emitters = false;
   bool audited = false;  ///< missed-pair figures exist (CompareOptions::audit)
   std::int64_t steps = 0;

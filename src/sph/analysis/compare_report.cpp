@@ -159,7 +159,8 @@ Image frame_image(const CompareResult& res, std::int64_t step, double mass) {
         }
       }
     }
-    Image panel = render_particles(xyz, res.dimension, colors, res.particle_radius, res.box_lo, res.box_hi, view);
+    Image panel =
+        render_particles(xyz, res.dimension, colors, res.particle_radius, res.box_lo, res.box_hi, view, res.obstacles);
     panels.push_back(std::move(panel));
     captions.push_back(r.failure.empty() ? fmt::format("{} (step {})", r.label, step)
                                          : fmt::format("{} (blew up before step {})", r.label, step));

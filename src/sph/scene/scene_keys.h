@@ -27,7 +27,7 @@ inline const std::vector<std::string> kRootKeys{"version",     "name",          
 inline const std::vector<std::string> kConfigurationKeys{
     "precision",        "timeStepSize", "numberOfSteps",     "stopAt",     "particleRadius", "kernelRadius",
     "gravitation",      "neighbors",    "fullRebuildPeriod", "verletSkin", "reorderPeriod",  "boundaryHandling",
-    "boundaryFriction", "kernel",       "outputEveryNSteps", "outputFps",  "outputFormats",  "outputFields",
+    "boundaryVolume", "boundaryFriction", "kernel",       "outputEveryNSteps", "outputFps",  "outputFormats",  "outputFields",
     "outputBoundary"};
 inline const std::vector<std::string> kFluidKeys{
     "density0",         "stiffness",     "viscosity",          "viscosityModel", "artificialViscosityAlpha",
@@ -62,6 +62,8 @@ inline constexpr Named<GradientCorrection> kGradientCorrectionNames[] = {
     {GradientCorrection::None, "none"}, {GradientCorrection::Renormalize, "renormalize"}};
 inline constexpr Named<BoundaryHandling> kBoundaryHandlingNames[] = {{BoundaryHandling::Penalty, "penalty"},
                                                                      {BoundaryHandling::Particles, "particles"}};
+inline constexpr Named<BoundaryVolume> kBoundaryVolumeNames[] = {{BoundaryVolume::RestFluid, "rest_fluid"},
+                                                                 {BoundaryVolume::Akinci, "akinci"}};
 inline constexpr Named<KernelKind> kKernelNames[] = {
     {KernelKind::Paper, "paper"}, {KernelKind::Cubic, "cubic"}, {KernelKind::Wendland, "wendland"}};
 inline constexpr Named<ViscosityModel> kViscosityModelNames[] = {{ViscosityModel::Paper, "paper"},

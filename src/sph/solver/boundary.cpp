@@ -1,5 +1,6 @@
 #include <sph/solver/boundary.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include <sph/core/error.h>
@@ -86,20 +87,66 @@ std::vector<Vec<D, double>> sample_boundary(const Box<D>& container, const std::
   return out;
 }
 
+template <int D>
+std::vector<Vec<D, double>> rest_fluid_sites(const Box<D>& container, const std::vector<Box<D>>& obstacles,
+                                             double spacing, double h) {
+  const int layers = boundary_layers(spacing, h);
+  const double depth = layers * spacing;
+  const auto in_box = [](const Vec<D, double>& x, const Box<D>& b) {
+    for (int d = 0; d < D; ++d)
+      if (!(x[d] > b.lo[d] && x[d] < b.hi[d])) return false;
+    return true;
+  };
+  const auto in_obstacle = [&](const Vec<D, double>& x) {
+    return std::any_of(obstacles.begin(), obstacles.end(), [&](const Box<D>& b) { return in_box(x, b); });
+  };
+  std::vector<Vec<D, double>> out;
+  std::array<AxisSites, D> axes;
+  for (int d = 0; d < D; ++d) axes[d] = axis_sites(container.lo[d], container.hi[d], spacing, layers, false);
+  for_each_site<D>(axes, [&](const std::array<int, D>& idx) {
+    bool near_face = false;
+    Vec<D, double> x;
+    for (int d = 0; d < D; ++d) {
+      near_face = near_face || idx[d] < layers || idx[d] >= axes[d].inner - layers;
+      x[d] = axes[d].x[static_cast<std::size_t>(idx[d])];
+    }
+    if (near_face && !in_obstacle(x)) out.push_back(x);
+  });
+  Box<D> core = container;  // the container's sites cover the depth next to its faces
+  for (int d = 0; d < D; ++d) core.lo[d] += depth, core.hi[d] -= depth;
+  for (const Box<D>& b : obstacles) {
+    for (int d = 0; d < D; ++d) axes[d] = axis_sites(b.lo[d], b.hi[d], spacing, layers, true);
+    for_each_site<D>(axes, [&](const std::array<int, D>& idx) {
+      Vec<D, double> x;
+      for (int d = 0; d < D; ++d) x[d] = axes[d].x[static_cast<std::size_t>(idx[d])];
+      if (in_box(x, core) && !in_obstacle(x)) out.push_back(x);
+    });
+  }
+  return out;
+}
+
 template <int D, std::floating_point R>
-std::vector<R> boundary_psi(std::span<const Vec<D, R>> samples, const FluidParams& fluid, R h) {
+std::vector<R> boundary_psi(std::span<const Vec<D, R>> samples, const FluidParams& fluid, R h,
+                            std::span<const Vec<D, R>> rest) {
   std::vector<R> psi(samples.size());
   if (samples.empty()) return psi;
   UniformGrid<D, R> grid;
   grid.build(samples, h);
   ListBuilder<D, R> builder;
-  NeighborLists lists;
+  NeighborLists lists, rest_lists;
   builder.build(grid, samples, h, lists);
+  if (!rest.empty()) {
+    UniformGrid<D, R> rest_grid;
+    rest_grid.build(rest, h);
+    builder.build_queries(rest_grid, samples, h, rest_lists);
+  }
   const SmoothingKernels<D, R> kernels(fluid, h);
   const R rho0 = static_cast<R>(fluid.rest_density);
   parallel_for(samples.size(), [&](std::size_t b) {
     R delta = kernels.w_zero();
     for (const std::uint32_t k : lists.of(b)) delta += kernels.w_r2(norm2(samples[b] - samples[k]));
+    if (!rest.empty())
+      for (const std::uint32_t k : rest_lists.of(b)) delta += kernels.w_r2(norm2(samples[b] - rest[k]));
     psi[b] = rho0 / delta;
   });
   return psi;
@@ -113,14 +160,22 @@ BoundarySet<D, R> make_boundary(const SimulationParams<D>& params) {
        sample_boundary<D>(params.container, params.obstacles, 2.0 * params.particle_radius, params.kernel_radius))
     set.position.push_back(vec_cast<R>(x));
   SPH_CHECK(set.position.size() < (std::size_t{1} << 31) / D, "too many boundary samples for 32-bit gather offsets");
-  set.psi = boundary_psi<D, R>(set.position, params.fluid, static_cast<R>(params.kernel_radius));
+  std::vector<Vec<D, R>> rest;
+  if (params.boundary.volume == BoundaryVolume::RestFluid)
+    for (const auto& x : rest_fluid_sites<D>(params.container, params.obstacles, 2.0 * params.particle_radius,
+                                             params.kernel_radius))
+      rest.push_back(vec_cast<R>(x));
+  set.psi = boundary_psi<D, R>(set.position, params.fluid, static_cast<R>(params.kernel_radius), rest);
   return set;
 }
 
 template std::vector<Vec<2, double>> sample_boundary<2>(const Box<2>&, const std::vector<Box<2>>&, double, double);
 template std::vector<Vec<3, double>> sample_boundary<3>(const Box<3>&, const std::vector<Box<3>>&, double, double);
-#define SPH_INSTANTIATE(D, R)                                                                    \
-  template std::vector<R> boundary_psi<D, R>(std::span<const Vec<D, R>>, const FluidParams&, R); \
+template std::vector<Vec<2, double>> rest_fluid_sites<2>(const Box<2>&, const std::vector<Box<2>>&, double, double);
+template std::vector<Vec<3, double>> rest_fluid_sites<3>(const Box<3>&, const std::vector<Box<3>>&, double, double);
+#define SPH_INSTANTIATE(D, R)                                                                     \
+  template std::vector<R> boundary_psi<D, R>(std::span<const Vec<D, R>>, const FluidParams&, R, \
+                                             std::span<const Vec<D, R>>);                       \
   template BoundarySet<D, R> make_boundary<D, R>(const SimulationParams<D>&);
 SPH_INSTANTIATE(2, float)
 SPH_INSTANTIATE(2, double)

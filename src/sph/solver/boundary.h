@@ -12,7 +12,10 @@
 /// from each face, samples outside the container dropped.
 ///
 /// Each sample b carries psi_b = rho0 V_b with V_b = 1 / sum_k W(x_b - x_k), the sum over the
-/// samples within h, b included (Akinci's eq. 4-5): where samples are dense each counts less.
+/// samples within h, b included (Akinci's eq. 4-5): where samples are dense each counts less;
+/// with BoundaryVolume::RestFluid (default) the sum also counts the fluid at rest on the
+/// solid's fluid side (rest_fluid_sites), so that a sample next to the fluid weighs what the
+/// fluid it stands for would.
 
 #include <span>
 #include <vector>
@@ -39,10 +42,21 @@ struct BoundarySet {
   std::size_t size() const { return position.size(); }
 };
 
-/// psi_b = rho0 / sum_k W(x_b - x_k) over the samples within h (b included), W the run's density
-/// kernel (FluidParams::kernel). Deterministic for any thread count.
+/// The lattice sites of fluid at rest next to the solids (BoundaryVolume::RestFluid): the
+/// container's interior sites within the layers' depth of a face, and each obstacle's sites
+/// within that depth outside it (on its own lattice, continued outwards), leaving out sites in
+/// an obstacle and, for an obstacle's, sites the container's already cover (within the depth of
+/// a container face), m.
+template <int D>
+std::vector<Vec<D, double>> rest_fluid_sites(const Box<D>& container, const std::vector<Box<D>>& obstacles,
+                                             double spacing, double h);
+
+/// psi_b = rho0 / delta_b, delta_b = sum_k W(x_b - x_k) over the samples within h (b included)
+/// and the `rest` points within h, W the run's density kernel (FluidParams::kernel).
+/// Deterministic for any thread count.
 template <int D, std::floating_point R>
-std::vector<R> boundary_psi(std::span<const Vec<D, R>> samples, const FluidParams& fluid, R h);
+std::vector<R> boundary_psi(std::span<const Vec<D, R>> samples, const FluidParams& fluid, R h,
+                            std::span<const Vec<D, R>> rest = {});
 
 /// The boundary of `params`: its samples and their psi under BoundaryHandling::Particles, empty
 /// otherwise.

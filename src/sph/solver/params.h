@@ -95,12 +95,24 @@ enum class BoundaryHandling {
   Particles,  ///< boundary particles (Akinci et al. 2012): solids sampled by static particles (boundary.h)
 };
 
+/// What a boundary sample's volume V_b = 1 / delta_b counts in delta_b = sum_k W(x_b - x_k).
+enum class BoundaryVolume {
+  /// The samples and the fluid at rest on the fluid's side of the solid (its lattice sites within
+  /// h): a solid in fluid at rest then reads exactly rho0 next to its walls (default).
+  RestFluid,
+  /// The samples alone (Akinci et al. 2012, eq. 4-5): the layer next to the fluid misses the
+  /// fluid half of its support and weighs more, so fluid next to a wall reads a few % dense.
+  Akinci,
+};
+
 /// Boundary particles' settings.
 struct BoundaryParams {
   BoundaryHandling handling = BoundaryHandling::Penalty;
+  BoundaryVolume volume = BoundaryVolume::RestFluid;
   /// Akinci et al. 2012's boundary viscosity sigma: nu = sigma h c0 / (2 rho_i) on approaching
-  /// fluid-boundary pairs (0: free slip).
-  double friction = 0.2;
+  /// fluid-boundary pairs (0: free slip; the default from the Martin & Moyce front,
+  /// docs/validation.md "Boundaries").
+  double friction = 0.01;
 
   friend bool operator==(const BoundaryParams&, const BoundaryParams&) = default;
 };

@@ -110,9 +110,10 @@ struct BoundaryParams {
   BoundaryHandling handling = BoundaryHandling::Penalty;
   BoundaryVolume volume = BoundaryVolume::RestFluid;
   /// Akinci et al. 2012's boundary viscosity sigma: nu = sigma h c0 / (2 rho_i) on approaching
-  /// fluid-boundary pairs (0: free slip; the default from the Martin & Moyce front,
-  /// docs/validation.md "Boundaries").
-  double friction = 0.01;
+  /// fluid-boundary pairs (0: free slip). It is also what damps sound waves at the walls
+  /// (boundary particles reflect them): below about 0.2 a resting tank keeps ringing
+  /// (docs/validation.md, "Boundaries").
+  double friction = 0.2;
 
   friend bool operator==(const BoundaryParams&, const BoundaryParams&) = default;
 };

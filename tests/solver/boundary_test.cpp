@@ -134,8 +134,7 @@ ParticleSet<D, double> lattice_fill(const SimulationParams<D>& p, int n) {
 }
 
 template <int D>
-void check_density_up_to_the_walls(KernelKind kernel, double bound,
-                                   BoundaryVolume volume = BoundaryVolume::Akinci) {
+void check_density_up_to_the_walls(KernelKind kernel, double bound, BoundaryVolume volume = BoundaryVolume::Akinci) {
   const int n = 12;
   SimulationParams<D> p = filled_box_params<D>(n, kernel);
   p.boundary.volume = volume;

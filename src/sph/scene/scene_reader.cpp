@@ -140,8 +140,8 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
   sim.boundary.handling =
       value_named(detail::kBoundaryHandlingNames,
                   c.choice("boundaryHandling", names_of(detail::kBoundaryHandlingNames), kDefaultBoundaryHandling));
-  sim.boundary.volume = value_named(
-      detail::kBoundaryVolumeNames, c.choice("boundaryVolume", names_of(detail::kBoundaryVolumeNames), "rest_fluid"));
+  sim.boundary.volume = value_named(detail::kBoundaryVolumeNames,
+                                    c.choice("boundaryVolume", names_of(detail::kBoundaryVolumeNames), "rest_fluid"));
   sim.boundary.friction =
       c.positive("boundaryFriction", "a boundary friction sigma >= 0 (Akinci et al. 2012; 0: free slip)",
                  sim.boundary.friction, true);

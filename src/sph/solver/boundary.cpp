@@ -162,8 +162,8 @@ BoundarySet<D, R> make_boundary(const SimulationParams<D>& params) {
   SPH_CHECK(set.position.size() < (std::size_t{1} << 31) / D, "too many boundary samples for 32-bit gather offsets");
   std::vector<Vec<D, R>> rest;
   if (params.boundary.volume == BoundaryVolume::RestFluid)
-    for (const auto& x : rest_fluid_sites<D>(params.container, params.obstacles, 2.0 * params.particle_radius,
-                                             params.kernel_radius))
+    for (const auto& x :
+         rest_fluid_sites<D>(params.container, params.obstacles, 2.0 * params.particle_radius, params.kernel_radius))
       rest.push_back(vec_cast<R>(x));
   set.psi = boundary_psi<D, R>(set.position, params.fluid, static_cast<R>(params.kernel_radius), rest);
   return set;
@@ -173,7 +173,7 @@ template std::vector<Vec<2, double>> sample_boundary<2>(const Box<2>&, const std
 template std::vector<Vec<3, double>> sample_boundary<3>(const Box<3>&, const std::vector<Box<3>>&, double, double);
 template std::vector<Vec<2, double>> rest_fluid_sites<2>(const Box<2>&, const std::vector<Box<2>>&, double, double);
 template std::vector<Vec<3, double>> rest_fluid_sites<3>(const Box<3>&, const std::vector<Box<3>>&, double, double);
-#define SPH_INSTANTIATE(D, R)                                                                     \
+#define SPH_INSTANTIATE(D, R)                                                                   \
   template std::vector<R> boundary_psi<D, R>(std::span<const Vec<D, R>>, const FluidParams&, R, \
                                              std::span<const Vec<D, R>>);                       \
   template BoundarySet<D, R> make_boundary<D, R>(const SimulationParams<D>&);

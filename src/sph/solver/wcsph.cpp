@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <type_traits>
 
 #include <sph/core/error.h>
 #include <sph/core/kernels.h>
@@ -73,15 +74,10 @@ class PackKernel {
  public:
   using P = simd::Pack<R>;
   explicit PackKernel(R h) : inv_h_(P::set1(R(1) / h)) {
-    if constexpr (K == KernelKind::Cubic) {
-      const CubicSplineKernel<D, R> k(h);
-      norm_ = P::set1(k.norm());
-      grad_norm_ = P::set1(k.norm() / (h * h));
-    } else {
-      const WendlandC2Kernel<D, R> k(h);
-      norm_ = P::set1(k.norm());
-      grad_norm_ = P::set1(k.norm() / (h * h));
-    }
+    using Scalar = std::conditional_t<K == KernelKind::Cubic, CubicSplineKernel<D, R>, WendlandC2Kernel<D, R>>;
+    const Scalar k(h);
+    norm_ = P::set1(k.norm());
+    grad_norm_ = P::set1(k.norm() / (h * h));
   }
   P w(const P& r) const {
     const P one = P::set1(R(1)), q = r * inv_h_, d = one - q;

@@ -172,9 +172,10 @@ void run_one(const fs::path& scene, const fs::path& work, std::map<std::string, 
   // The independent check: what the frames show.
   const FrameCheck frames = check_frames(dir);
   EXPECT_GE(frames.frames, 1u);
-  if (frames.outside > 0 || frames.max_mach > 1.0)
+  if (frames.outside > 0 || frames.max_mach > 1.0) {
     EXPECT_NE(status, "completed") << frames.outside << " particles outside the container in the frames, max Mach "
                                    << frames.max_mach;
+  }
 }
 
 TEST(TrustCorpus, EverySceneGetsItsVerdictAndNoneEndsCompletedOutsideOrSupersonic) {
@@ -191,8 +192,9 @@ TEST(TrustCorpus, EverySceneGetsItsVerdictAndNoneEndsCompletedOutsideOrSupersoni
 
 TEST(TrustCorpus, EveryExpectFileHasItsScene) {
   for (const auto& e : fs::directory_iterator(kTrustDir))
-    if (e.path().extension() == ".expect")
+    if (e.path().extension() == ".expect") {
       EXPECT_TRUE(fs::is_regular_file(fs::path(e.path()).replace_extension(".json"))) << e.path();
+    }
 }
 
 }  // namespace

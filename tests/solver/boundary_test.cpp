@@ -230,7 +230,9 @@ TEST(BoundarySettling, EveryModeHoldsTheFluidAndTheAuditCountsBoundaryMisses) {
       ASSERT_EQ(info.health.inside_solid, 0u) << to_string(mode) << " step " << s;
     }
     EXPECT_GT(stored, 0u);
-    if (mode != NeighborMode::Adaptive) EXPECT_EQ(missed, 0u) << to_string(mode);
+    if (mode != NeighborMode::Adaptive) {
+      EXPECT_EQ(missed, 0u) << to_string(mode);
+    }
     // The fluid has reached the obstacle.
     const auto& x = sim.particles().position;
     EXPECT_TRUE(std::any_of(x.begin(), x.end(), [](const V2& q) { return q[0] > 0.28; })) << to_string(mode);

@@ -57,6 +57,34 @@ void remove_pictures(const fs::path& dir) {
 
 }  // namespace
 
+std::string stats_header() {
+  std::string s;
+  for (const StatsColumn& c : kStatsColumns) (s += s.empty() ? "" : ",") += c.name;
+  return s;
+}
+
+std::string stats_row(const StepStats& stats) {
+  std::string s;
+  bool first = true;
+  for (const StatsColumn& c : kStatsColumns) {
+    if (!first) s += ',';
+    first = false;
+    if (c.audit_only && !stats.info.audited) continue;
+    switch (c.format) {
+      case StatsFormat::Count:
+        s += fmt::format("{}", c.count(stats));
+        break;
+      case StatsFormat::Real9:
+        s += fmt::format("{:.9g}", c.real(stats));
+        break;
+      case StatsFormat::Real6:
+        s += fmt::format("{:.6g}", c.real(stats));
+        break;
+    }
+  }
+  return s;
+}
+
 void prepare_resume_directory(const fs::path& dir) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec))
@@ -98,7 +126,7 @@ template <int D, std::floating_point R>
 void RunOutput<D, R>::open_stats() {
   stats_.open(stats_tmp_, std::ios::trunc);
   if (!stats_) throw Error("cannot create stats.csv", dir_.string());
-  stats_ << kStatsColumns << '\n';
+  stats_ << stats_header() << '\n';
 }
 
 template <int D, std::floating_point R>
@@ -142,7 +170,7 @@ std::pair<std::string, std::int64_t> stats_rows_before(const fs::path& file, std
   std::ifstream in(file);
   std::string line, rows;
   std::int64_t count = 0;
-  if (!std::getline(in, line) || line != kStatsColumns) return {};  // another header: not ours
+  if (!std::getline(in, line) || line != stats_header()) return {};  // another header: not ours
   std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   std::size_t begin = 0;
   for (std::size_t end; (end = all.find('\n', begin)) != std::string::npos; begin = end + 1) {
@@ -224,21 +252,7 @@ double RunOutput<D, R>::after_step(const Simulation<D, R>& sim, const StepInfo& 
   const double t_output = w.lap();
   totals_ += info.seconds;
   output_seconds_ += t_output;
-  const double mean_neighbors =
-      info.particles ? static_cast<double>(info.neighbors.pairs_stored) / static_cast<double>(info.particles) : 0.0;
-  const std::string audit = info.audited ? fmt::format("{},{},{:.6g}", info.audit.missed_pairs,
-                                                       info.audit.particles_missing, info.audit.max_penetration)
-                                         : std::string(",,");
-  stats_ << fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.6g},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}",
-                        info.step + 1, info.time, info.particles, sim.kinetic_energy(), sim.max_speed(), mean_neighbors,
-                        info.neighbors.lists_rebuilt, info.neighbors.pairs_stored, info.pairs_within_h, audit,
-                        info.seconds.grid, info.seconds.lists, info.seconds.density, info.seconds.forces,
-                        info.seconds.integrate, t_output);
-  const HealthStats& h = info.health;
-  stats_ << fmt::format(",{},{:.6g},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g}", h.outside, h.outside_depth, h.inside_solid,
-                        h.inside_depth, h.max_mach, h.rho_min, h.rho_max, h.energy);
-  stats_ << fmt::format(",{},{}", info.neighbors.boundary_pairs_stored,
-                        info.audited ? std::to_string(info.boundary_audit.missed_pairs) : std::string());
+  stats_ << stats_row({info, sim.kinetic_energy(), sim.max_speed(), t_output});
   if (info.audited) {
     boundary_missed_ += info.boundary_audit.missed_pairs;
     boundary_steps_with_misses_ += info.boundary_audit.missed_pairs > 0 ? 1 : 0;

@@ -12,10 +12,12 @@
 ///   DIR/checkpoint.sphc        the latest checkpoint (see checkpoint.h), if one was written
 /// Every file appears whole or not at all.
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <sph/io/frame_writer.h>
@@ -26,18 +28,98 @@
 
 namespace sph {
 
-/// Header of stats.csv (README.md, "What a run writes", explains each column). `step` is the
+/// What one row of stats.csv is made of: a step's StepInfo and what was measured after it.
+struct StepStats {
+  const StepInfo& info;
+  double kinetic_energy = 0;  ///< of the particles after the step, J (J/m in 2D)
+  double max_speed = 0;       ///< m/s
+  double t_output = 0;        ///< wall seconds spent writing the step's output
+};
+
+/// How a stats.csv column writes its value.
+enum class StatsFormat {
+  Count,  ///< an unsigned integer
+  Real9,  ///< a real, 9 significant digits
+  Real6,  ///< a real, 6 significant digits
+};
+
+/// One column of stats.csv (README.md, "What a run writes", explains each): its name, how it is
+/// written, and its value for a step (`count` for StatsFormat::Count, `real` otherwise).
+/// Audit columns are empty in the rows of steps that were not audited.
+struct StatsColumn {
+  std::string_view name;
+  StatsFormat format = StatsFormat::Count;
+  bool audit_only = false;
+  std::uint64_t (*count)(const StepStats&) = nullptr;
+  double (*real)(const StepStats&) = nullptr;
+};
+
+namespace detail {
+constexpr StatsColumn count_column(std::string_view name, std::uint64_t (*f)(const StepStats&), bool audit = false) {
+  return {name, StatsFormat::Count, audit, f, nullptr};
+}
+constexpr StatsColumn real_column(std::string_view name, StatsFormat format, double (*f)(const StepStats&),
+                                  bool audit = false) {
+  return {name, format, audit, nullptr, f};
+}
+}  // namespace detail
+
+/// The columns of stats.csv, in order: the one list that the header, every row, the Python
+/// module's `Simulation.counters` and the readers of a run's stats derive from. `step` is the
 /// number of steps done after the row's step (1 for the first row, numberOfSteps for the last),
-/// as summary.json's "steps" and --steps count them; `time` is the simulated time then. The three audit columns
-/// (missed_pairs, particles_missing, max_missed_penetration) are empty unless the run audits.
-/// Then eight of the health monitor's statistics of the step (HealthStats; docs/reliability.md),
-/// and the boundary particles' lists: entries stored, and (audited runs) the fluid-boundary
-/// pairs within h they missed (0 and empty with penalty walls).
-inline constexpr const char* kStatsColumns =
-    "step,time,particles,kinetic_energy,max_speed,mean_neighbors,lists_rebuilt,pairs_stored,pairs_within_h,"
-    "missed_pairs,particles_missing,max_missed_penetration,t_grid,t_lists,t_density,t_forces,t_integrate,t_output,"
-    "outside,outside_depth,inside_solid,inside_depth,max_mach,rho_min,rho_max,energy,boundary_pairs_stored,"
-    "boundary_missed_pairs";
+/// as summary.json's "steps" and --steps count them; `time` is the simulated time then. The three
+/// audit columns (missed_pairs, particles_missing, max_missed_penetration) are empty unless the
+/// run audits. Then eight of the health monitor's statistics of the step (HealthStats;
+/// docs/reliability.md), and the boundary particles' lists: entries stored, and (audited runs)
+/// the fluid-boundary pairs within h they missed (0 and empty with penalty walls).
+inline constexpr StatsColumn kStatsColumns[] = {
+    detail::count_column("step", [](const StepStats& s) { return static_cast<std::uint64_t>(s.info.step + 1); }),
+    detail::real_column("time", StatsFormat::Real9, [](const StepStats& s) { return s.info.time; }),
+    detail::count_column("particles", [](const StepStats& s) { return static_cast<std::uint64_t>(s.info.particles); }),
+    detail::real_column("kinetic_energy", StatsFormat::Real9, [](const StepStats& s) { return s.kinetic_energy; }),
+    detail::real_column("max_speed", StatsFormat::Real9, [](const StepStats& s) { return s.max_speed; }),
+    detail::real_column("mean_neighbors", StatsFormat::Real6,
+                        [](const StepStats& s) {
+                          return s.info.particles ? static_cast<double>(s.info.neighbors.pairs_stored) /
+                                                        static_cast<double>(s.info.particles)
+                                                  : 0.0;
+                        }),
+    detail::count_column("lists_rebuilt", [](const StepStats& s) { return s.info.neighbors.lists_rebuilt; }),
+    detail::count_column("pairs_stored", [](const StepStats& s) { return s.info.neighbors.pairs_stored; }),
+    detail::count_column("pairs_within_h", [](const StepStats& s) { return s.info.pairs_within_h; }),
+    detail::count_column(
+        "missed_pairs", [](const StepStats& s) { return s.info.audit.missed_pairs; }, true),
+    detail::count_column(
+        "particles_missing", [](const StepStats& s) { return s.info.audit.particles_missing; }, true),
+    detail::real_column(
+        "max_missed_penetration", StatsFormat::Real6, [](const StepStats& s) { return s.info.audit.max_penetration; },
+        true),
+    detail::real_column("t_grid", StatsFormat::Real6, [](const StepStats& s) { return s.info.seconds.grid; }),
+    detail::real_column("t_lists", StatsFormat::Real6, [](const StepStats& s) { return s.info.seconds.lists; }),
+    detail::real_column("t_density", StatsFormat::Real6, [](const StepStats& s) { return s.info.seconds.density; }),
+    detail::real_column("t_forces", StatsFormat::Real6, [](const StepStats& s) { return s.info.seconds.forces; }),
+    detail::real_column("t_integrate", StatsFormat::Real6, [](const StepStats& s) { return s.info.seconds.integrate; }),
+    detail::real_column("t_output", StatsFormat::Real6, [](const StepStats& s) { return s.t_output; }),
+    detail::count_column("outside", [](const StepStats& s) { return s.info.health.outside; }),
+    detail::real_column("outside_depth", StatsFormat::Real6,
+                        [](const StepStats& s) { return s.info.health.outside_depth; }),
+    detail::count_column("inside_solid", [](const StepStats& s) { return s.info.health.inside_solid; }),
+    detail::real_column("inside_depth", StatsFormat::Real6,
+                        [](const StepStats& s) { return s.info.health.inside_depth; }),
+    detail::real_column("max_mach", StatsFormat::Real6, [](const StepStats& s) { return s.info.health.max_mach; }),
+    detail::real_column("rho_min", StatsFormat::Real6, [](const StepStats& s) { return s.info.health.rho_min; }),
+    detail::real_column("rho_max", StatsFormat::Real6, [](const StepStats& s) { return s.info.health.rho_max; }),
+    detail::real_column("energy", StatsFormat::Real9, [](const StepStats& s) { return s.info.health.energy; }),
+    detail::count_column("boundary_pairs_stored",
+                         [](const StepStats& s) { return s.info.neighbors.boundary_pairs_stored; }),
+    detail::count_column(
+        "boundary_missed_pairs", [](const StepStats& s) { return s.info.boundary_audit.missed_pairs; }, true),
+};
+
+/// The header line of stats.csv: the column names, comma-separated.
+std::string stats_header();
+/// The stats.csv row of a step (without the line's end), each column as kStatsColumns writes it.
+std::string stats_row(const StepStats& stats);
 
 /// Facts about the run that are not in the scene.
 struct RunInfo {

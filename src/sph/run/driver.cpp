@@ -71,6 +71,20 @@ void RunDriver<D, R>::advance(std::int64_t n) {
 }
 
 template <int D, std::floating_point R>
+const StepInfo& RunDriver<D, R>::step() {
+  SPH_CHECK(!output_ && !ran_, "RunDriver::step: only for a run that writes nothing, outside run()");
+  return sim_.step();
+}
+
+template <int D, std::floating_point R>
+std::vector<std::string> RunDriver<D, R>::new_warnings(const StepInfo& step) const {
+  std::vector<std::string> texts;
+  for (std::size_t k = 0; k < kHealthKinds; ++k)
+    if ((step.health.new_warnings >> k & 1u) != 0) texts.push_back(sim_.health().warning(static_cast<HealthKind>(k)));
+  return texts;
+}
+
+template <int D, std::floating_point R>
 RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver& on_step) {
   SPH_CHECK(!ran_, "RunDriver::run: a driver runs once");
   ran_ = true;
@@ -92,9 +106,7 @@ RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver
       const StepInfo& step = sim_.step();
       const bool last = s + 1 == steps;
       if (step.health.new_warnings != 0) {
-        for (std::size_t k = 0; k < kHealthKinds; ++k) {
-          if ((step.health.new_warnings >> k & 1u) == 0) continue;
-          const std::string& w = sim_.health().warning(static_cast<HealthKind>(k));
+        for (const std::string& w : new_warnings(step)) {
           if (callbacks.warning) callbacks.warning(w);
           if (settings_.strict) {
             result.error = w + " (--strict)";

@@ -116,6 +116,14 @@ class RunDriver {
   /// before a timed stretch. Only for a run without a directory (SPH_CHECK) that has not run
   /// yet. Throws the step's sph::Error.
   void advance(std::int64_t n);
+  /// One step and nothing else (no output, no callbacks, no limit at the scene's last step): for
+  /// a caller that drives the steps itself, as the Python module does. Only for a run without a
+  /// directory (SPH_CHECK) that has not run(). Throws the step's sph::Error (a blow-up, a failed
+  /// health check); its warnings are new_warnings() of what it returns.
+  const StepInfo& step();
+  /// The texts of the health warnings a step raised first (HealthMonitor::warning), in the
+  /// order of the health kinds: what run() reports through RunCallbacks::warning.
+  std::vector<std::string> new_warnings(const StepInfo& step) const;
   /// Runs the steps left, until the scene's last, a stop request or a failure; a new run first
   /// writes its initial output (frame 0, scene.json). Ends the output (summary.json with the
   /// status) and returns how the run ended. A failure of a step, of its output or of a

@@ -86,6 +86,15 @@ class Simulation {
   const HealthMonitor& health() const { return monitor_; }
 
   const ParticleSet<D, R>& particles() const { return particles_; }
+  /// The particles, to change between steps (the Python module: its setters, and handing the
+  /// arrays its views show to those views). The number of particles must not change. After a
+  /// change of positions or velocities call particles_moved(); a field given a new buffer with
+  /// the same values needs nothing.
+  ParticleSet<D, R>& edit_particles() { return particles_; }
+  /// The positions or velocities were changed between steps: the next step rebuilds every
+  /// neighbor list (the strategy's own state, such as the adaptive flags and the verlet
+  /// reference positions, starts again from those lists).
+  void particles_moved() { neighbors_->invalidate(); }
   const SimulationParams<D>& params() const { return params_; }
   const NeighborStrategy<D, R>& neighbors() const { return *neighbors_; }
   /// The boundary particles (empty with penalty walls).

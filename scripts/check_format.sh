@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The format check: every C++ file of src/, apps/ and tests/ is as clang-format (.clang-format)
+# The format check: every C++ file of src/, apps/, tests/ and python/ is as clang-format (.clang-format)
 # writes it. Changes nothing: lists each file that differs, with clang-format's first
 # complaints, and exits 1 if there is any. To fix a file: clang-format -i FILE.
 #   bash scripts/check_format.sh [FILE...]          (no argument: the whole tree)
@@ -13,7 +13,7 @@ cf=${CLANG_FORMAT:-$(command -v clang-format-14 || command -v clang-format)} || 
 if [ $# -gt 0 ]; then
   files=("$@")
 else
-  mapfile -t files < <(find src apps tests -name '*.h' -o -name '*.cpp' | sort)
+  mapfile -t files < <(find src apps tests python -name '*.h' -o -name '*.cpp' | sort)
 fi
 bad=0
 for f in "${files[@]}"; do

@@ -5,7 +5,8 @@
 #   1. runs the installed `sph validate --quick` and `sph bench --suite tank --size small`, with
 #      their default scenes, and checks that they read them from the moved prefix's
 #      share/sph/scenes (validate prints "scenes from DIR"; bench.json records the tank scene);
-#   2. configures and builds tests/install, a user's project of find_package(sph) linking
+#   2. imports the installed Python module sph (when built) and steps an installed scene;
+#   3. configures and builds tests/install, a user's project of find_package(sph) linking
 #      sph::solver, against the moved prefix, and runs it.
 # What this proves: the install holds the program, its data, the libraries, their headers and a
 # working package; the installed program finds its data from its own location (no path of the
@@ -52,10 +53,32 @@ scene=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["tank"]
   fail "sph bench read the tank scene $scene, not the installed $prefix/share/sph/scenes/paper/tank_fill_3d.json"
 ran=$SECONDS
 
+# The Python module (when the build has it): installed with its stub, and `import sph` from the
+# moved prefix runs a few steps of an installed scene.
+case $build in /*) cache=$build/CMakeCache.txt ;; *) cache=$root/$build/CMakeCache.txt ;; esac
+if grep -q '^SPH_PYTHON:BOOL=ON' "$cache"; then
+  pydir=$(sed -n 's/^SPH_INSTALL_PYTHONDIR:STRING=//p' "$cache")
+  python=$(sed -n 's/^SPH_PYTHON_EXECUTABLE:INTERNAL=//p' "$cache")
+  ls "$prefix/$pydir"/sph.*.so >/dev/null 2>&1 || fail "the install has no Python module in $pydir"
+  [ -f "$prefix/$pydir/sph.pyi" ] || fail "the install has no $pydir/sph.pyi"
+  PYTHONPATH="$prefix/$pydir" "$python" - "$prefix" "$pydir" >python.log 2>&1 <<'PY' || { cat python.log; fail "import sph from the installed prefix"; }
+import os, sys
+import sph
+prefix, pydir = sys.argv[1], sys.argv[2]
+assert os.path.dirname(sph.__file__) == os.path.join(prefix, pydir), sph.__file__
+scene = sph.load_scene(os.path.join(prefix, "share/sph/scenes/paper/dam_break_2d.json"),
+                       overrides={"FluidBlocks[0].end": [0.1, 0.2]})
+sim = sph.Simulation(scene, threads=1)
+sim.step(3)
+assert sim.steps == 3 and sim.positions.shape == (200, 2)
+print("import sph:", sph.__file__)
+PY
+fi
+
 cmake -S "$root/tests/install" -B consumer -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$prefix" \
   >consumer.log 2>&1 || { cat consumer.log; fail "configuring a find_package(sph) project"; }
 cmake --build consumer >>consumer.log 2>&1 || { cat consumer.log; fail "building a project that links sph::solver"; }
 ./consumer/consumer || fail "the consumer program"
 echo "check_install: passed in $((SECONDS - t0)) s: the install, moved with its prefix, ran validate --quick and" \
-  "the small tank bench on its own share/sph/scenes from outside the repository ($((ran - t0)) s), and a" \
+  "the small tank bench on its own share/sph/scenes from outside the repository ($((ran - t0)) s), imported sph, and a" \
   "find_package(sph) project linking sph::solver built and ran against it ($((SECONDS - ran)) s)"

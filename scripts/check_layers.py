@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """The layer check: every #include of src/ and apps/ goes one way along the layer order.
 
-The order is SPH_LAYERS in CMakeLists.txt (the one place it is written), then apps/sph on top.
-A file of layer L (src/sph/L/..., or apps/sph/...) may include <sph/M/...> only when M is L or
-a layer before L; every included sph header must exist; and the includes between the project's
+The order is SPH_LAYERS in CMakeLists.txt (the one place it is written), then apps/sph and the
+Python module python/ on top (each may include every layer, neither the other). A file of layer
+L (src/sph/L/..., apps/sph/... or python/...) may include <sph/M/...> only when M is L or a layer
+before L; every included sph header must exist; and the includes between the project's
 own headers (<sph/...> and "..." ones) must form no cycle. Prints one line per violation
 (file:line: what, and the rule) and exits 1 if there is any. Python 3 standard library only.
 
@@ -24,11 +25,11 @@ def layer_order(root):
         m = SPH_LAYERS.search(f.read())
     if not m:
         sys.exit(f'check_layers: no set(SPH_LAYERS ...) in {path}')
-    return m.group(1).split() + ['apps']
+    return m.group(1).split() + ['apps', 'python']
 
 
 def files_of(root):
-    for top in ('src', 'apps'):
+    for top in ('src', 'apps', 'python'):
         for d, _, names in os.walk(os.path.join(root, top)):
             for n in sorted(names):
                 if n.endswith(SOURCE_EXT):
@@ -37,8 +38,8 @@ def files_of(root):
 
 def layer_of(rel):
     parts = rel.split(os.sep)
-    if parts[0] == 'apps':
-        return 'apps'
+    if parts[0] in ('apps', 'python'):
+        return parts[0]
     if len(parts) >= 4 and parts[:2] == ['src', 'sph']:
         return parts[2]
     return None
@@ -57,7 +58,8 @@ def main():
             problems.append(f'{rel}:1: is in no layer of {", ".join(order)}; '
                             'rule: every source file lives in src/sph/<layer>/ or apps/sph/')
             continue
-        allowed = ', '.join(order[:rank[layer] + 1])
+        top = rank['apps']  # apps and python: every layer, and their own files
+        allowed = ', '.join(order[:rank[layer] + 1] if rank[layer] < top else order[:top] + [layer])
         with open(os.path.join(root, rel), encoding='utf-8', errors='replace') as f:
             lines = f.read().splitlines()
         for number, text in enumerate(lines, 1):
@@ -68,11 +70,11 @@ def main():
             if kind == '<' and name.startswith('sph/'):
                 parts = name.split('/')
                 target = parts[1] if len(parts) >= 3 else None
-                if target not in rank or target == 'apps':
+                if target not in rank or target in ('apps', 'python'):
                     problems.append(f'{rel}:{number}: includes <{name}>, which is in no layer; '
                                     f'rule: rooted includes name a layer, <sph/<layer>/file.h>, of {", ".join(order[:-1])}')
                     continue
-                if rank[target] > rank[layer]:
+                if rank[target] > min(rank[layer], top - 1) and target != layer:
                     problems.append(f'{rel}:{number}: includes <{name}> of the later layer {target}; '
                                     f'rule: a file of {layer} may include only {allowed} '
                                     f'(layer order: {" -> ".join(order)}, CMakeLists.txt SPH_LAYERS)')
@@ -126,7 +128,7 @@ def main():
     if problems:
         print(f'check_layers: {len(problems)} violation(s) in {len(files)} files')
         return 1
-    print(f'check_layers: {len(files)} files of src/ and apps/ include one way along {" -> ".join(order)}, no cycle')
+    print(f'check_layers: {len(files)} files of src/, apps/ and python/ include one way along {" -> ".join(order)}, no cycle')
     return 0
 
 

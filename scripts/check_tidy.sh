@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # The lint check: clang-tidy (.clang-tidy: the naming rules and a focused set of bug and
-# performance checks, warnings as errors) on every C++ source of src/ and apps/, and through
-# its HeaderFilterRegex on the headers of src/sph they include, with the compile commands of a
+# performance checks, warnings as errors) on every C++ source of src/, apps/ and python/, and through
+# its HeaderFilterRegex on the headers of src/sph and python/ they include, with the compile commands of a
 # configured build directory (default build/; scripts/build.sh makes it). Exits 1 on any finding.
-#   bash scripts/check_tidy.sh [BUILD_DIR] [FILE...]      (no file: all of src/ and apps/)
+#   bash scripts/check_tidy.sh [BUILD_DIR] [FILE...]      (no file: all of src/, apps/ and python/)
 # JOBS (default: nproc) files at a time. CLANG_TIDY names the program (default clang-tidy-14).
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -20,7 +20,7 @@ tidy=${CLANG_TIDY:-$(command -v clang-tidy-14 || command -v clang-tidy)} || {
 if [ $# -gt 0 ]; then
   files=("$@")
 else
-  mapfile -t files < <(find src apps -name '*.cpp' | sort)
+  mapfile -t files < <(find src apps python -name '*.cpp' | sort)
 fi
 log=$(mktemp -d)
 trap 'rm -rf "$log"' EXIT
@@ -69,4 +69,4 @@ if [ -s "$log/failed" ]; then
   echo "check_tidy: findings in $(wc -l <"$log/failed") of ${#files[@]} files (and the headers they include); see .clang-tidy"
   exit 1
 fi
-echo "check_tidy: ${#files[@]} sources of src/ and apps/ and the headers they include pass .clang-tidy"
+echo "check_tidy: ${#files[@]} sources of src/, apps/ and python/ and the headers they include pass .clang-tidy"

@@ -8,6 +8,9 @@ packages=(
   nlohmann-json3-dev libcli11-dev libfmt-dev libomp-dev
   libgtest-dev libgmock-dev libpng-dev
   python3 python3-vtk9 python3-numpy
+  # The Python module (python/: pybind11 and the Python headers), its tests (pytest) and the
+  # examples' plots (matplotlib).
+  python3-dev python3-pybind11 pybind11-dev python3-pytest python3-matplotlib
   # Readers and players the tests check our output with: meshio (PLY, VTK), ffmpeg/ffprobe
   # (sph render --mp4), headless Chromium driven by Selenium through ChromeDriver (sph view).
   python3-meshio ffmpeg chromium chromium-driver python3-selenium

@@ -1,0 +1,71 @@
+#pragma once
+/// \file What the parts of the Python module share: its exception types, the scene it wraps,
+/// and the conversions every part uses. The module (module.cpp) is an edge of the house: every
+/// function it offers calls the library's public API.
+
+#include <string>
+#include <vector>
+
+#include <pybind11/pybind11.h>
+
+#include <sph/core/error.h>
+#include <sph/scene/scene_desc.h>
+
+namespace sph::python {
+
+namespace py = pybind11;
+
+/// A scene the reader refused (a bad key, value or file): raised as sph.SceneError.
+class SceneError : public Error {
+ public:
+  using Error::Error;
+  explicit SceneError(const Error& e) : Error(e.message(), e.where()) {}
+};
+
+/// A step that failed (a blow-up, a failed health check): raised as sph.SimulationError.
+class SimulationError : public Error {
+ public:
+  using Error::Error;
+  explicit SimulationError(const Error& e) : Error(e.message(), e.where()) {}
+};
+
+/// The Python types of the module's errors and warnings (set by module.cpp before anything runs).
+struct ErrorTypes {
+  py::object error, scene_error, simulation_error, health_warning;
+};
+ErrorTypes& error_types();
+
+/// A scene as the strict reader accepted it (sph.Scene).
+struct Scene {
+  SceneDesc desc;
+};
+
+/// Calls `f` and turns the sph::Error it throws into a SceneError (the scene reader's errors).
+template <class F>
+decltype(auto) reading_scene(F&& f) {
+  try {
+    return f();
+  } catch (const SceneError&) {
+    throw;
+  } catch (const Error& e) {
+    throw SceneError(e);
+  }
+}
+
+/// "KEY=VALUE" overrides (the --set flag's form) from a {key path: value} dict; each value is
+/// written as JSON. Raises TypeError for a key that is not a string or a value JSON cannot hold.
+std::vector<std::string> override_strings(const py::handle& overrides);
+
+/// `desc` read again with `overrides` applied (the way sph run applies --set and its flags), so
+/// that every value goes through the reader's checks. Throws SceneError.
+SceneDesc with_overrides(const SceneDesc& desc, const std::vector<std::string>& overrides);
+
+/// Sets the worker threads of the calling thread's parallel loops; `threads` must be positive.
+void use_threads(int threads);
+
+/// Registers the parts of the module.
+void register_scene(py::module_& m);
+void register_simulation(py::module_& m);
+void register_runs(py::module_& m);
+
+}  // namespace sph::python

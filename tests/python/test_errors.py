@@ -1,0 +1,134 @@
+"""Every exception type of the module, each with the message `sph run` gives for the same input."""
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+import sph
+from conftest import DAM_BREAK, SMALL_2D, run_sph
+
+
+def dam_break_dict():
+    with open(DAM_BREAK) as f:
+        return json.load(f)
+
+
+def test_the_error_types():
+    assert issubclass(sph.Error, RuntimeError)
+    assert issubclass(sph.SceneError, sph.Error) and issubclass(sph.SceneError, ValueError)
+    assert issubclass(sph.SimulationError, sph.Error)
+    assert issubclass(sph.HealthWarning, UserWarning)
+
+
+def test_a_misspelt_key_names_its_path_with_the_message_of_sph_run(tmp_path):
+    d = dam_break_dict()
+    d["Fluid"]["stiffnes"] = d["Fluid"].pop("stiffness")
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(d))
+    with pytest.raises(sph.SceneError) as file_error:
+        sph.load_scene(str(path))
+    e = file_error.value
+    assert e.key == "Fluid.stiffnes"
+    assert e.where == f"{path}: Fluid.stiffnes"
+    assert str(e) == f"{e.where}: {e.message}" and "stiffness" in e.message  # it names the expected key
+    r = run_sph("run", path, "-o", tmp_path / "out", check=False)
+    assert r.returncode == 2 and f"sph: error: {e}\n" in r.stderr
+    # The same from a dict, named "<dict>".
+    with pytest.raises(sph.SceneError) as dict_error:
+        sph.Scene.from_dict(d)
+    assert dict_error.value.key == "Fluid.stiffnes" and dict_error.value.message == e.message
+    assert dict_error.value.where == "<dict>: Fluid.stiffnes"
+
+
+def test_bad_values_and_overrides(small_2d):
+    with pytest.raises(sph.SceneError) as e:
+        sph.load_scene(DAM_BREAK, overrides={"Fluid.density0": -5})
+    assert e.value.key == "Fluid.density0" and "--set Fluid.density0" in e.value.where
+    with pytest.raises(sph.SceneError) as e:
+        small_2d.with_overrides({"Configuration.neighbors": "fastest"})
+    assert e.value.key == "Configuration.neighbors"
+    for mode in sph.NEIGHBOR_MODES:
+        assert mode in e.value.message  # the accepted names
+    with pytest.raises(sph.SceneError) as e:
+        sph.Simulation(small_2d, neighbors="fastest")
+    assert e.value.key == "Configuration.neighbors"
+    with pytest.raises(sph.SceneError, match="NaN or infinite"):
+        sph.load_scene(DAM_BREAK, overrides={"Fluid.stiffness": float("nan")})
+    with pytest.raises(TypeError, match="dict"):
+        sph.load_scene(DAM_BREAK, overrides=["Fluid.stiffness=3"])
+    with pytest.raises(TypeError, match="scene value"):
+        sph.Scene.from_dict({"version": 1, "name": object()})
+    # NumPy numbers are numbers.
+    s = sph.load_scene(DAM_BREAK, overrides={"Fluid.stiffness": np.float64(1700), "FluidBlocks[0].end": np.array([0.2, 0.4])})
+    assert s.to_dict()["Fluid"]["stiffness"] == 1700
+
+
+def test_syntax_errors_and_files():
+    with pytest.raises(sph.SceneError) as e:
+        sph.Scene.from_json('{"version": 1,\n "name": }', source="inline")
+    assert e.value.key is None and e.value.where.startswith("inline:2:")
+    with pytest.raises(sph.SceneError) as e:
+        sph.load_scene("/no/such/scene.json")
+    assert e.value.where == "/no/such/scene.json" and e.value.key is None
+
+
+def test_scene_round_trip(small_2d):
+    again = sph.Scene.from_dict(small_2d.to_dict())
+    assert again.to_dict() == small_2d.to_dict() and again.source == "<dict>"
+    assert again != small_2d  # (the source differs)
+    assert sph.Scene.from_json(small_2d.to_json(), source=small_2d.source) == small_2d
+    assert small_2d.dimension == 2 and small_2d.precision == "double" and small_2d.steps == 20
+    assert small_2d.name == "dam_break_2d" and small_2d.source == DAM_BREAK
+
+
+def test_a_blow_up_raises_simulation_error_and_stops_the_simulation(small_2d):
+    sim = sph.Simulation(small_2d)
+    v = np.zeros((len(sim), 2))
+    v[5] = [400.0, 0.0]  # ten times the speed of sound
+    sim.velocities = v
+    with pytest.raises(sph.SimulationError) as e:
+        sim.step(5)
+    assert "supersonic" in e.value.message and "particle id 5" in e.value.message
+    assert sim.steps == 1  # the failed step's state
+    with pytest.raises(sph.SimulationError, match="failed earlier"):
+        sim.step()
+
+
+def test_a_health_warning_is_a_python_warning(small_2d):
+    sim = sph.Simulation(small_2d)
+    v = np.zeros((len(sim), 2))
+    v[5] = [20.0, 0.0]  # Mach 0.5: past the warning level 0.3, below the failure level 1
+    sim.velocities = v
+    with pytest.warns(sph.HealthWarning) as given:
+        sim.step(1)
+    texts = [str(w.message) for w in given]
+    assert texts == sim.warnings
+    assert any(w.startswith("Mach 0.49") for w in texts)
+    with warnings.catch_warnings(record=True) as later:
+        warnings.simplefilter("always")
+        sim.step(2)
+    assert not {str(w.message) for w in later} & set(texts)  # each kind once
+    assert sim.steps == 3
+
+
+def test_argument_errors(small_2d):
+    with pytest.raises(ValueError, match="threads"):
+        sph.Simulation(small_2d, threads=0)
+    sim = sph.Simulation(small_2d)
+    with pytest.raises(ValueError, match="0 or more"):
+        sim.step(-1)
+    with pytest.raises(TypeError):
+        sim.step("two")
+    with pytest.raises(ValueError, match="threads"):
+        sim.threads = 0
+
+
+def test_frame_errors(tmp_path):
+    with pytest.raises(sph.Error) as e:
+        sph.read_frame(str(tmp_path / "none.vtu"))
+    assert e.value.where == str(tmp_path / "none.vtu")
+    bad = tmp_path / "bad.vtu"
+    bad.write_text("<VTKFile>not a frame</VTKFile>")
+    with pytest.raises(sph.Error):
+        sph.read_frame(str(bad))

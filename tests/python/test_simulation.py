@@ -1,0 +1,140 @@
+"""Simulation through the API against `sph run`: the same bits, the same counters, the same lists."""
+import numpy as np
+import pytest
+
+import sph
+from conftest import run_sph, stats_rows, write_scene
+
+STEPS = 20
+
+
+def frame_after(scene, tmp_path, steps, neighbors, threads=2):
+    """The frame `sph run` writes after `steps` steps of `scene`, and its run directory."""
+    path = write_scene(scene, tmp_path / "scene.json")
+    out = tmp_path / f"run_{neighbors}_{threads}"
+    run_sph("run", path, "-o", out, "--steps", steps, "--every", steps, "--neighbors", neighbors,
+            "--threads", threads, "--no-progress")
+    return sph.read_frame(str(out / "frames" / "frame_000001.vtu")), out
+
+
+@pytest.mark.parametrize("neighbors", ["standard", "adaptive", "verlet"])
+def test_positions_equal_the_sph_run_frame_bit_for_bit(small_2d, tmp_path, neighbors):
+    frame, _ = frame_after(small_2d, tmp_path, STEPS, neighbors)
+    sim = sph.Simulation(small_2d, neighbors=neighbors, threads=2)
+    sim.step(STEPS)
+    assert sim.steps == STEPS and sim.time == pytest.approx(STEPS * sim.dt)
+    assert frame["time"] == sim.time
+    n = len(sim)
+    assert frame["position"].shape == (n, 3)
+    # The file holds the run's own doubles: equality, not closeness.
+    assert np.array_equal(frame["position"][:, :2], sim.positions)
+    assert np.all(frame["position"][:, 2] == 0)
+    assert np.array_equal(frame["velocity"][:, :2], sim.velocities)
+    assert np.array_equal(frame["density"], sim.densities)
+    assert np.array_equal(frame["pressure"], sim.pressures)
+    assert np.array_equal(frame["id"], sim.ids)
+    # And the simulation did move: the frame is not the initial state.
+    first = sph.Simulation(small_2d, neighbors=neighbors)
+    assert not np.array_equal(first.positions, sim.positions)
+
+
+def test_float_3d_equals_the_sph_run_frame_bit_for_bit(small_3d, tmp_path):
+    frame, _ = frame_after(small_3d, tmp_path, STEPS, "adaptive")
+    sim = sph.Simulation(small_3d, threads=2)
+    assert sim.dtype == np.float32 and sim.positions.dtype == np.float32 and sim.dimension == 3
+    sim.step(STEPS)
+    assert np.array_equal(frame["position"], sim.positions.astype(np.float64))
+    assert np.array_equal(frame["velocity"], sim.velocities.astype(np.float64))
+    assert np.array_equal(frame["id"], sim.ids)
+
+
+@pytest.mark.parametrize("neighbors", ["standard", "adaptive"])
+def test_any_thread_count_gives_the_same_bits(small_2d, neighbors):
+    results = []
+    for threads in (1, 2, 3):
+        sim = sph.Simulation(small_2d, neighbors=neighbors, threads=threads)
+        assert sim.threads == threads
+        sim.step(STEPS)
+        results.append((sim.positions.tobytes(), sim.velocities.tobytes(), sim.densities.tobytes(),
+                        sim.counters["pairs_stored"], sim.counters["lists_rebuilt"]))
+    assert results[0] == results[1] == results[2]
+
+
+def test_step_in_pieces_equals_one_call(small_2d):
+    a = sph.Simulation(small_2d, neighbors="adaptive")
+    a.step(STEPS)
+    b = sph.Simulation(small_2d, neighbors="adaptive")
+    for _ in range(4):
+        b.step(STEPS // 4)
+    b.step(0)
+    assert b.steps == STEPS
+    assert a.positions.tobytes() == b.positions.tobytes()
+
+
+def test_counters_are_the_stats_csv_row(small_2d, tmp_path):
+    _, out = frame_after(small_2d, tmp_path, STEPS, "adaptive")
+    last = stats_rows(out / "stats.csv")[-1]
+    sim = sph.Simulation(small_2d, neighbors="adaptive")
+    assert sim.counters == {}
+    sim.step(STEPS)
+    c = sim.counters
+    assert tuple(c) == sph.STATS_COLUMNS
+    assert ",".join(sph.STATS_COLUMNS) == open(out / "stats.csv").readline().strip()
+    for name in ("step", "particles", "lists_rebuilt", "pairs_stored", "pairs_within_h", "outside",
+                 "boundary_pairs_stored"):
+        assert isinstance(c[name], int) and c[name] == int(last[name]), name
+    for name in ("time", "kinetic_energy", "max_speed", "energy"):  # written with 9 digits
+        assert c[name] == pytest.approx(float(last[name]), rel=1e-8), name
+    assert c["missed_pairs"] is None  # not audited
+    assert c["t_output"] == 0.0 and c["t_density"] > 0.0
+    assert c["kinetic_energy"] == sim.kinetic_energy()
+
+
+def test_neighbor_lists_hold_every_pair_closer_than_h(small_2d):
+    sim = sph.Simulation(small_2d, neighbors="standard")
+    with pytest.raises(sph.Error, match="before the first step"):
+        sim.neighbors(0)
+    sim.step(3)
+    # The lists of a step are built from the positions at its start: those after step 2.
+    before = sph.Simulation(small_2d, neighbors="standard")
+    before.step(2)
+    by_id = dict(zip(before.ids.tolist(), map(tuple, before.positions)))
+    h = sim.scene.to_dict()["Configuration"]["kernelRadius"]
+    offsets, indices = sim.neighbor_lists()
+    n = len(sim)
+    assert offsets.shape == (n + 1,) and offsets[0] == 0 and offsets[-1] == len(indices)
+    assert len(indices) == sim.counters["pairs_stored"]
+    ids = sim.ids
+    x = np.array([by_id[k] for k in ids.tolist()])
+    for i in range(0, n, 37):
+        listed = np.sort(ids[indices[offsets[i]:offsets[i + 1]]])
+        assert np.array_equal(np.sort(ids[sim.neighbors(i)]), listed)
+        d2 = np.sum((x - x[i]) ** 2, axis=1)
+        close = np.sort(ids[(d2 < h * h) & (np.arange(n) != i)])
+        assert np.array_equal(listed, close), i
+    with pytest.raises(IndexError):
+        sim.neighbors(n)
+    with pytest.raises(IndexError):
+        sim.neighbors(-1)
+
+
+def test_write_frame_is_read_back(small_2d, tmp_path):
+    sim = sph.Simulation(small_2d)
+    sim.step(2)
+    for fmt in sph.FRAME_FORMATS:
+        path = str(tmp_path / f"f.{fmt}")
+        sim.write_frame(path)
+        back = sph.read_frame(path)
+        assert back["time"] == pytest.approx(sim.time)
+        assert np.array_equal(back["id"], sim.ids)
+        if fmt == "ply":  # PLY holds single precision
+            assert np.array_equal(back["position"][:, :2], sim.positions.astype(np.float32))
+        else:
+            assert np.array_equal(back["position"][:, :2], sim.positions)
+    sim.write_frame(str(tmp_path / "d.vtu"), fields=["density"])
+    assert set(sph.read_frame(str(tmp_path / "d.vtu"))) == {"time", "position", "density"}
+    with pytest.raises(sph.Error, match="ending in"):
+        sim.write_frame(str(tmp_path / "f.csv"))
+    with pytest.raises(sph.Error, match="not a field frames hold") as e:
+        sim.write_frame(str(tmp_path / "f.vtu"), fields=["mass"])
+    assert e.value.where == "fields"

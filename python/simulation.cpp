@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -85,19 +86,23 @@ class PySimulation {
   PySimulation(const PySimulation&) = delete;
   PySimulation& operator=(const PySimulation&) = delete;
 
-  /// Calls f(driver) with the driver of the scene's dimension and precision.
+  /// Calls f(driver) with the driver of the scene's dimension and precision. Refused (RuntimeError)
+  /// while another Python thread steps the simulation or writes its frame with the GIL released.
   template <class F>
   decltype(auto) visit(F&& f) {
+    check_idle();
     return std::visit([&](auto& d) -> decltype(auto) { return f(*d); }, driver_);
   }
   template <class F>
   decltype(auto) visit(F&& f) const {
+    check_idle();
     return std::visit([&](const auto& d) -> decltype(auto) { return f(*d); }, driver_);
   }
 
   void step(std::int64_t n) {
     if (n < 0) throw py::value_error("n must be 0 or more steps, got " + std::to_string(n));
     for (std::int64_t k = 0; k < n; ++k) {
+      check_idle();
       if (!failure_.empty())
         throw SimulationError("the simulation failed earlier (" + failure_ +
                               "); its state is that of the failed step: make a new Simulation");
@@ -105,10 +110,11 @@ class PySimulation {
       std::vector<std::string> warnings;
       std::optional<Error> failed;
       {
+        const Busy busy(busy_);  // (reset after the GIL is taken back)
         py::gil_scoped_release release;
         use_threads(threads_);
         try {
-          visit([&](auto& d) { warnings = d.new_warnings(d.step()); });
+          std::visit([&](auto& d) { warnings = d->new_warnings(d->step()); }, driver_);
         } catch (const Error& e) {
           failed = e;
         }
@@ -277,6 +283,7 @@ class PySimulation {
     }
     visit([&](const auto& d) {
       const auto& sim = d.simulation();
+      const Busy busy(busy_);
       py::gil_scoped_release release;
       sph::write_frame(*format, path, sim.particles(), sim.time(), selected);
     });
@@ -292,6 +299,24 @@ class PySimulation {
   }
 
  private:
+  /// Marks the simulation busy for its life (with the GIL held when it starts and ends).
+  class Busy {
+   public:
+    explicit Busy(bool& flag) : flag_(flag) { flag_ = true; }
+    ~Busy() { flag_ = false; }
+    Busy(const Busy&) = delete;
+    Busy& operator=(const Busy&) = delete;
+
+   private:
+    bool& flag_;
+  };
+
+  void check_idle() const {
+    if (busy_)
+      throw std::runtime_error(
+          "the simulation is stepping or writing a frame in another thread; use it from one thread at a time");
+  }
+
   template <class Driver>
   const NeighborLists& checked_lists(const Driver& d) const {
     if (d.simulation().steps_done() == 0)
@@ -344,7 +369,8 @@ class PySimulation {
                std::unique_ptr<RunDriver<3, float>>, std::unique_ptr<RunDriver<3, double>>>
       driver_;
   int threads_ = 1;
-  std::string failure_;  // the error of the step that failed ("" if none)
+  std::string failure_;        // the error of the step that failed ("" if none)
+  mutable bool busy_ = false;  // stepping or writing with the GIL released (Busy)
   std::vector<std::pair<std::string, py::object>> views_;
 };
 

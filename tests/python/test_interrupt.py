@@ -20,6 +20,7 @@ def interrupt_after(seconds):
     return t
 
 
+@pytest.mark.filterwarnings("ignore::sph.HealthWarning")  # (long runs of the small dam break gain energy)
 def test_ctrl_c_interrupts_step_n_after_a_step_and_leaves_the_simulation_usable(small_2d):
     sim = sph.Simulation(small_2d, neighbors="adaptive", threads=2)
     sim.step(1)

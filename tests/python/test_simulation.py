@@ -138,3 +138,36 @@ def test_write_frame_is_read_back(small_2d, tmp_path):
     with pytest.raises(sph.Error, match="not a field frames hold") as e:
         sim.write_frame(str(tmp_path / "f.vtu"), fields=["mass"])
     assert e.value.where == "fields"
+
+
+def test_a_simulation_stepping_in_one_thread_refuses_the_others(small_2d):
+    import threading
+    sim = sph.Simulation(small_2d, threads=1)
+    sim.step(1)
+    started = threading.Event()
+    errors = []
+
+    def step_long():
+        started.set()
+        sim.step(400)
+
+    t = threading.Thread(target=step_long)
+    t.start()
+    started.wait()
+    refused = 0
+    while t.is_alive():  # the GIL is released while it steps: this thread runs meanwhile
+        for call in (lambda: sim.positions, lambda: sim.step(1), lambda: sim.counters,
+                     lambda: setattr(sim, "velocities", np.zeros((len(sim), 2)))):
+            try:
+                call()
+            except RuntimeError as e:
+                assert "another thread" in str(e)
+                refused += 1
+            except Exception as e:  # noqa: BLE001
+                errors.append(e)
+    t.join()
+    assert not errors and refused > 0
+    assert sim.steps == 401  # only the stepping thread's steps
+    plain = sph.Simulation(small_2d, threads=1)
+    plain.step(401)
+    assert plain.positions.tobytes() == sim.positions.tobytes()

@@ -1,9 +1,11 @@
 // RunDriver and open_run_to_resume in this process: a run stopped by its stop callback and
 // resumed gives exactly the files of a run never stopped; a stop request writes a checkpoint;
-// the statuses; resuming a finished run is refused.
+// the statuses; resuming a finished run is refused; step() (the Python module's loop) gives the
+// steps of run(), and particles_moved() makes the next step rebuild every list.
 
 #include <algorithm>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -196,6 +198,29 @@ TEST(RunDriver, ARunWithoutADirectoryWritesNothingAndStillStops) {
   EXPECT_EQ(r.steps_done, 12);
   EXPECT_EQ(observed, 7) << "steps 6 to 12";
   EXPECT_TRUE(entries(tmp.path()).empty());
+}
+
+TEST(RunDriver, StepGivesTheStepsOfRunAndGoesOnPastTheScenesLast) {
+  TempDir tmp;
+  RunDriver<2, double> ran(dam_break("adaptive", 30), RunSettings{tmp / "o", 0});
+  ran.run();
+  RunDriver<2, double> stepped(dam_break("adaptive", 30), RunSettings{});
+  for (int k = 0; k < 30; ++k) EXPECT_EQ(stepped.step().step, k);
+  EXPECT_EQ(stepped.simulation().particles().position, ran.simulation().particles().position);
+  EXPECT_EQ(stepped.simulation().particles().velocity, ran.simulation().particles().velocity);
+  EXPECT_EQ(stepped.step().step, 30) << "no limit at the scene's numberOfSteps";
+  EXPECT_THROW(ran.step(), std::logic_error) << "a run with a directory steps through run() only";
+}
+
+TEST(RunDriver, ParticlesMovedRebuildsEveryListInTheNextStep) {
+  RunDriver<2, double> run(dam_break("adaptive", 30), RunSettings{});
+  for (int k = 0; k < 5; ++k) run.step();
+  const std::size_t n = run.simulation().particles().size();
+  EXPECT_LT(run.step().neighbors.lists_rebuilt, n) << "adaptive: only the flagged lists";
+  for (auto& v : run.simulation().edit_particles().velocity) v[0] += 0.5;
+  run.simulation().particles_moved();
+  EXPECT_EQ(run.step().neighbors.lists_rebuilt, n);
+  EXPECT_LT(run.step().neighbors.lists_rebuilt, n);
 }
 
 TEST(RunDriver, AFailedStepIsReturnedWithItsMessage) {

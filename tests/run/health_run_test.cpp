@@ -1,9 +1,11 @@
 // The health monitor through the run driver: a warning is given once through the callback and
 // recorded in the status, summary.json and stats.csv; RunSettings::strict makes it a failure in
-// the step that raised it; a resumed run remembers the warnings given before its checkpoint.
+// the step that raised it; a resumed run remembers the warnings given before its checkpoint;
+// stepping with RunDriver::step gives the same warnings through new_warnings.
 
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -50,6 +52,22 @@ TEST(HealthRun, AWarningIsGivenOnceAndRecordedInTheStatusSummaryAndStats) {
   const std::string stats = slurp(tmp / "o" / "stats.csv");
   EXPECT_NE(stats.find(",outside,outside_depth,inside_solid,inside_depth,max_mach,rho_min,rho_max,energy,"),
             std::string::npos);
+}
+
+TEST(HealthRun, StepByStepGivesTheWarningsOfRunOnceAtTheirStep) {
+  TempDir tmp;
+  std::vector<std::pair<std::int64_t, std::string>> heard;  // (steps done, warning) of run()
+  RunCallbacks callbacks;
+  RunDriver<2, double> ran(thrown_dam_break(), RunSettings{tmp / "o", 0});
+  callbacks.warning = [&](const std::string& w) { heard.emplace_back(ran.simulation().steps_done(), w); };
+  ran.run(callbacks);
+  ASSERT_EQ(heard.size(), 1u);
+  RunDriver<2, double> stepped(thrown_dam_break(), RunSettings{});
+  std::vector<std::pair<std::int64_t, std::string>> given;
+  for (int k = 0; k < 40; ++k)
+    for (const std::string& w : stepped.new_warnings(stepped.step())) given.emplace_back(k + 1, w);
+  EXPECT_EQ(given, heard);
+  EXPECT_EQ(stepped.simulation().health().warnings(), ran.simulation().health().warnings());
 }
 
 TEST(HealthRun, StrictMakesTheFirstWarningAFailureInItsStep) {

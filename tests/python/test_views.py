@@ -18,6 +18,8 @@ def test_views_are_read_only_and_share_the_simulation_memory(small_2d):
         a[0, 0] = 1.0
     with pytest.raises(ValueError, match="read-only"):
         sim.densities[:] = 0
+    with pytest.raises(ValueError, match="WRITEABLE"):  # and cannot be made writeable
+        a.flags.writeable = True
 
 
 def test_every_field_of_the_table_is_a_property(small_2d):

@@ -30,7 +30,8 @@ STATS_COLUMNS = ("step,time,particles,kinetic_energy,max_speed,mean_neighbors,li
                  "pairs_within_h,missed_pairs,particles_missing,max_missed_penetration,"
                  "t_grid,t_lists,t_density,t_forces,t_integrate,t_output,"
                  "outside,outside_depth,inside_solid,inside_depth,max_mach,rho_min,rho_max,energy,"
-                 "boundary_pairs_stored,boundary_missed_pairs")
+                 "boundary_pairs_stored,boundary_missed_pairs,"
+                 "entries_rebuilt,list_insertions,list_removals,list_overflows,skin")
 PHASES = ("grid", "lists", "density", "forces", "integrate", "output")
 POINT_FIELDS = {"velocity": 3, "density": 1, "pressure": 1, "id": 1, "initial_position": 3}
 

@@ -28,7 +28,7 @@ TEST(NeighborModeTable, EveryNameParsesBackToItsModeAndItsStrategy) {
     EXPECT_EQ((make_neighbor_strategy<2, double>(info.mode, options)->mode()), info.mode);
     EXPECT_EQ((make_neighbor_strategy<3, float>(info.mode, options)->mode()), info.mode);
   }
-  EXPECT_EQ(names.size(), 4u);
+  EXPECT_EQ(names.size(), 6u);
 }
 
 TEST(NeighborModeTable, UnknownNameIsRefusedNamingEveryMode) {
@@ -37,26 +37,30 @@ TEST(NeighborModeTable, UnknownNameIsRefusedNamingEveryMode) {
     FAIL() << "no error";
   } catch (const Error& e) {
     EXPECT_EQ(e.where(), "--neighbors");
-    EXPECT_EQ(
-        e.message(),
-        "unknown neighbor mode \"fast\"; expected one of \"standard\", \"adaptive\", \"verlet\", \"brute_force\"");
+    EXPECT_EQ(e.message(),
+              "unknown neighbor mode \"fast\"; expected one of \"standard\", \"adaptive\", \"verlet\", \"tracked\", "
+              "\"adaptive_exact\", \"brute_force\"");
   }
   EXPECT_THROW(parse_neighbor_mode(""), Error);
   EXPECT_THROW(parse_neighbor_mode("Standard"), Error) << "names are case-sensitive";
 }
 
 TEST(NeighborModeTable, ListsDerivedFromTheTable) {
-  EXPECT_EQ(neighbor_mode_names(), (std::vector<std::string>{"standard", "adaptive", "verlet", "brute_force"}));
+  EXPECT_EQ(neighbor_mode_names(),
+            (std::vector<std::string>{"standard", "adaptive", "verlet", "tracked", "adaptive_exact", "brute_force"}));
   EXPECT_EQ(neighbor_mode_names(NeighborModeSet::Compared),
-            (std::vector<std::string>{"standard", "adaptive", "verlet"}));
+            (std::vector<std::string>{"standard", "adaptive", "verlet", "tracked", "adaptive_exact"}));
   EXPECT_EQ(neighbor_modes(NeighborModeSet::Compared),
-            (std::vector<NeighborMode>{NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet}));
+            (std::vector<NeighborMode>{NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet,
+                                       NeighborMode::Tracked, NeighborMode::AdaptiveExact}));
   EXPECT_EQ(neighbor_modes(NeighborModeSet::All).size(), std::size(kNeighborModes));
   EXPECT_FALSE(neighbor_mode_info(NeighborMode::BruteForce).compared) << "the oracle is too slow to time";
-  EXPECT_EQ(join_neighbor_mode_names(NeighborModeSet::Compared, ",", ","), "standard,adaptive,verlet");
-  EXPECT_EQ(join_neighbor_mode_names(NeighborModeSet::Compared, ", ", " or "), "standard, adaptive or verlet");
+  EXPECT_EQ(join_neighbor_mode_names(NeighborModeSet::Compared, ",", ","),
+            "standard,adaptive,verlet,tracked,adaptive_exact");
+  EXPECT_EQ(join_neighbor_mode_names(NeighborModeSet::Compared, ", ", " or "),
+            "standard, adaptive, verlet, tracked or adaptive_exact");
   EXPECT_EQ(join_neighbor_mode_names(NeighborModeSet::All, ", ", " and "),
-            "standard, adaptive, verlet and brute_force");
+            "standard, adaptive, verlet, tracked, adaptive_exact and brute_force");
 }
 
 }  // namespace

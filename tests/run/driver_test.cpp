@@ -123,7 +123,7 @@ TEST_P(StopAndResume, GivesTheFilesOfARunNeverStopped) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Modes, StopAndResume, testing::Values("standard", "adaptive"));
+INSTANTIATE_TEST_SUITE_P(Modes, StopAndResume, testing::Values("standard", "adaptive", "tracked", "adaptive_exact"));
 
 TEST(RunDriver, StopsTwiceAndResumesTwiceBitwise) {
   TempDir tmp;

@@ -24,13 +24,14 @@
 
 namespace sph {
 
-/// The format version this build writes and reads. Version 4 records the run's identity (run id
+/// The format version this build writes and reads. Version 6 stores each neighbor list's capacity
+/// after the lists (NeighborLists::save) and knows the tracked modes. Version 4 records the run's identity (run id
 /// and scene fingerprint) after --checkpoint-every, and the health monitor's state
 /// (HealthMonitor::save_state) after the neighbor strategy's. Version 3 stores the particle fields by
 /// name and kind, in kParticleFields order, then the fields a run added (ParticleSet::save);
 /// version 2 kept the frames' times and the schedule's next tick instead of version 1's .vtu
 /// file list.
-inline constexpr std::uint32_t kCheckpointVersion = 5;
+inline constexpr std::uint32_t kCheckpointVersion = 6;
 /// The checkpoint's file name in a run's output directory.
 inline constexpr const char* kCheckpointFile = "checkpoint.sphc";
 

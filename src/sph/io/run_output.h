@@ -71,7 +71,10 @@ constexpr StatsColumn real_column(std::string_view name, StatsFormat format, dou
 /// audit columns (missed_pairs, particles_missing, max_missed_penetration) are empty unless the
 /// run audits. Then eight of the health monitor's statistics of the step (HealthStats;
 /// docs/reliability.md), and the boundary particles' lists: entries stored, and (audited runs)
-/// the fluid-boundary pairs within h they missed (0 and empty with penalty walls).
+/// the fluid-boundary pairs within h they missed (0 and empty with penalty walls). Last, the work
+/// of the step's list building: entries written by (re)builds and insertions, the tracked modes'
+/// insertions into and removals from other particles' lists and lists that outgrew their room,
+/// and the lists' skin (m; 0 in the modes without one).
 inline constexpr StatsColumn kStatsColumns[] = {
     detail::count_column("step", [](const StepStats& s) { return static_cast<std::uint64_t>(s.info.step + 1); }),
     detail::real_column("time", StatsFormat::Real9, [](const StepStats& s) { return s.info.time; }),
@@ -114,6 +117,11 @@ inline constexpr StatsColumn kStatsColumns[] = {
                          [](const StepStats& s) { return s.info.neighbors.boundary_pairs_stored; }),
     detail::count_column(
         "boundary_missed_pairs", [](const StepStats& s) { return s.info.boundary_audit.missed_pairs; }, true),
+    detail::count_column("entries_rebuilt", [](const StepStats& s) { return s.info.neighbors.entries_rebuilt; }),
+    detail::count_column("list_insertions", [](const StepStats& s) { return s.info.neighbors.insertions; }),
+    detail::count_column("list_removals", [](const StepStats& s) { return s.info.neighbors.removals; }),
+    detail::count_column("list_overflows", [](const StepStats& s) { return s.info.neighbors.overflows; }),
+    detail::real_column("skin", StatsFormat::Real6, [](const StepStats& s) { return s.info.neighbors.skin; }),
 };
 
 /// The header line of stats.csv: the column names, comma-separated.

@@ -176,8 +176,9 @@ void ListBuilder<D, R>::build_queries(const UniformGrid<D, R>& grid, std::span<c
 
 template <int D, std::floating_point R>
 void ListBuilder<D, R>::rebuild_some(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> positions, R radius,
-                                     std::span<const std::uint8_t> rebuild, NeighborLists& lists) {
-  rebuild_some_with(grid, positions.size(), GridPoints<D, R>{grid, positions}, radius, rebuild, lists);
+                                     std::span<const std::uint8_t> rebuild, NeighborLists& lists,
+                                     RebuildVisitor* visitor) {
+  rebuild_some_with(grid, positions.size(), GridPoints<D, R>{grid, positions}, radius, rebuild, lists, visitor);
 }
 
 template <int D, std::floating_point R>
@@ -193,22 +194,36 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
   const R r2 = radius * radius;
   const std::size_t chunks = chunk_count(n);
   out.chunks_.resize(chunks);
+  out.begin_.resize(n);
   out.end_.resize(n);
+  if (room_)
+    out.cap_.resize(n);
+  else
+    out.cap_.clear();
   chunk_entries_.resize(chunks);
 
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     auto& buf = out.chunks_[c];
     Stencil<D, R> st;
-    std::size_t used = 0;
+    std::size_t used = 0, entries = 0;
     for (std::size_t i = b; i < e; ++i) {
       st.update(grid, query.cell(i));
       ensure_room(buf, used + st.candidates + kRoom);
       const std::uint32_t m = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + used);
+      out.begin_[i] = static_cast<std::uint32_t>(used);
+      out.end_[i] = static_cast<std::uint32_t>(used + m);
+      entries += m;
       used += m;
-      out.end_[i] = static_cast<std::uint32_t>(used);
+      if (room_) {
+        const std::uint32_t cap = list_capacity(m);
+        ensure_room(buf, used - m + cap + kRoom);
+        std::fill_n(buf.data() + used, cap - m, 0u);
+        out.cap_[i] = cap;
+        used += cap - m;
+      }
     }
     std::fill_n(buf.data() + used, kRoom, 0u);  // readable padding, valid indices (not stale ones)
-    chunk_entries_[c] = used;
+    chunk_entries_[c] = entries;
   });
   out.entries_ = 0;
   for (std::size_t c = 0; c < chunks; ++c) out.entries_ += chunk_entries_[c];
@@ -217,24 +232,35 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
 template <int D, std::floating_point R>
 template <class Query>
 void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::size_t n, const Query& query, R radius,
-                                          std::span<const std::uint8_t> rebuild, NeighborLists& lists) {
+                                          std::span<const std::uint8_t> rebuild, NeighborLists& lists,
+                                          RebuildVisitor* visitor) {
   const std::size_t old_n = lists.particle_count();
   SPH_CHECK(rebuild.size() == n && old_n <= n, "rebuild flags must cover every particle");
+  SPH_CHECK(room_ == lists.has_room() || old_n == 0, "lists with room are rebuilt with room");
+  SPH_CHECK(visitor == nullptr || room_, "only lists with room are rebuilt in place");
   const R r2 = radius * radius;
   const std::size_t chunks = chunk_count(n);
   lists.chunks_.resize(chunks);
+  lists.begin_.resize(n);
   lists.end_.resize(n);
+  if (room_) lists.cap_.resize(n);
   chunk_entries_.resize(chunks);
 
   // Each thread copies a chunk's old lists aside before merging. The copy buffers are grown
   // here, before the loop, to the largest old chunk: their size depends only on the lists, not
   // on which thread meets which chunk, so a steady state allocates nothing for any schedule.
   std::size_t largest_old = 0;
-  for (std::size_t c = 0; c * kChunkSize < old_n; ++c)
-    largest_old = std::max<std::size_t>(largest_old, lists.end_[std::min(old_n, (c + 1) * kChunkSize) - 1]);
+  for (std::size_t c = 0; c * kChunkSize < old_n; ++c) {
+    const std::size_t last = std::min(old_n, (c + 1) * kChunkSize) - 1;
+    largest_old = std::max<std::size_t>(largest_old, lists.begin_[last] + lists.capacity(last));
+  }
   old_copy_.resize(static_cast<std::size_t>(num_threads()));
   for (auto& copy : old_copy_) ensure_room(copy, largest_old);
 
+  if (room_ && lists.has_room()) {
+    rebuild_in_place(grid, n, query, radius, rebuild, lists, visitor);
+    return;
+  }
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     const auto marked = [&](std::size_t i) { return rebuild[i] != 0 || i >= old_n; };
     std::size_t kept = 0;
@@ -250,36 +276,101 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
       return;
     }
     // The chunk's old lists are copied aside, then the chunk's buffer is rewritten in order:
-    // kept lists from the copy, marked ones gathered in place. The buffer belongs to the chunk
-    // and keeps its room, so it grows only when the chunk's lists do.
+    // kept lists (with their room) from the copy, marked ones gathered in place. The buffer
+    // belongs to the chunk and keeps its room, so it grows only when the chunk's lists do.
     std::vector<std::uint32_t>& buf = lists.chunks_[c];
     const std::size_t last_old = std::min(e, old_n);  // particles [b, last_old) had lists
-    const std::size_t old_size = last_old > b ? lists.end_[last_old - 1] : 0;
+    const std::size_t old_size = last_old > b ? lists.begin_[last_old - 1] + lists.capacity(last_old - 1) : 0;
     std::vector<std::uint32_t>& old_copy = old_copy_[static_cast<std::size_t>(thread_index())];
     std::copy_n(buf.data(), old_size, old_copy.data());
     Stencil<D, R> st;
-    std::size_t at = 0;
-    std::uint32_t old_end = 0;  // end of list i - 1 before this merge
+    std::size_t at = 0, entries = 0;
     for (std::size_t i = b; i < e; ++i) {
-      const std::uint32_t old_begin = old_end;
-      old_end = i < old_n ? lists.end_[i] : old_end;
+      std::uint32_t len = 0, cap = 0;
       if (marked(i)) {
         st.update(grid, query.cell(i));
         ensure_room(buf, at + st.candidates + kRoom);
-        at += gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at);
+        len = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at);
+        cap = room_ ? list_capacity(len) : len;
+        ensure_room(buf, at + cap + kRoom);
       } else {
-        const std::uint32_t len = old_end - old_begin;
-        ensure_room(buf, at + len + kRoom);
+        const std::uint32_t old_begin = lists.begin_[i];
+        len = lists.end_[i] - old_begin;
+        cap = static_cast<std::uint32_t>(lists.capacity(i));
+        ensure_room(buf, at + cap + kRoom);
         std::copy_n(old_copy.data() + old_begin, len, buf.data() + at);
-        at += len;
       }
-      lists.end_[i] = static_cast<std::uint32_t>(at);
+      std::fill_n(buf.data() + at + len, cap - len, 0u);  // a list's room holds valid indices
+      lists.begin_[i] = static_cast<std::uint32_t>(at);
+      lists.end_[i] = static_cast<std::uint32_t>(at + len);
+      if (room_) lists.cap_[i] = cap;
+      at += cap;
+      entries += len;
     }
     std::fill_n(buf.data() + at, kRoom, 0u);  // readable padding, valid indices
-    chunk_entries_[c] = at;
+    chunk_entries_[c] = entries;
   });
   lists.entries_ = 0;
   for (std::size_t c = 0; c < chunks; ++c) lists.entries_ += chunk_entries_[c];
+}
+
+template <int D, std::floating_point R>
+template <class Query>
+void ListBuilder<D, R>::rebuild_in_place(const UniformGrid<D, R>& grid, std::size_t n, const Query& query, R radius,
+                                         std::span<const std::uint8_t> rebuild, NeighborLists& lists,
+                                         RebuildVisitor* visitor) {
+  // Lists with room of their own: a marked list is gathered aside and copied into its slot, and
+  // only a list that no longer fits has its chunk laid out again; the others are not touched.
+  const std::size_t old_n = lists.particle_count();
+  const R r2 = radius * radius;
+  const std::size_t chunks = chunk_count(n);
+  lists.chunks_.resize(chunks);
+  lists.begin_.resize(n);
+  lists.end_.resize(n);
+  lists.cap_.resize(n);
+  chunk_delta_.assign(chunks, 0);
+  old_copy_.resize(static_cast<std::size_t>(num_threads()));
+  relayout_copy_.resize(old_copy_.size());
+  parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
+    std::vector<std::uint32_t>& buf = lists.chunks_[c];
+    std::vector<std::uint32_t>& scratch = old_copy_[static_cast<std::size_t>(thread_index())];
+    std::int64_t delta = 0;
+    Stencil<D, R> st;
+    for (std::size_t i = b; i < e; ++i) {
+      if (rebuild[i] == 0 && i < old_n) continue;
+      st.update(grid, query.cell(i));
+      if (i >= old_n) {  // appended: its list goes after the chunk's last one
+        const std::size_t at = i == b ? 0 : lists.begin_[i - 1] + lists.cap_[i - 1];
+        ensure_room(buf, at + st.candidates + kRoom);
+        const std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at);
+        const std::uint32_t cap = list_capacity(len);
+        ensure_room(buf, at + cap + kRoom);
+        std::fill_n(buf.data() + at + len, cap - len + kRoom, 0u);
+        lists.begin_[i] = static_cast<std::uint32_t>(at);
+        lists.end_[i] = static_cast<std::uint32_t>(at + len);
+        lists.cap_[i] = cap;
+        delta += len;
+        if (visitor) visitor->rebuilt(c, i, {}, {buf.data() + at, len});
+        continue;
+      }
+      ensure_room(scratch, st.candidates + kRoom);
+      const std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, scratch.data());
+      if (len > lists.cap_[i]) {
+        const std::uint32_t want = list_capacity(len);
+        lists.relayout_chunk(c, relayout_copy_[static_cast<std::size_t>(thread_index())],
+                             [&](std::size_t q) { return q == i ? want : std::uint32_t{0}; });
+      }
+      delta += static_cast<std::int64_t>(len) - static_cast<std::int64_t>(lists.end_[i] - lists.begin_[i]);
+      if (visitor) visitor->rebuilt(c, i, lists.of(i), {scratch.data(), len});
+      std::copy_n(scratch.data(), len, buf.data() + lists.begin_[i]);
+      // Entries past the new end keep old, valid indices (below the old particle count).
+      lists.end_[i] = lists.begin_[i] + len;
+    }
+    chunk_delta_[c] = delta;
+  });
+  std::int64_t total = static_cast<std::int64_t>(lists.entries_);
+  for (std::size_t c = 0; c < chunks; ++c) total += chunk_delta_[c];
+  lists.entries_ = static_cast<std::size_t>(total);
 }
 
 template class ListBuilder<2, float>;

@@ -18,6 +18,15 @@ namespace sph {
 /// tested per instruction and the hits compressed into the list. Lists are written in place
 /// into their chunk's storage, and storage is kept between builds, so rebuilding allocates
 /// nothing in steady state.
+/// Told of each list that ListBuilder::rebuild_some() rebuilds in place (lists with room), in the
+/// thread that owns the list's chunk, in particle order within the chunk: `before` is the old list
+/// (empty for a particle appended since), `after` the new one. Both are valid only during the call.
+struct RebuildVisitor {
+  virtual ~RebuildVisitor() = default;
+  virtual void rebuilt(std::size_t chunk, std::size_t i, std::span<const std::uint32_t> before,
+                       std::span<const std::uint32_t> after) = 0;
+};
+
 template <int D, std::floating_point R>
 class ListBuilder {
  public:
@@ -29,7 +38,7 @@ class ListBuilder {
   /// `positions`. Deterministic for any thread count; chunks without a marked particle are
   /// not touched.
   void rebuild_some(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> positions, R radius,
-                    std::span<const std::uint8_t> rebuild, NeighborLists& lists);
+                    std::span<const std::uint8_t> rebuild, NeighborLists& lists, RebuildVisitor* visitor = nullptr);
 
   /// Boundary lists: for each query point i (queries[i], not a point of the grid), every grid
   /// point strictly closer than `radius`, in the grid's cell order. The same kernels, storage and
@@ -44,16 +53,31 @@ class ListBuilder {
   /// scalar one (tests check that both give the same lists).
   void use_vector_kernel(bool on) { vector_ = on; }
 
+  /// Lists built from now on keep room of their own (NeighborLists::capacity), list_capacity()
+  /// slots for a list of that size, so that other lists' particles can be inserted (the tracked
+  /// modes); rebuild_some() keeps a kept list's capacity. Off by default (compact lists).
+  void keep_room(bool on) { room_ = on; }
+  /// The capacity a list of `size` entries is built with when lists keep room: a quarter more and 4.
+  static std::uint32_t list_capacity(std::uint32_t size) { return size + size / 4 + 4; }
+
  private:
   template <class Query>
   void build_with(const UniformGrid<D, R>& grid, std::size_t n, const Query& query, R radius, NeighborLists& out);
   template <class Query>
   void rebuild_some_with(const UniformGrid<D, R>& grid, std::size_t n, const Query& query, R radius,
-                         std::span<const std::uint8_t> rebuild, NeighborLists& lists);
+                         std::span<const std::uint8_t> rebuild, NeighborLists& lists,
+                         RebuildVisitor* visitor = nullptr);
+
+  template <class Query>
+  void rebuild_in_place(const UniformGrid<D, R>& grid, std::size_t n, const Query& query, R radius,
+                        std::span<const std::uint8_t> rebuild, NeighborLists& lists, RebuildVisitor* visitor);
 
   bool vector_ = true;
+  bool room_ = false;
   std::vector<std::size_t> chunk_entries_;
-  std::vector<std::vector<std::uint32_t>> old_copy_;  // rebuild_some: one per thread
+  std::vector<std::int64_t> chunk_delta_;
+  std::vector<std::vector<std::uint32_t>> old_copy_;       // rebuild_some: one per thread
+  std::vector<std::vector<std::uint32_t>> relayout_copy_;  // rebuild_some in place: one per thread
 };
 
 extern template class ListBuilder<2, float>;

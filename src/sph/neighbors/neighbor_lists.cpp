@@ -8,7 +8,8 @@
 namespace sph {
 
 std::size_t NeighborLists::memory_bytes() const {
-  std::size_t bytes = chunks_.capacity() * sizeof(chunks_[0]) + end_.capacity() * sizeof(std::uint32_t);
+  std::size_t bytes = chunks_.capacity() * sizeof(chunks_[0]) +
+                      (begin_.capacity() + end_.capacity() + cap_.capacity()) * sizeof(std::uint32_t);
   for (const auto& c : chunks_) bytes += c.capacity() * sizeof(std::uint32_t);
   return bytes;
 }
@@ -17,10 +18,12 @@ NeighborLists NeighborLists::from(const std::vector<std::vector<std::uint32_t>>&
   NeighborLists out;
   const std::size_t n = lists.size();
   out.chunks_.resize(chunk_count(n));
+  out.begin_.resize(n);
   out.end_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     auto& chunk = out.chunks_[i / kChunkSize];
     SPH_CHECK(chunk.size() + lists[i].size() < (std::size_t{1} << 32), "neighbor list chunk too large");
+    out.begin_[i] = static_cast<std::uint32_t>(chunk.size());
     chunk.insert(chunk.end(), lists[i].begin(), lists[i].end());
     out.end_[i] = static_cast<std::uint32_t>(chunk.size());
     out.entries_ += lists[i].size();
@@ -33,8 +36,11 @@ bool NeighborLists::padding_is_valid() const {
   const std::size_t n = particle_count();
   for (std::size_t c = 0; c < chunks_.size(); ++c) {
     const std::size_t last = std::min(n, (c + 1) * kChunkSize) - 1;
-    const std::size_t end = end_[last];
+    const std::size_t end = begin_[last] + capacity(last);
     if (chunks_[c].size() < end + kPadding) return false;
+    for (std::size_t i = c * kChunkSize; i <= last; ++i)  // a list's unused room, too
+      for (std::size_t k = end_[i]; k < begin_[i] + capacity(i); ++k)
+        if (chunks_[c][k] >= n) return false;
     for (std::size_t k = end; k < end + kPadding; ++k)
       if (chunks_[c][k] >= n) return false;
   }
@@ -42,11 +48,22 @@ bool NeighborLists::padding_is_valid() const {
 }
 
 void NeighborLists::save(StateWriter& out) const {
-  out.put(end_);
+  // Compact: each chunk's lists one after the other (offsets as if without room), then the
+  // capacities (empty without room of their own), from which load() lays the room out again.
+  const std::size_t n = end_.size();
+  std::vector<std::uint32_t> end(n);
+  std::vector<std::uint32_t> data;
+  for (std::size_t i = 0; i < n; ++i) end[i] = (i % kChunkSize != 0 ? end[i - 1] : 0) + (end_[i] - begin_[i]);
+  out.put(end);
   for (std::size_t c = 0; c < chunks_.size(); ++c) {
-    const std::size_t last = std::min(end_.size(), (c + 1) * kChunkSize) - 1;
-    out.put(std::span<const std::uint32_t>(chunks_[c].data(), end_[last]));
+    data.clear();
+    for (std::size_t i = c * kChunkSize; i < std::min(n, (c + 1) * kChunkSize); ++i) {
+      const auto l = of(i);
+      data.insert(data.end(), l.begin(), l.end());
+    }
+    out.put(data);
   }
+  out.put(cap_);
 }
 
 void NeighborLists::load(StateReader& in, std::size_t index_limit) {
@@ -55,10 +72,12 @@ void NeighborLists::load(StateReader& in, std::size_t index_limit) {
   const std::size_t n = end_.size();
   const std::size_t limit = index_limit > 0 ? index_limit : n;
   chunks_.resize(chunk_count(n));
+  begin_.resize(n);
   for (std::size_t c = 0; c < chunks_.size(); ++c) {
     const std::size_t first = c * kChunkSize, last = std::min(n, first + kChunkSize) - 1;
     for (std::size_t i = first + 1; i <= last; ++i)
       in.expect(end_[i - 1] <= end_[i], "neighbor list offsets go backwards");
+    for (std::size_t i = first; i <= last; ++i) begin_[i] = i == first ? 0 : end_[i - 1];
     std::vector<std::uint32_t>& chunk = chunks_[c];
     in.get(chunk);
     in.expect(chunk.size() == end_[last], "a neighbor list chunk of the wrong length");
@@ -66,6 +85,14 @@ void NeighborLists::load(StateReader& in, std::size_t index_limit) {
     entries_ += chunk.size();
     chunk.resize(chunk.size() + kPadding, 0);
   }
+  std::vector<std::uint32_t> cap;
+  in.get(cap);
+  in.expect(cap.empty() || cap.size() == n, "neighbor list capacities do not match the lists");
+  if (cap.empty()) return;
+  for (std::size_t i = 0; i < n; ++i) in.expect(cap[i] >= end_[i] - begin_[i], "a neighbor list over its capacity");
+  cap_ = std::move(cap);
+  std::vector<std::uint32_t> scratch;
+  for (std::size_t c = 0; c < chunks_.size(); ++c) relayout_chunk(c, scratch, [](std::size_t) { return 0; });
 }
 
 bool operator==(const NeighborLists& a, const NeighborLists& b) {

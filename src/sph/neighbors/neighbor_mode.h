@@ -9,7 +9,7 @@
 namespace sph {
 
 /// Neighbor strategies (kNeighborModes describes each).
-enum class NeighborMode { Standard, Adaptive, Verlet, BruteForce };
+enum class NeighborMode { Standard, Adaptive, Verlet, Tracked, AdaptiveExact, BruteForce };
 
 /// One neighbor mode as users name and select it.
 struct NeighborModeInfo {
@@ -29,6 +29,14 @@ inline constexpr NeighborModeInfo kNeighborModes[] = {
      true},
     {NeighborMode::Verlet, "verlet", "exact lists of radius h + skin, all rebuilt once a particle moved half the skin",
      true},
+    {NeighborMode::Tracked, "tracked",
+     "exact per-particle lists of radius h + skin: a list is rebuilt once its particle moved a third of the skin, "
+     "and inserted into its new neighbors' lists (docs/neighbor-modes.md)",
+     true},
+    {NeighborMode::AdaptiveExact, "adaptive_exact",
+     "the paper's Eq. 7 test on tracked lists (a pair predicted to leave h + skin flags both): Algorithm 2 without "
+     "missed pairs",
+     true},
     {NeighborMode::BruteForce, "brute_force", "compares every pair, O(N^2): the tests' oracle, for tiny scenes", false},
 };
 
@@ -37,7 +45,7 @@ enum class NeighborModeSet { All, Compared };
 
 /// The table's entry of `mode`.
 const NeighborModeInfo& neighbor_mode_info(NeighborMode mode);
-/// The mode's name: "standard", "adaptive", "verlet" or "brute_force".
+/// The mode's name (the table's).
 std::string_view to_string(NeighborMode mode);
 /// Parses a mode name; throws sph::Error naming the accepted values otherwise.
 NeighborMode parse_neighbor_mode(std::string_view name, const std::string& where = {});

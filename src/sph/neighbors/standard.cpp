@@ -20,6 +20,7 @@ void StandardNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
   counters_.lists_seconds = watch.lap();
   counters_.lists_rebuilt = particles.size();
   counters_.pairs_stored = lists_.entry_count();
+  counters_.entries_rebuilt = lists_.entry_count();
   counters_.boundary_pairs_stored = this->boundary_.lists().entry_count();
 }
 
@@ -60,6 +61,7 @@ void BruteForceNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
   counters_.lists_seconds = watch.lap();
   counters_.lists_rebuilt = particles.size();
   counters_.pairs_stored = lists_.entry_count();
+  counters_.entries_rebuilt = lists_.entry_count();
   counters_.boundary_pairs_stored = boundary_lists_.entry_count();
 }
 

@@ -3,6 +3,7 @@
 #include <sph/core/error.h>
 #include <sph/neighbors/adaptive.h>
 #include <sph/neighbors/standard.h>
+#include <sph/neighbors/tracked.h>
 #include <sph/neighbors/verlet.h>
 
 namespace sph {
@@ -22,6 +23,11 @@ std::unique_ptr<NeighborStrategy<D, R>> make_neighbor_strategy(NeighborMode mode
           static_cast<R>(options.verlet_skin > 0 ? options.verlet_skin : kDefaultSkinFraction * options.radius);
       return std::make_unique<VerletNeighbors<D, R>>(radius, skin);
     }
+    case NeighborMode::Tracked:
+    case NeighborMode::AdaptiveExact:
+      return std::make_unique<TrackedNeighbors<D, R>>(radius, static_cast<R>(options.tracked_skin),
+                                                      options.full_rebuild_period, static_cast<R>(options.time_step),
+                                                      mode == NeighborMode::AdaptiveExact);
   }
   throw Error("unknown neighbor mode");
 }

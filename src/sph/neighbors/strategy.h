@@ -19,6 +19,11 @@ struct NeighborCounters {
   std::uint64_t lists_rebuilt = 0;          ///< particles whose list was rebuilt this step
   std::uint64_t pairs_stored = 0;           ///< directed entries stored in all lists
   std::uint64_t boundary_pairs_stored = 0;  ///< entries stored in the boundary lists
+  std::uint64_t entries_rebuilt = 0;        ///< entries written by this step's (re)builds and insertions
+  std::uint64_t insertions = 0;             ///< tracked modes: a rebuilt particle entered another's list
+  std::uint64_t removals = 0;               ///< tracked modes: a rebuilt particle left another's list
+  std::uint64_t overflows = 0;              ///< tracked modes: lists that outgrew their room (chunk laid out again)
+  double skin = 0;                          ///< lists hold pairs within h + skin (0: exactly h), m
   double grid_seconds = 0;                  ///< wall time spent building the grid
   double lists_seconds = 0;                 ///< wall time spent building lists
 };
@@ -28,6 +33,10 @@ struct NeighborOptions {
   double radius = 0;              ///< kernel support h, m
   int full_rebuild_period = 200;  ///< adaptive: rebuild every list each this many steps
   double verlet_skin = 0;         ///< verlet: lists hold pairs closer than h + skin, m; 0: default
+  /// tracked, adaptive_exact: lists hold pairs closer than h + skin, m; 0: chosen at each full
+  /// rebuild by tracked_skin() from the time step and the speeds seen
+  double tracked_skin = 0;
+  double time_step = 0;  ///< the solver's step, s (the tracked modes' automatic skin)
 };
 
 /// Default verlet skin as a fraction of h (docs/paper-reproduction.md shows how it was chosen).
@@ -63,6 +72,9 @@ class NeighborStrategy {
   /// Eq. 7). The strategy reads and clears them in its next update(). Empty for strategies
   /// that do not ask for the test (the solver then skips it).
   virtual std::span<std::uint8_t> pair_exit_flags() { return {}; }
+  /// The radius of the Eq. 7 test: h for the paper's lists, h + skin for adaptive_exact's (a pair
+  /// is flagged when it is predicted to leave the lists' reach).
+  R pair_exit_radius() const { return list_radius(); }
 
   /// The particles were reordered in memory: the lists refer to old indices, so the next
   /// update() rebuilds every list (and restarts whatever the strategy tracks per particle).

@@ -84,12 +84,16 @@ double estimated_bytes_of(const SceneBody<D>& body, std::size_t real_bytes) {
   double radius = p.kernel_radius;
   if (p.neighbors == NeighborMode::Verlet)
     radius += p.verlet_skin > 0 ? p.verlet_skin : kDefaultSkinFraction * p.kernel_radius;
+  // The tracked modes: their largest skin (automatic: at most h / 2), and the room of each list.
+  const bool tracked = p.neighbors == NeighborMode::Tracked || p.neighbors == NeighborMode::AdaptiveExact;
+  if (tracked) radius += p.tracked_skin > 0 ? p.tracked_skin : 0.5 * p.kernel_radius;
   // Lattice neighbors within the list radius: the area or volume of its ball over dx^D.
   const double q = radius / (2.0 * p.particle_radius);
   const double neighbors = D == 2 ? 3.14159265358979 * q * q : 4.18879020478639 * q * q * q;
   const double fields = 4.0 * D * real_bytes + 3.0 * real_bytes + 8.0;  // 4 vectors, 3 scalars, id
-  const double lists = 4.0 * neighbors * (17.0 / 16.0) + 4.0;           // entries + spare room, end offset
-  const double grid = D * real_bytes + 8.0;                             // coordinates in cell order, cell, index
+  const double lists = tracked ? 4.0 * (neighbors * 1.25 + 4.0) * (17.0 / 16.0) + 12.0 + D * real_bytes + 2.0
+                               : 4.0 * neighbors * (17.0 / 16.0) + 8.0;  // entries + spare room, offsets
+  const double grid = D * real_bytes + 8.0;                              // coordinates in cell order, cell, index
   return n * (fields + lists + grid);
 }
 }  // namespace

@@ -25,11 +25,10 @@ inline const std::vector<std::string> kRootKeys{"version",     "name",          
                                                 "dimension",   "Configuration", "Fluid",       "Container",
                                                 "FluidBlocks", "Obstacles",     "Emitters"};
 inline const std::vector<std::string> kConfigurationKeys{
-    "precision",         "timeStepSize",     "numberOfSteps", "stopAt",
-    "particleRadius",    "kernelRadius",     "gravitation",   "neighbors",
-    "fullRebuildPeriod", "verletSkin",       "reorderPeriod", "boundaryHandling",
-    "boundaryVolume",    "boundaryFriction", "kernel",        "outputEveryNSteps",
-    "outputFps",         "outputFormats",    "outputFields",  "outputBoundary"};
+    "precision",        "timeStepSize",   "numberOfSteps",     "stopAt",     "particleRadius",    "kernelRadius",
+    "gravitation",      "neighbors",      "fullRebuildPeriod", "verletSkin", "trackedSkin",       "reorderPeriod",
+    "boundaryHandling", "boundaryVolume", "boundaryFriction",  "kernel",     "outputEveryNSteps", "outputFps",
+    "outputFormats",    "outputFields",   "outputBoundary"};
 inline const std::vector<std::string> kFluidKeys{
     "density0",         "stiffness",     "viscosity",          "viscosityModel", "artificialViscosityAlpha",
     "negativePressure", "pressureForce", "gradientCorrection", "particleMass"};

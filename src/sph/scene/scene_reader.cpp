@@ -148,6 +148,16 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
   sim.fluid.kernel = value_named(detail::kKernelNames, c.choice("kernel", names_of(detail::kKernelNames), "paper"));
   sim.verlet_skin = c.positive("verletSkin", "a positive verlet skin in metres (default 0.1 h)",
                                kDefaultSkinFraction * sim.kernel_radius);
+  sim.tracked_skin = c.positive(
+      "trackedSkin", "a tracked skin in metres, or 0 for the automatic one (the default, chosen at each full rebuild)",
+      0.0, true);
+  if ((sim.neighbors == NeighborMode::Tracked || sim.neighbors == NeighborMode::AdaptiveExact) &&
+      sim.tracked_skin > 2.0 * sim.kernel_radius)
+    c.ctx().fail(c.child("trackedSkin"),
+                 fmt::format("a skin of {:g} m is more than twice h = {:g} m: lists would hold over 27 times the "
+                             "pairs needed in 3D; expected 0 (automatic) or a skin of at most 2 h = {:g} m (typical: "
+                             "0.02 h to 0.5 h)",
+                             sim.tracked_skin, sim.kernel_radius, 2.0 * sim.kernel_radius));
   // Only the verlet mode uses the skin; in the other modes it is read (positive) and has no effect.
   if (sim.neighbors == NeighborMode::Verlet && sim.verlet_skin > 2.0 * sim.kernel_radius)
     c.ctx().fail(c.child("verletSkin"),

@@ -56,6 +56,7 @@ OrderedJson configuration_json(const SceneDesc& desc, const SimulationParams<D>&
       .put("neighbors", std::string(to_string(sim.neighbors)))
       .put("fullRebuildPeriod", sim.full_rebuild_period)
       .put("verletSkin", sim.verlet_skin)
+      .put("trackedSkin", sim.tracked_skin)
       .put("reorderPeriod", sim.reorder_period)
       .put("boundaryHandling", detail::name_of(detail::kBoundaryHandlingNames, sim.boundary.handling))
       .put("boundaryVolume", detail::name_of(detail::kBoundaryVolumeNames, sim.boundary.volume))

@@ -157,7 +157,8 @@ struct SimulationParams {
   /// curve and every list is rebuilt; 0 never reorders. Defaults to full_rebuild_period so
   /// that adaptive runs rebuild nothing extra.
   int reorder_period = 200;
-  double verlet_skin = 0;  ///< verlet mode: skin, m; 0 means kDefaultSkinFraction * h
+  double verlet_skin = 0;   ///< verlet mode: skin, m; 0 means kDefaultSkinFraction * h
+  double tracked_skin = 0;  ///< tracked modes: skin, m; 0 means automatic (tracked_skin())
   /// Audit the lists every step against exact lists (StepInfo::audit); costs about one
   /// standard list build per step.
   bool audit = false;

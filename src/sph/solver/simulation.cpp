@@ -109,6 +109,8 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
   opt.radius = params_.kernel_radius;
   opt.full_rebuild_period = params_.full_rebuild_period;
   opt.verlet_skin = params_.verlet_skin;
+  opt.tracked_skin = params_.tracked_skin;
+  opt.time_step = params_.time_step;
   SPH_CHECK(params_.reorder_period >= 0, "reorder period must be >= 0");
   neighbors_ = make_neighbor_strategy<D, R>(params_.neighbors, opt);
   neighbors_->set_boundary(boundary_.position);
@@ -216,7 +218,7 @@ const StepInfo& Simulation<D, R>::step() {
   const WallContact<D, R> walls(params_.container, params_.obstacles, static_cast<R>(params_.particle_radius),
                                 params_.walls, params_.boundary.handling == BoundaryHandling::Penalty);
   compute_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity), walls,
-                        neighbors_->pair_exit_flags(), dt, solid);
+                        neighbors_->pair_exit_flags(), dt, solid, neighbors_->pair_exit_radius());
   info.seconds.forces = watch.lap();
   ++steps_;  // counted even if the checks below throw (as before the passes were fused)
   info.health = integrate_and_check<true>(dt);

@@ -220,12 +220,13 @@ simd::Pack<R> gradient_factor(const PackKernel<K, D, R>* kernel, const simd::Pac
 template <KernelKind K, PressureForce kForm, bool kPressure, bool kExitTest, int D, std::floating_point R>
 void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                 const Vec<D, R>& gravity, const WallContact<D, R>& walls, std::span<std::uint8_t> flags, R dt,
-                const BoundaryView<D, R>& boundary) {
+                const BoundaryView<D, R>& boundary, R exit_radius) {
   using P = simd::Pack<R>;
   constexpr int W = simd::kLanes<R>;
   constexpr bool kVariational = kForm == PressureForce::Variational;
   const P hv = P::set1(h), h2v = P::set1(h * h), zero = P::set1(R(0)), one = P::set1(R(1)), minus_one = P::set1(R(-1)),
           half = P::set1(R(0.5));
+  const P exit2v = P::set1(exit_radius * exit_radius);  // Eq. 7's radius: h, or the lists' radius
   const P grad_c = P::set1(R(-3) * SpikyKernel<D, R>(h).norm());
   const P grad6_c = P::set1(R(-6) * Poly6Kernel<D, R>(h).norm());
   const R lap_c = ViscosityKernel<D, R>(h).laplacian_norm();
@@ -325,7 +326,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
         }
       }
       if constexpr (kExitTest)
-        for (Mask out = valid & (q2 > h2v); out != 0; out &= out - 1) {
+        for (Mask out = valid & (q2 > exit2v); out != 0; out &= out - 1) {
           flag_i = true;
           set_flag(idx[k0 + static_cast<std::size_t>(__builtin_ctz(out))]);
         }
@@ -360,7 +361,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
           }
         }
         if constexpr (kExitTest)
-          if ((valid & (q2 > h2v)) != 0) flag_i = true;
+          if ((valid & (q2 > exit2v)) != 0) flag_i = true;
       }
     }
     if constexpr (kExitTest)
@@ -482,15 +483,18 @@ std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborList
 template <int D, std::floating_point R>
 void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                            const Vec<D, R>& gravity, const WallContact<D, R>& walls, std::span<std::uint8_t> exit_flags,
-                           R dt, const BoundaryView<D, R>& boundary) {
+                           R dt, const BoundaryView<D, R>& boundary, R exit_radius) {
   SPH_CHECK(exit_flags.empty() || exit_flags.size() == ps.size(), "one exit flag per particle");
+  if (!(exit_radius > R(0))) exit_radius = h;
   check_pass_inputs(ps, lists);
   if (boundary.active()) check_boundary_inputs(ps, boundary);
   const auto run = [&]<KernelKind kKernel, PressureForce kForm, bool kPressure>() {
     if (exit_flags.empty())
-      force_pass<kKernel, kForm, kPressure, false>(ps, lists, h, fluid, gravity, walls, exit_flags, dt, boundary);
+      force_pass<kKernel, kForm, kPressure, false>(ps, lists, h, fluid, gravity, walls, exit_flags, dt, boundary,
+                                                   exit_radius);
     else
-      force_pass<kKernel, kForm, kPressure, true>(ps, lists, h, fluid, gravity, walls, exit_flags, dt, boundary);
+      force_pass<kKernel, kForm, kPressure, true>(ps, lists, h, fluid, gravity, walls, exit_flags, dt, boundary,
+                                                  exit_radius);
   };
   // The kernel's pass for each form; with the cubic spline and Wendland C2 the variational
   // form is the symmetric one (the pressure gradient is the density kernel's anyway).
@@ -553,7 +557,7 @@ double lattice_mass(double rest_density, double spacing, double h, KernelKind ke
                                                         const FluidParams&, const BoundaryView<D, R>&);             \
   template void compute_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&,        \
                                             const Vec<D, R>&, const WallContact<D, R>&, std::span<std::uint8_t>, R, \
-                                            const BoundaryView<D, R>&);
+                                            const BoundaryView<D, R>&, R);
 SPH_INSTANTIATE(2, float)
 SPH_INSTANTIATE(2, double)
 SPH_INSTANTIATE(3, float)

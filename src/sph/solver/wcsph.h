@@ -124,10 +124,13 @@ class WallContact {
 /// exit_flags[j] to 1 when it holds (flags are only ever set, never cleared, so concurrent
 /// setting is race-free and the result is the same for any thread count). This pass gathers
 /// every neighbor's position and velocity anyway, so the test costs a few operations per pair.
+/// `exit_radius` replaces h in the test where it is positive (the adaptive_exact mode's lists
+/// reach h + skin, and a pair is flagged when it is predicted to leave them).
 template <int D, std::floating_point R>
 void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                            const Vec<D, R>& gravity, const WallContact<D, R>& walls,
-                           std::span<std::uint8_t> exit_flags = {}, R dt = 0, const BoundaryView<D, R>& boundary = {});
+                           std::span<std::uint8_t> exit_flags = {}, R dt = 0, const BoundaryView<D, R>& boundary = {},
+                           R exit_radius = 0);
 
 /// Particle mass such that a particle inside a lattice of spacing dx (square in 2D, cubic in
 /// 3D) has exactly density rho0 under the density kernel's sum of Eq. 4 with support h (poly6

@@ -1,0 +1,298 @@
+// The tracked modes: lists are symmetric, hold every pair within h after any motion (the proof's
+// invariant, on adversarial motions), rebuild only the particles that moved a third of the skin
+// (or that Eq. 7 flagged, in adaptive_exact), and give the same lists for any thread count and
+// after a save and load.
+
+#include <algorithm>
+#include <random>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include <sph/core/parallel.h>
+#include <sph/core/state_stream.h>
+#include <sph/neighbors/standard.h>
+#include <sph/neighbors/tracked.h>
+
+namespace sph {
+namespace {
+
+using V3 = Vec<3, double>;
+using V2 = Vec<2, double>;
+
+constexpr double kH = 0.1;
+constexpr double kSkin = 0.02;
+
+struct ThreadCount {
+  int saved = num_threads();
+  ~ThreadCount() { set_num_threads(saved); }
+};
+
+template <int D>
+ParticleSet<D, double> random_particles(std::size_t n, double extent, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0, extent);
+  ParticleSet<D, double> ps;
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec<D, double> x;
+    for (int d = 0; d < D; ++d) x[d] = u(rng);
+    ps.add(x, Vec<D, double>{}, 1.0);
+  }
+  return ps;
+}
+
+/// Every pair within h is listed both ways, the lists are symmetric, without self or
+/// duplicates, and hold only pairs within h + skin + the motion allowed since (3 triggers).
+template <int D>
+void expect_exact(const TrackedNeighbors<D, double>& t, const ParticleSet<D, double>& ps, const std::string& when) {
+  SCOPED_TRACE(when);
+  const NeighborLists& l = t.lists();
+  ASSERT_EQ(l.particle_count(), ps.size());
+  ASSERT_TRUE(l.padding_is_valid());
+  const NeighborLists exact = brute_force_lists<D, double>(ps.position, kH);
+  std::vector<std::vector<std::uint32_t>> sorted(ps.size());
+  std::size_t entries = 0;
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    const auto s = l.of(i);
+    sorted[i].assign(s.begin(), s.end());
+    std::sort(sorted[i].begin(), sorted[i].end());
+    entries += s.size();
+    ASSERT_EQ(std::adjacent_find(sorted[i].begin(), sorted[i].end()), sorted[i].end()) << "a duplicate in list " << i;
+    ASSERT_FALSE(std::binary_search(sorted[i].begin(), sorted[i].end(), static_cast<std::uint32_t>(i)));
+  }
+  EXPECT_EQ(entries, l.entry_count());
+  const double reach = kH + t.skin() + 3 * t.trigger();
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    for (const std::uint32_t j : exact.of(i))
+      ASSERT_TRUE(std::binary_search(sorted[i].begin(), sorted[i].end(), j)) << "pair " << i << "-" << j << " missed";
+    for (const std::uint32_t j : sorted[i]) {
+      ASSERT_TRUE(std::binary_search(sorted[j].begin(), sorted[j].end(), static_cast<std::uint32_t>(i)))
+          << "lists not symmetric: " << i << " lists " << j;
+      ASSERT_LT(std::sqrt(norm2(ps.position[i] - ps.position[j])), reach) << "a pair far beyond the lists' reach";
+    }
+  }
+}
+
+TEST(Tracked, FirstUpdateListsThePairsWithinHPlusSkin) {
+  auto ps = random_particles<3>(2500, 1.0, 1);
+  TrackedNeighbors<3, double> t(kH, kSkin, 200, 1e-3, false);
+  t.update(ps);
+  const NeighborLists wide = brute_force_lists<3, double>(ps.position, kH + kSkin);
+  EXPECT_EQ(t.counters().lists_rebuilt, ps.size());
+  ASSERT_EQ(t.lists().entry_count(), wide.entry_count());
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    std::vector<std::uint32_t> a(t.lists().of(i).begin(), t.lists().of(i).end());
+    std::vector<std::uint32_t> b(wide.of(i).begin(), wide.of(i).end());
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    ASSERT_EQ(a, b);
+    EXPECT_GE(t.lists().capacity(i), t.lists().of(i).size() + 4);  // room of its own
+  }
+  EXPECT_EQ(t.counters().skin, kSkin);
+  EXPECT_TRUE(t.pair_exit_flags().empty());
+}
+
+TEST(Tracked, RebuildsOnlyTheParticlesThatMovedAThirdOfTheSkin) {
+  auto ps = random_particles<3>(2000, 1.0, 2);
+  TrackedNeighbors<3, double> t(kH, kSkin, 200, 1e-3, false);
+  t.update(ps);
+  ps.position[10] += V3{0.9 * t.trigger(), 0, 0};  // under the trigger: kept
+  t.update(ps);
+  EXPECT_EQ(t.counters().lists_rebuilt, 0u);
+  ps.position[10] += V3{0.2 * t.trigger(), 0, 0};  // 1.1 triggers from its build: rebuilt
+  ps.position[20] += V3{0, -1.5 * t.trigger(), 0};
+  t.update(ps);
+  EXPECT_EQ(t.counters().lists_rebuilt, 2u);
+  expect_exact(t, ps, "after two rebuilds");
+  t.update(ps);  // their builds moved with them: nothing to rebuild
+  EXPECT_EQ(t.counters().lists_rebuilt, 0u);
+}
+
+// The proof's worst case: two particles closing head-on, each just under the trigger per step
+// (so that each is rebuilt every other step), through a resting lattice.
+TEST(Tracked, TwoParticlesApproachingHeadOnAreNeverMissed) {
+  ParticleSet<3, double> ps;
+  for (int a = 0; a < 12; ++a)
+    for (int b = 0; b < 12; ++b)
+      for (int c = 0; c < 12; ++c) ps.add(V3{0.05 * a, 0.05 * b, 0.05 * c} + V3::filled(0.0123), V3{}, 1.0);
+  const std::size_t p = ps.size(), q = p + 1;
+  ps.add(V3{0.03, 0.301, 0.302}, V3{}, 1.0);
+  ps.add(V3{0.58, 0.302, 0.301}, V3{}, 1.0);
+  TrackedNeighbors<3, double> t(kH, kSkin, 1000, 1e-3, false);
+  t.update(ps);
+  const double step = 0.999 * t.trigger();
+  bool met = false;
+  for (int s = 0; s < 400 && ps.position[p][0] < 0.58; ++s) {
+    ps.position[p] += V3{step, 0, 0};
+    ps.position[q] -= V3{step, 0, 0};
+    t.update(ps);
+    met = met || norm2(ps.position[p] - ps.position[q]) < kH * kH;
+    expect_exact(t, ps, "step " + std::to_string(s));
+    if (HasFatalFailure()) return;
+    EXPECT_LE(t.counters().lists_rebuilt, 2u);  // only the two movers
+  }
+  EXPECT_TRUE(met);
+}
+
+// A fast particle crossing a resting cluster, several triggers per step, and random jumps of
+// other particles: every step's lists are exact.
+TEST(Tracked, AParticleCrossingAClusterAndRandomJumpsAreNeverMissed) {
+  auto ps = random_particles<3>(1500, 0.5, 3);
+  const std::size_t fast = ps.size();
+  ps.add(V3{-0.1, 0.25, 0.25}, V3{}, 1.0);
+  TrackedNeighbors<3, double> t(kH, kSkin, 1000, 1e-3, false);
+  t.update(ps);
+  std::mt19937 rng(4);
+  std::uniform_int_distribution<std::size_t> who(0, fast - 1);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::uint64_t insertions = 0, removals = 0;
+  for (int s = 0; s < 60; ++s) {
+    ps.position[fast] += V3{0.013, 0.0005 * u(rng), 0};
+    for (int k = 0; k < 20; ++k) ps.position[who(rng)] += V3{u(rng), u(rng), u(rng)} * (0.6 * t.trigger());
+    t.update(ps);
+    insertions += t.counters().insertions;
+    removals += t.counters().removals;
+    expect_exact(t, ps, "step " + std::to_string(s));
+    if (HasFatalFailure()) return;
+    EXPECT_LT(t.counters().lists_rebuilt, 40u);
+  }
+  EXPECT_GT(insertions, 100u);  // the fast particle entered many lists and left them
+  EXPECT_GT(removals, 100u);
+}
+
+// An emitter next to a pool at rest: only the new particles are built, the pool's lists gain
+// them by insertion, and no pair is missed (2D).
+TEST(Tracked, EmissionNextToARestingPoolInsertsTheNewParticles) {
+  ParticleSet<2, double> ps;
+  for (int a = 0; a < 40; ++a)
+    for (int b = 0; b < 20; ++b) ps.add(V2{0.025 * a, 0.025 * b}, V2{}, 1.0);
+  TrackedNeighbors<2, double> t(kH, kSkin, 1000, 1e-3, false);
+  t.update(ps);
+  for (int s = 0; s < 5; ++s) {
+    const std::size_t before = ps.size();
+    for (int a = 0; a < 10; ++a) ps.add(V2{0.3 + 0.025 * a, 0.5 + 0.025 * s}, V2{}, 1.0);
+    t.update(ps);
+    EXPECT_EQ(t.counters().lists_rebuilt, ps.size() - before);
+    EXPECT_GT(t.counters().insertions, 0u);
+    expect_exact(t, ps, "emission " + std::to_string(s));
+  }
+}
+
+// A resting particle that many others crowd into: its list outgrows its room, its chunk is laid
+// out again, and the lists stay exact.
+TEST(Tracked, AListThatOutgrowsItsRoomIsLaidOutAgain) {
+  ParticleSet<2, double> ps;
+  ps.add(V2{0.5, 0.5}, V2{}, 1.0);
+  for (int k = 0; k < 60; ++k)
+    ps.add(V2{0.5 + 0.3 * std::cos(k * 0.1047), 0.5 + 0.3 * std::sin(k * 0.1047)}, V2{}, 1.0);
+  TrackedNeighbors<2, double> t(kH, kSkin, 1000, 1e-3, false);
+  t.update(ps);
+  ASSERT_EQ(t.lists().of(0).size(), 0u);
+  std::uint64_t overflows = 0;
+  for (int s = 0; s < 12; ++s) {
+    for (std::size_t k = 1; k < ps.size(); ++k) ps.position[k] = V2{0.5, 0.5} + (ps.position[k] - V2{0.5, 0.5}) * 0.85;
+    t.update(ps);
+    overflows += t.counters().overflows;
+    expect_exact(t, ps, "squeeze " + std::to_string(s));
+  }
+  EXPECT_GT(overflows, 0u);
+  EXPECT_EQ(t.lists().of(0).size(), ps.size() - 1);
+}
+
+std::vector<NeighborCounters> run_sequence(TrackedNeighbors<3, double>& t, ParticleSet<3, double>& ps, int from,
+                                           int to) {
+  std::vector<NeighborCounters> out;
+  for (int s = from; s < to; ++s) {
+    std::mt19937 rng(100 + static_cast<unsigned>(s));
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (auto& x : ps.position) x += V3{u(rng), u(rng), u(rng)} * (0.25 * t.trigger());
+    if (s % 7 == 3)
+      for (int k = 0; k < 30; ++k) ps.add(V3{0.4 + 0.01 * k, 0.5, 0.5}, V3{}, 1.0);
+    if (!t.pair_exit_flags().empty())
+      for (std::size_t i = static_cast<std::size_t>(s); i < t.pair_exit_flags().size(); i += 97)
+        t.pair_exit_flags()[i] = 1;  // the solver's Eq. 7 flags, of the particles the last update saw
+    t.update(ps);
+    out.push_back(t.counters());
+  }
+  return out;
+}
+
+bool same_counts(const std::vector<NeighborCounters>& a, const std::vector<NeighborCounters>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t k = 0; k < a.size(); ++k)
+    if (a[k].lists_rebuilt != b[k].lists_rebuilt || a[k].pairs_stored != b[k].pairs_stored ||
+        a[k].insertions != b[k].insertions || a[k].removals != b[k].removals || a[k].overflows != b[k].overflows ||
+        a[k].entries_rebuilt != b[k].entries_rebuilt)
+      return false;
+  return true;
+}
+
+TEST(Tracked, SameListsInTheSameOrderForAnyThreadCount) {
+  ThreadCount keep;
+  for (const bool exit_test : {false, true}) {
+    SCOPED_TRACE(exit_test ? "adaptive_exact" : "tracked");
+    auto ps1 = random_particles<3>(5000, 1.0, 5);
+    auto ps3 = ps1;
+    TrackedNeighbors<3, double> one(kH, kSkin, 25, 1e-3, exit_test), three(kH, kSkin, 25, 1e-3, exit_test);
+    set_num_threads(1);
+    const auto c1 = run_sequence(one, ps1, 0, 40);
+    set_num_threads(3);
+    const auto c3 = run_sequence(three, ps3, 0, 40);
+    EXPECT_TRUE(one.lists() == three.lists());
+    EXPECT_TRUE(same_counts(c1, c3));
+    expect_exact(three, ps3, "after 40 steps");
+  }
+}
+
+TEST(Tracked, SavedAndLoadedStateContinuesIdentically) {
+  for (const bool exit_test : {false, true}) {
+    SCOPED_TRACE(exit_test ? "adaptive_exact" : "tracked");
+    auto ps = random_particles<3>(3000, 1.0, 6);
+    TrackedNeighbors<3, double> a(kH, 0, 25, 1e-3, exit_test);
+    run_sequence(a, ps, 0, 20);
+    std::stringstream buf;
+    StateWriter w(buf);
+    a.save_state(w);
+    TrackedNeighbors<3, double> b(kH, 0, 25, 1e-3, exit_test);
+    StateReader r(buf, 1u << 30, "a test");
+    b.load_state(r, ps.size());
+    auto ps_b = ps;
+    const auto ca = run_sequence(a, ps, 20, 45);
+    const auto cb = run_sequence(b, ps_b, 20, 45);
+    EXPECT_TRUE(a.lists() == b.lists());
+    EXPECT_TRUE(same_counts(ca, cb));
+    EXPECT_EQ(a.skin(), b.skin());
+  }
+}
+
+TEST(AdaptiveExact, Eq7FlagsRebuildTheFlaggedParticles) {
+  auto ps = random_particles<3>(2000, 1.0, 7);
+  TrackedNeighbors<3, double> t(kH, kSkin, 200, 1e-3, true);
+  t.update(ps);
+  ASSERT_EQ(t.pair_exit_flags().size(), ps.size());
+  EXPECT_EQ(t.pair_exit_radius(), kH + kSkin);
+  t.pair_exit_flags()[5] = 1;
+  t.pair_exit_flags()[700] = 1;
+  t.update(ps);
+  EXPECT_EQ(t.counters().lists_rebuilt, 2u);
+  EXPECT_TRUE(std::all_of(t.pair_exit_flags().begin(), t.pair_exit_flags().end(), [](auto f) { return f == 0; }));
+  expect_exact(t, ps, "after the flagged rebuilds");
+}
+
+TEST(TrackedSkin, GrowsWithTheSpeedAndStaysWithinItsBounds) {
+  const double h = 0.04, dt = 4e-4;
+  EXPECT_EQ(tracked_skin(h, 0.0, dt, 3), 0.02 * h);
+  EXPECT_EQ(tracked_skin(h, 1e6, dt, 3), 0.5 * h);
+  double last = 0;
+  for (const double v : {0.1, 0.3, 1.0, 3.0}) {
+    const double s = tracked_skin(h, v, dt, 3);
+    EXPECT_GT(s, last);
+    EXPECT_GE(s, 0.02 * h);
+    EXPECT_LE(s, 0.5 * h);
+    last = s;
+  }
+  EXPECT_GT(tracked_skin(h, 1.0, dt, 2), tracked_skin(h, 1.0, dt, 3));
+}
+
+}  // namespace
+}  // namespace sph

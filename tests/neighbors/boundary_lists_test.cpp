@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <random>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -13,6 +14,7 @@
 #include <sph/neighbors/adaptive.h>
 #include <sph/neighbors/audit.h>
 #include <sph/neighbors/standard.h>
+#include <sph/neighbors/tracked.h>
 #include <sph/neighbors/verlet.h>
 
 namespace sph {
@@ -113,8 +115,8 @@ TEST(BoundaryLists, EveryStrategyListsThePairsWithinH) {
   const auto samples = wall_samples<double>();
   auto ps = random_particles<double>(3000, 0.0, 1.0, 11);
   const NeighborLists exact = brute_force_query_lists<3, double>(ps.position, samples, kH);
-  for (NeighborMode mode :
-       {NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet, NeighborMode::BruteForce}) {
+  for (NeighborMode mode : {NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet, NeighborMode::Tracked,
+                            NeighborMode::AdaptiveExact, NeighborMode::BruteForce}) {
     NeighborOptions opt;
     opt.radius = kH;
     auto s = make_neighbor_strategy<3, double>(mode, opt);
@@ -125,7 +127,7 @@ TEST(BoundaryLists, EveryStrategyListsThePairsWithinH) {
     ListAuditor<3, double> auditor;
     const ListAudit a = auditor.audit_boundary(ps.position, samples, s->boundary_lists(), kH);
     EXPECT_EQ(a.missed_pairs, 0u) << to_string(mode);
-    if (mode != NeighborMode::Verlet) {
+    if (mode == NeighborMode::Standard || mode == NeighborMode::Adaptive || mode == NeighborMode::BruteForce) {
       expect_equal_lists<double>(s->boundary_lists(), exact);
     } else {  // h + skin: a superset
       EXPECT_GT(s->boundary_lists().entry_count(), exact.entry_count());
@@ -146,6 +148,31 @@ TEST(BoundaryLists, VerletNeverMissesWhileParticlesMoveWithinTheSkin) {
     v.update(ps);
     ASSERT_EQ(auditor.audit_boundary(ps.position, samples, v.boundary_lists(), kH).missed_pairs, 0u) << step;
   }
+}
+
+// The tracked modes rebuild a particle's boundary list with its fluid list (after it moved a
+// third of the skin) and index the samples again when a full rebuild chooses another skin.
+TEST(BoundaryLists, TrackedNeverMissesWhileParticlesMoveAndTheSkinChanges) {
+  const auto samples = wall_samples<double>();
+  auto ps = random_particles<double>(2000, 0.0, 1.0, 14);
+  TrackedNeighbors<3, double> t(kH, 0, 10, 0.1, false);  // automatic skin, full rebuild every 10
+  t.set_boundary(samples);
+  ListAuditor<3, double> auditor;
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> u(-0.004, 0.004);
+  std::set<double> skins;
+  for (int step = 0; step < 40; ++step) {
+    for (std::size_t i = 0; i < ps.size(); ++i) {
+      const V3 dx{{u(rng), u(rng), u(rng)}};
+      ps.position[i] += dx;
+      ps.velocity[i] = dx * (1.0 + step);  // faster and faster: a larger automatic skin
+    }
+    t.update(ps);
+    skins.insert(t.skin());
+    ASSERT_EQ(auditor.audit_boundary(ps.position, samples, t.boundary_lists(), kH).missed_pairs, 0u) << step;
+    ASSERT_EQ(t.boundary_lists().particle_count(), ps.size());
+  }
+  EXPECT_GE(skins.size(), 3u) << "the skin was chosen again at the full rebuilds";
 }
 
 TEST(BoundaryLists, AdaptiveRebuildsAFlaggedParticlesBoundaryListAndTheAuditSeesTheRest) {

@@ -45,6 +45,11 @@ void TrackedNeighbors<D, R>::choose_skin(const ParticleSet<D, R>& particles) {
   const double mean = n > 0 ? sum / static_cast<double>(n) : 0.0;
   const R skin = static_cast<R>(tracked_skin(radius_, mean, dt_, D));
   if (skin == skin_) return;
+  set_skin(skin);
+}
+
+template <int D, std::floating_point R>
+void TrackedNeighbors<D, R>::set_skin(R skin) {
   skin_ = skin;
   // The samples' grid is indexed for the lists' radius.
   samples_copy_.assign(this->boundary_.samples().begin(), this->boundary_.samples().end());
@@ -220,11 +225,7 @@ void TrackedNeighbors<D, R>::load_state(StateReader& in, std::size_t particles) 
   R skin = 0;
   in.get(skin);
   in.expect(skin > R(0) && (fixed_skin_ <= R(0) || skin == fixed_skin_), "tracked neighbor state has another skin");
-  if (skin != skin_) {
-    skin_ = skin;
-    samples_copy_.assign(this->boundary_.samples().begin(), this->boundary_.samples().end());
-    if (!samples_copy_.empty()) this->boundary_.set_samples(samples_copy_, radius_ + skin_);
-  }
+  if (skin != skin_) set_skin(skin);
   in.get(flags_);
   in.get(built_at_);
   lists_.load(in);

@@ -67,6 +67,7 @@ class TrackedNeighbors final : public NeighborStrategy<D, R> {
   R list_radius() const override { return radius_ + skin_; }
   void full_build(const ParticleSet<D, R>& particles);
   void choose_skin(const ParticleSet<D, R>& particles);
+  void set_skin(R skin);  // and indexes the boundary samples for the new radius
   void apply_changes();
 
   R radius_, fixed_skin_, skin_, dt_;

@@ -55,6 +55,9 @@ TEST(NeighborModeTable, ListsDerivedFromTheTable) {
                                        NeighborMode::Tracked, NeighborMode::AdaptiveExact}));
   EXPECT_EQ(neighbor_modes(NeighborModeSet::All).size(), std::size(kNeighborModes));
   EXPECT_FALSE(neighbor_mode_info(NeighborMode::BruteForce).compared) << "the oracle is too slow to time";
+  for (const NeighborModeInfo& info : kNeighborModes)  // the modes that read Configuration.trackedSkin
+    EXPECT_EQ(info.tracked, info.mode == NeighborMode::Tracked || info.mode == NeighborMode::AdaptiveExact)
+        << info.name;
   EXPECT_EQ(join_neighbor_mode_names(NeighborModeSet::Compared, ",", ","),
             "standard,adaptive,verlet,tracked,adaptive_exact");
   EXPECT_EQ(join_neighbor_mode_names(NeighborModeSet::Compared, ", ", " or "),

@@ -41,17 +41,7 @@ void AdaptiveNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
       this->boundary_.rebuild_some(particles.position, flags_);
     }
   }
-  if (full) {
-    counters_.entries_rebuilt = lists_.entry_count();
-  } else if (flagged > 0) {
-    chunk_entries_.assign(chunk_count(n), 0);
-    parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
-      std::uint64_t m = 0;
-      for (std::size_t i = b; i < e; ++i) m += flags_[i] != 0 ? lists_.of(i).size() : 0;
-      chunk_entries_[c] = m;
-    });
-    for (std::uint64_t m : chunk_entries_) counters_.entries_rebuilt += m;
-  }
+  if (full || flagged > 0) counters_.entries_rebuilt = builder_.entries_written();
   std::fill(flags_.begin(), flags_.end(), std::uint8_t{0});  // rebuilt lists start clean
   counters_.lists_seconds = watch.lap();
   counters_.lists_rebuilt = flagged;

@@ -44,7 +44,6 @@ class AdaptiveNeighbors final : public NeighborStrategy<D, R> {
   std::int64_t updates_ = 0;
   bool invalid_ = false;
   std::vector<std::uint8_t> flags_;
-  std::vector<std::uint64_t> chunk_entries_;
   UniformGrid<D, R> grid_;
   ListBuilder<D, R> builder_;
   NeighborLists lists_;

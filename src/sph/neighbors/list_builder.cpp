@@ -227,6 +227,7 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
   });
   out.entries_ = 0;
   for (std::size_t c = 0; c < chunks; ++c) out.entries_ += chunk_entries_[c];
+  written_ = out.entries_;
 }
 
 template <int D, std::floating_point R>
@@ -245,6 +246,7 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
   lists.end_.resize(n);
   if (room_) lists.cap_.resize(n);
   chunk_entries_.resize(chunks);
+  chunk_written_.assign(chunks, 0);
 
   // Each thread copies a chunk's old lists aside before merging. The copy buffers are grown
   // here, before the loop, to the largest old chunk: their size depends only on the lists, not
@@ -284,13 +286,14 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
     std::vector<std::uint32_t>& old_copy = old_copy_[static_cast<std::size_t>(thread_index())];
     std::copy_n(buf.data(), old_size, old_copy.data());
     Stencil<D, R> st;
-    std::size_t at = 0, entries = 0;
+    std::size_t at = 0, entries = 0, written = 0;
     for (std::size_t i = b; i < e; ++i) {
       std::uint32_t len = 0, cap = 0;
       if (marked(i)) {
         st.update(grid, query.cell(i));
         ensure_room(buf, at + st.candidates + kRoom);
         len = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at);
+        written += len;
         cap = room_ ? list_capacity(len) : len;
         ensure_room(buf, at + cap + kRoom);
       } else {
@@ -309,9 +312,11 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
     }
     std::fill_n(buf.data() + at, kRoom, 0u);  // readable padding, valid indices
     chunk_entries_[c] = entries;
+    chunk_written_[c] = written;
   });
   lists.entries_ = 0;
-  for (std::size_t c = 0; c < chunks; ++c) lists.entries_ += chunk_entries_[c];
+  written_ = 0;
+  for (std::size_t c = 0; c < chunks; ++c) lists.entries_ += chunk_entries_[c], written_ += chunk_written_[c];
 }
 
 template <int D, std::floating_point R>
@@ -329,12 +334,14 @@ void ListBuilder<D, R>::rebuild_in_place(const UniformGrid<D, R>& grid, std::siz
   lists.end_.resize(n);
   lists.cap_.resize(n);
   chunk_delta_.assign(chunks, 0);
+  chunk_written_.assign(chunks, 0);
   old_copy_.resize(static_cast<std::size_t>(num_threads()));
   relayout_copy_.resize(old_copy_.size());
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     std::vector<std::uint32_t>& buf = lists.chunks_[c];
     std::vector<std::uint32_t>& scratch = old_copy_[static_cast<std::size_t>(thread_index())];
     std::int64_t delta = 0;
+    std::size_t written = 0;
     Stencil<D, R> st;
     for (std::size_t i = b; i < e; ++i) {
       if (rebuild[i] == 0 && i < old_n) continue;
@@ -350,11 +357,13 @@ void ListBuilder<D, R>::rebuild_in_place(const UniformGrid<D, R>& grid, std::siz
         lists.end_[i] = static_cast<std::uint32_t>(at + len);
         lists.cap_[i] = cap;
         delta += len;
+        written += len;
         if (visitor) visitor->rebuilt(c, i, {}, {buf.data() + at, len});
         continue;
       }
       ensure_room(scratch, st.candidates + kRoom);
       const std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, scratch.data());
+      written += len;
       if (len > lists.cap_[i]) {
         const std::uint32_t want = list_capacity(len);
         lists.relayout_chunk(c, relayout_copy_[static_cast<std::size_t>(thread_index())],
@@ -367,9 +376,11 @@ void ListBuilder<D, R>::rebuild_in_place(const UniformGrid<D, R>& grid, std::siz
       lists.end_[i] = lists.begin_[i] + len;
     }
     chunk_delta_[c] = delta;
+    chunk_written_[c] = written;
   });
   std::int64_t total = static_cast<std::int64_t>(lists.entries_);
-  for (std::size_t c = 0; c < chunks; ++c) total += chunk_delta_[c];
+  written_ = 0;
+  for (std::size_t c = 0; c < chunks; ++c) total += chunk_delta_[c], written_ += chunk_written_[c];
   lists.entries_ = static_cast<std::size_t>(total);
 }
 

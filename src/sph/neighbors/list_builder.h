@@ -53,6 +53,10 @@ class ListBuilder {
   /// scalar one (tests check that both give the same lists).
   void use_vector_kernel(bool on) { vector_ = on; }
 
+  /// Entries the last build() or rebuild_some() gathered: every list's for build(), the
+  /// rebuilt lists' for rebuild_some() (the kept ones are not counted).
+  std::size_t entries_written() const { return written_; }
+
   /// Lists built from now on keep room of their own (NeighborLists::capacity), list_capacity()
   /// slots for a list of that size, so that other lists' particles can be inserted (the tracked
   /// modes); rebuild_some() keeps a kept list's capacity. Off by default (compact lists).
@@ -76,6 +80,8 @@ class ListBuilder {
   bool room_ = false;
   std::vector<std::size_t> chunk_entries_;
   std::vector<std::int64_t> chunk_delta_;
+  std::vector<std::size_t> chunk_written_;
+  std::size_t written_ = 0;
   std::vector<std::vector<std::uint32_t>> old_copy_;       // rebuild_some: one per thread
   std::vector<std::vector<std::uint32_t>> relayout_copy_;  // rebuild_some in place: one per thread
 };

@@ -19,6 +19,8 @@ struct NeighborModeInfo {
   /// Run by `sph compare` and `sph bench` by default, and accepted by them. The brute-force
   /// oracle of the tests (O(N^2)) is not: it is too slow to time.
   bool compared;
+  /// Keeps tracked lists (TrackedNeighbors: h + Configuration.trackedSkin, rebuilt per particle).
+  bool tracked = false;
 };
 
 /// Every mode, in the enum's order.
@@ -32,11 +34,11 @@ inline constexpr NeighborModeInfo kNeighborModes[] = {
     {NeighborMode::Tracked, "tracked",
      "exact per-particle lists of radius h + skin: a list is rebuilt once its particle moved a third of the skin, "
      "and inserted into its new neighbors' lists (docs/neighbor-modes.md)",
-     true},
+     true, true},
     {NeighborMode::AdaptiveExact, "adaptive_exact",
      "the paper's Eq. 7 test on tracked lists (a pair predicted to leave h + skin flags both): Algorithm 2 without "
      "missed pairs",
-     true},
+     true, true},
     {NeighborMode::BruteForce, "brute_force", "compares every pair, O(N^2): the tests' oracle, for tiny scenes", false},
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
@@ -71,7 +72,7 @@ void TrackedNeighbors<D, R>::full_build(const ParticleSet<D, R>& particles) {
   changes_.resize(chunk_count(particles.size()));
   for (auto& c : changes_) c.reserve(2 * kChunkSize);
   counters_.lists_rebuilt = particles.size();
-  counters_.entries_rebuilt = lists_.entry_count();
+  counters_.entries_rebuilt = builder_.entries_written();
 }
 
 template <int D, std::floating_point R>
@@ -84,7 +85,7 @@ void TrackedNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
   invalid_ = false;
   ++updates_;
   counters_ = {};
-  flags_.resize(n, 0);
+  if (exit_test_) flags_.resize(n, 0);
   if (full) {
     full_build(particles);
   } else {
@@ -119,7 +120,6 @@ void TrackedNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
       built_at_.resize(n);
       changes_.resize(chunks);
       for (std::size_t c = 0; c < chunks; ++c) changes_[c].clear();
-      rebuilt_entries_.assign(chunks, 0);
       stamps_.resize(static_cast<std::size_t>(num_threads()));
       next_stamp_.resize(stamps_.size(), 0);
       for (std::size_t t = 0; t < stamps_.size(); ++t) {
@@ -127,7 +127,9 @@ void TrackedNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
           stamps_[t].reserve(particles.position.capacity());
           stamps_[t].resize(n, 0);
         }
-        if (next_stamp_[t] > 0xfffffff0u) {  // about to wrap: start again from clean stamps
+        // An update gives each thread at most two stamps per particle; if that could wrap, start
+        // again from clean stamps (an old stamp equal to a new one would hide a change).
+        if (next_stamp_[t] > std::numeric_limits<std::uint32_t>::max() - 2 * n - 2) {
           std::fill(stamps_[t].begin(), stamps_[t].end(), 0u);
           next_stamp_[t] = 0;
         }
@@ -139,7 +141,6 @@ void TrackedNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
         void rebuilt(std::size_t c, std::size_t i, std::span<const std::uint32_t> before,
                      std::span<const std::uint32_t> after) override {
           self.built_at_[i] = ps.position[i];
-          self.rebuilt_entries_[c] += after.size();
           std::vector<Change>& out = self.changes_[c];
           const auto me = static_cast<std::uint32_t>(i);
           const std::uint8_t* marks = self.marks_.data();
@@ -162,7 +163,7 @@ void TrackedNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
       } diff(*this, particles);
       builder_.rebuild_some(grid_, particles.position, r, marks_, lists_, &diff);
       this->boundary_.rebuild_some(particles.position, marks_);
-      for (std::uint64_t x : rebuilt_entries_) counters_.entries_rebuilt += x;
+      counters_.entries_rebuilt = builder_.entries_written();
       // 3. Applied in chunk order: the same lists for any thread count.
       apply_changes();
       counters_.entries_rebuilt += counters_.insertions;

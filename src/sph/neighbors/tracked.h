@@ -82,7 +82,6 @@ class TrackedNeighbors final : public NeighborStrategy<D, R> {
   std::vector<std::vector<std::uint32_t>> stamps_;  // per thread: one stamp per particle
   std::vector<std::uint32_t> next_stamp_;           // per thread: the last stamp given
   std::vector<std::uint32_t> chunk_counts_;
-  std::vector<std::uint64_t> rebuilt_entries_;
   std::vector<R> chunk_speed_;
   std::vector<std::uint32_t> relayout_scratch_;
   std::vector<Vec<D, R>> samples_copy_;

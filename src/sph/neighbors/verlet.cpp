@@ -49,7 +49,7 @@ void VerletNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
     built_at_.assign(particles.position.begin(), particles.position.end());
     max_disp_ = 0;
     counters_.lists_rebuilt = n;
-    counters_.entries_rebuilt = lists_.entry_count();
+    counters_.entries_rebuilt = builder_.entries_written();
   }
   counters_.skin = static_cast<double>(skin_);
   counters_.lists_seconds = watch.lap();

@@ -85,7 +85,7 @@ double estimated_bytes_of(const SceneBody<D>& body, std::size_t real_bytes) {
   if (p.neighbors == NeighborMode::Verlet)
     radius += p.verlet_skin > 0 ? p.verlet_skin : kDefaultSkinFraction * p.kernel_radius;
   // The tracked modes: their largest skin (automatic: at most h / 2), and the room of each list.
-  const bool tracked = p.neighbors == NeighborMode::Tracked || p.neighbors == NeighborMode::AdaptiveExact;
+  const bool tracked = neighbor_mode_info(p.neighbors).tracked;
   if (tracked) radius += p.tracked_skin > 0 ? p.tracked_skin : 0.5 * p.kernel_radius;
   // Lattice neighbors within the list radius: the area or volume of its ball over dx^D.
   const double q = radius / (2.0 * p.particle_radius);

@@ -151,20 +151,19 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
   sim.tracked_skin = c.positive(
       "trackedSkin", "a tracked skin in metres, or 0 for the automatic one (the default, chosen at each full rebuild)",
       0.0, true);
-  if ((sim.neighbors == NeighborMode::Tracked || sim.neighbors == NeighborMode::AdaptiveExact) &&
-      sim.tracked_skin > 2.0 * sim.kernel_radius)
-    c.ctx().fail(c.child("trackedSkin"),
-                 fmt::format("a skin of {:g} m is more than twice h = {:g} m: lists would hold over 27 times the "
-                             "pairs needed in 3D; expected 0 (automatic) or a skin of at most 2 h = {:g} m (typical: "
-                             "0.02 h to 0.5 h)",
-                             sim.tracked_skin, sim.kernel_radius, 2.0 * sim.kernel_radius));
-  // Only the verlet mode uses the skin; in the other modes it is read (positive) and has no effect.
-  if (sim.neighbors == NeighborMode::Verlet && sim.verlet_skin > 2.0 * sim.kernel_radius)
-    c.ctx().fail(c.child("verletSkin"),
-                 fmt::format("a skin of {:g} m is more than twice h = {:g} m: lists would hold over 27 times the "
-                             "pairs needed in 3D; expected a skin above 0 and at most 2 h = {:g} m (typical: 0.05 h "
-                             "to 0.5 h)",
-                             sim.verlet_skin, sim.kernel_radius, 2.0 * sim.kernel_radius));
+  // Each skin is read (and checked for its sign) in every mode; its own modes also refuse a skin
+  // over 2 h.
+  const auto refuse_huge_skin = [&](const char* key, double skin, const char* expected, const char* typical) {
+    if (skin > 2.0 * sim.kernel_radius)
+      c.ctx().fail(c.child(key), fmt::format("a skin of {:g} m is more than twice h = {:g} m: lists would hold over 27 "
+                                             "times the pairs needed in 3D; expected {} at most 2 h = {:g} m "
+                                             "(typical: {})",
+                                             skin, sim.kernel_radius, expected, 2.0 * sim.kernel_radius, typical));
+  };
+  if (neighbor_mode_info(sim.neighbors).tracked)
+    refuse_huge_skin("trackedSkin", sim.tracked_skin, "0 (automatic) or a skin of", "0.02 h to 0.5 h");
+  if (sim.neighbors == NeighborMode::Verlet)
+    refuse_huge_skin("verletSkin", sim.verlet_skin, "a skin above 0 and", "0.05 h to 0.5 h");
 }
 
 /// Configuration.numberOfSteps or stopAt (an end time, turned into steps of dt), and the output

@@ -100,7 +100,7 @@ py::dict run_scene(const Scene& scene, const std::string& output, const py::obje
     py::gil_scoped_release release;
     use_threads(n_threads);
     dispatch(desc, [&]<int D, class R>() {
-      RunDriver<D, R> driver(desc, RunSettings{dir, checkpoint_every, strict});
+      RunDriver<D, R> driver(desc, RunSettings{dir, checkpoint_every, strict, {}});
       RunCallbacks callbacks;
       std::int64_t shown = 0;
       callbacks.progress = [&](std::int64_t done, std::size_t particles) {

@@ -8,6 +8,9 @@ packages=(
   nlohmann-json3-dev libcli11-dev libfmt-dev libomp-dev
   libgtest-dev libgmock-dev libpng-dev
   python3 python3-vtk9 python3-numpy
+  # Surfaces (sph surface): OpenVDB's level sets (its CMake module needs Boost.Iostreams), and
+  # its Python module, with which the tests read the .vdb files back.
+  libopenvdb-dev libboost-iostreams-dev python3-openvdb
   # The Python module (python/: pybind11 and the Python headers), its tests (pytest) and the
   # examples' plots (matplotlib).
   python3-dev python3-pybind11 pybind11-dev python3-pytest python3-matplotlib

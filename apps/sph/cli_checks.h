@@ -2,10 +2,16 @@
 // Checks of command-line values shared by the subcommands, with messages that say what is
 // expected in words (CLI11's own range checks print the limits of a double: 310 digits).
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <exception>
 #include <filesystem>
+#include <sstream>
 #include <string>
+#include <vector>
 
+#include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
 #include <sph/core/error.h>
@@ -35,6 +41,40 @@ inline void check_output_path(const std::string& path, const std::string& flag) 
   if (!ec && p.relative_path().empty())
     throw Error("\"" + path + "\" is the root of the file system; expected a directory of its own, e.g. -o out/my_run",
                 flag);
+}
+
+/// The frame indices a command works on (sph render, sph surface): "all", "first", "last", or a comma list of indices
+/// (negative ones count from the end: -1 is the last).
+inline std::vector<std::size_t> parse_frames(const std::string& s, std::size_t count) {
+  std::vector<std::size_t> out;
+  if (s == "all") {
+    for (std::size_t k = 0; k < count; ++k) out.push_back(k);
+    return out;
+  }
+  std::stringstream ss(s == "first" ? std::string("0") : s == "last" ? std::string("-1") : s);
+  for (std::string item; std::getline(ss, item, ',');) {
+    long long k = 0;
+    std::size_t used = 0;
+    try {
+      k = std::stoll(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size())
+      throw Error(fmt::format("\"{}\" is not a frame list; expected all, first, last or frame numbers separated by "
+                              "commas (negative ones count from the end), e.g. 0,50,-1",
+                              s),
+                  "--frames");
+    const long long n = static_cast<long long>(count);
+    if (k < -n || k >= n)
+      throw Error(
+          fmt::format("frame {} does not exist: the run has frames 0 to {} (or -{} to -1 from the end)", k, n - 1, n),
+          "--frames");
+    out.push_back(static_cast<std::size_t>(k < 0 ? n + k : k));
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
 }
 
 }  // namespace sph::app

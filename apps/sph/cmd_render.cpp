@@ -74,40 +74,6 @@ std::pair<double, double> parse_range(const std::string& s) {
   return {lo, hi};
 }
 
-/// The frame indices to render: "all", "first", "last", or a comma list of indices (negative
-/// ones count from the end: -1 is the last).
-std::vector<std::size_t> parse_frames(const std::string& s, std::size_t count) {
-  std::vector<std::size_t> out;
-  if (s == "all") {
-    for (std::size_t k = 0; k < count; ++k) out.push_back(k);
-    return out;
-  }
-  std::stringstream ss(s == "first" ? std::string("0") : s == "last" ? std::string("-1") : s);
-  for (std::string item; std::getline(ss, item, ',');) {
-    long long k = 0;
-    std::size_t used = 0;
-    try {
-      k = std::stoll(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size())
-      throw Error(fmt::format("\"{}\" is not a frame list; expected all, first, last or frame numbers separated by "
-                              "commas (negative ones count from the end), e.g. 0,50,-1",
-                              s),
-                  "--frames");
-    const long long n = static_cast<long long>(count);
-    if (k < -n || k >= n)
-      throw Error(
-          fmt::format("frame {} does not exist: the run has frames 0 to {} (or -{} to -1 from the end)", k, n - 1, n),
-          "--frames");
-    out.push_back(static_cast<std::size_t>(k < 0 ? n + k : k));
-  }
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
-}
-
 /// Creates `dir` if needed, checks that it is writable and removes the images and movie of an
 /// earlier render (only the files a render makes: is_render_output), so that two renders are
 /// never mixed and a user's other files there are kept.

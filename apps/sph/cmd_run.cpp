@@ -23,6 +23,7 @@
 #include <sph/scene/builders.h>
 #include <sph/scene/dispatch.h>
 #include <sph/scene/scene_reader.h>
+#include <sph/surface/mesh_files.h>
 
 #include "cli_checks.h"
 #include "commands.h"
@@ -44,6 +45,9 @@ struct RunOptions {
   bool overwrite = false;
   bool strict = false;
   std::int64_t checkpoint_every = 0;
+  bool surface = false;  // --surface: DIR/surface/ per frame
+  std::string surface_format = "all";
+  double surface_resolution = 2, surface_smoothing = 2;
   std::string resume;
   std::optional<std::string> formats;  // --format vtu,ply
   std::optional<std::string> fields;   // --fields velocity,density or none
@@ -185,7 +189,16 @@ void print_done(const RunDriver<D, R>& run, const RunResult& result, bool audit)
 template <int D, std::floating_point R>
 int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesystem::path& dir,
               CheckpointReader* checkpoint) {
-  const RunSettings settings{dir, opt.checkpoint_every, opt.strict};
+  RunSettings settings{dir, opt.checkpoint_every, opt.strict, {}};
+  if (opt.surface) {
+    SurfaceOutput surface;
+    surface.formats = parse_surface_formats(opt.surface_format, "--surface-format");
+    if (D == 2 && !surface.formats.ply && !surface.formats.obj)
+      throw Error("a 2D run's surfaces are polylines, which have no level set; choose ply or obj", "--surface-format");
+    surface.settings.resolution = opt.surface_resolution;
+    surface.settings.smoothing = opt.surface_smoothing;
+    settings.surface = surface;
+  }
   std::optional<RunDriver<D, R>> run;
   if (checkpoint)
     run.emplace(desc, *checkpoint, settings);
@@ -334,6 +347,17 @@ std::function<int()> add_run_command(CLI::App& app) {
   cmd->add_flag("--strict", opt->strict,
                 "Health warnings (particles outside the container, Mach above 0.3, density 30 % above rest, energy "
                 "growing; docs/reliability.md) fail the run: exit 1, status \"failed: ... (--strict)\"");
+  cmd->add_flag("--surface", opt->surface,
+                "Also mesh the free surface of every frame: DIR/surface/surface_NNNNNN.ply, .obj and (3D) .vdb, as "
+                "sph surface does (docs/visualization.md)");
+  cmd->add_option("--surface-format", opt->surface_format, "With --surface: all, or a comma list of ply, obj and vdb")
+      ->default_str("all");
+  cmd->add_option("--surface-resolution", opt->surface_resolution,
+                  "With --surface: voxels per particle spacing, 0.5 to 8")
+      ->default_str("2");
+  cmd->add_option("--surface-smoothing", opt->surface_smoothing,
+                  "With --surface: kernel radius in particle spacings, 1 to 4")
+      ->default_str("2");
   cmd->add_option("--checkpoint-every", opt->checkpoint_every,
                   "Write DIR/checkpoint.sphc every N steps and at the last step (the latest replaces the "
                   "previous, atomically). Ctrl-C or SIGTERM always writes one: the run finishes its step, "

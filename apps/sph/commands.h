@@ -23,6 +23,8 @@ std::function<int()> add_bench_command(CLI::App& app);
 std::function<int()> add_validate_command(CLI::App& app);
 /// Adds `sph render`.
 std::function<int()> add_render_command(CLI::App& app);
+/// Adds `sph surface`.
+std::function<int()> add_surface_command(CLI::App& app);
 /// Adds `sph view`.
 std::function<int()> add_view_command(CLI::App& app);
 

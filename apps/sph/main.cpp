@@ -75,6 +75,8 @@ int main(int argc, char** argv) {
       "                     validate against experiment and physics: report, plots, CSVs (exit 1 on a miss)\n"
       "  sph render DIR [--color-by speed|kinetic_energy|density|pressure|initial_position] [--mp4]\n"
       "                     PNG images (and an MP4) of a run's frames; a comparison's runs side by side\n"
+      "  sph surface DIR [--frames all] [--resolution 2] [--smoothing 2] [--format ply,obj,vdb]\n"
+      "                     free-surface meshes (PLY, OBJ) and OpenVDB level sets of a run's frames\n"
       "  sph view DIR [-o FILE.html] [--max-frames N] [--color-by LIST]\n"
       "                     one HTML page that plays the run in 3D in a browser, offline\n\n"
       "Example: sph run scenes/paper/dam_break_2d.json -o out/dam_break_2d\n"
@@ -90,6 +92,7 @@ int main(int argc, char** argv) {
   std::function<int()> validate_cmd = add_validate_command(app);
   std::function<int()> render_cmd = add_render_command(app);
   std::function<int()> view_cmd = add_view_command(app);
+  std::function<int()> surface_cmd = add_surface_command(app);
 
   try {
     app.parse(argc, argv);
@@ -108,8 +111,8 @@ int main(int argc, char** argv) {
     // Point at the help of the subcommand the user typed, if any.
     std::string sub = "run";
     for (int i = 1; i < argc; ++i)
-      if (const std::string a = argv[i];
-          a == "run" || a == "compare" || a == "bench" || a == "validate" || a == "render" || a == "view") {
+      if (const std::string a = argv[i]; a == "run" || a == "compare" || a == "bench" || a == "validate" ||
+                                         a == "render" || a == "view" || a == "surface") {
         sub = a;
         break;
       }
@@ -122,6 +125,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("validate")) return validate_cmd();
     if (app.got_subcommand("render")) return render_cmd();
     if (app.got_subcommand("view")) return view_cmd();
+    if (app.got_subcommand("surface")) return surface_cmd();
     return app.got_subcommand("compare") ? compare_cmd() : run_cmd();
   } catch (const sph::Error& e) {
     fmt::print(stderr, "sph: error: {}\n", e.what());

@@ -26,20 +26,31 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// "frame_NNNNNN.EXT" -> NNNNNN (6 digits or more), or nullopt.
-std::optional<std::uint64_t> frame_number(const std::string& name, const std::string& ext) {
-  if (name.rfind("frame_", 0) != 0 || name.size() < 6 + 6 + 1 + ext.size()) return std::nullopt;
+/// "PREFIXNNNNNN.EXT" -> NNNNNN (6 to 12 digits), or nullopt.
+std::optional<std::uint64_t> numbered_file(const std::string& name, const std::string& prefix, const std::string& ext) {
+  if (name.rfind(prefix, 0) != 0 || name.size() < prefix.size() + 6 + 1 + ext.size()) return std::nullopt;
   const std::string tail = "." + ext;
   if (name.compare(name.size() - tail.size(), tail.size(), tail) != 0) return std::nullopt;
-  const std::string digits = name.substr(6, name.size() - 6 - tail.size());
+  const std::string digits = name.substr(prefix.size(), name.size() - prefix.size() - tail.size());
   if (digits.size() < 6 || digits.size() > 12) return std::nullopt;
   return detail::parse_count(digits);
+}
+
+/// "frame_NNNNNN.EXT" -> NNNNNN (6 digits or more), or nullopt.
+std::optional<std::uint64_t> frame_number(const std::string& name, const std::string& ext) {
+  return numbered_file(name, "frame_", ext);
 }
 
 }  // namespace
 
 bool is_render_output(const std::string& file_name) {
   return file_name == "movie.mp4" || frame_number(file_name, "png").has_value();
+}
+
+bool is_surface_output(const std::string& file_name) {
+  for (const char* ext : {"ply", "obj", "vdb"})
+    if (numbered_file(file_name, "surface_", ext)) return true;
+  return false;
 }
 
 std::vector<fs::path> list_frames(const fs::path& dir, FrameFormat format) {

@@ -70,6 +70,10 @@ std::vector<std::filesystem::path> run_directories(const std::filesystem::path& 
 /// removes only these from DIR/render), never a user's other files.
 bool is_render_output(const std::string& file_name);
 
+/// True for the names of the files `sph surface` (and `sph run --surface`) make in their output
+/// directory: surface_NNNNNN.ply, .obj and .vdb (6 to 12 digits); the only files they replace.
+bool is_surface_output(const std::string& file_name);
+
 // --- Run identity --------------------------------------------------------------------------
 
 /// The file of a run directory that names the run that owns it (docs/reliability.md, "Run

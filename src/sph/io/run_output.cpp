@@ -53,6 +53,9 @@ void remove_pictures(const fs::path& dir) {
   for (const auto& entry : fs::directory_iterator(dir / "render", ec))
     if (is_render_output(entry.path().filename().string())) fs::remove(entry.path(), ec);
   if (fs::is_empty(dir / "render", ec)) fs::remove(dir / "render", ec);
+  for (const auto& entry : fs::directory_iterator(dir / "surface", ec))
+    if (is_surface_output(entry.path().filename().string())) fs::remove(entry.path(), ec);
+  if (fs::is_empty(dir / "surface", ec)) fs::remove(dir / "surface", ec);
 }
 
 }  // namespace

@@ -137,7 +137,8 @@ struct RunInfo {
 
 /// Creates `dir` if needed and checks that files can be created in it; removes the files a
 /// previous run left there (frames, stats, summary, run.json, and the pictures of `sph render`
-/// and `sph view`: render/frame_NNNNNN.png, render/movie.mp4, view.html). Throws sph::Error naming the path.
+/// and `sph view`: render/frame_NNNNNN.png, render/movie.mp4, view.html; the surfaces of `sph surface`
+/// and `sph run --surface`: surface/surface_NNNNNN.ply, .obj, .vdb). Throws sph::Error naming the path.
 void prepare_output_directory(const std::filesystem::path& dir);
 
 /// For a resumed run: checks that `dir` is a directory where files can be created, and

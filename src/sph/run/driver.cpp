@@ -4,6 +4,7 @@
 
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
+#include <sph/io/atomic_file.h>
 #include <sph/run/memory.h>
 #include <sph/scene/builders.h>
 
@@ -39,6 +40,12 @@ RunDriver<D, R>::RunDriver(SceneDesc desc, RunSettings settings)
       sim_(build_simulation<D, R>(desc_)),
       info_{std::string(to_string(sim_.params().neighbors)), num_threads()} {
   SPH_CHECK(settings_.checkpoint_every == 0 || !settings_.dir.empty(), "RunDriver: checkpoints need a directory");
+  SPH_CHECK(!settings_.surface || !settings_.dir.empty(), "RunDriver: surfaces need a directory");
+  if (settings_.surface) {
+    settings_.surface->settings.spacing = 2 * sim_.params().particle_radius;
+    if (const std::string e = surface_settings_error(settings_.surface->settings); !e.empty())
+      throw Error(e, "--surface");
+  }
   if (!settings_.dir.empty()) {
     prepare_output_directory(settings_.dir);
     output_ = std::make_unique<RunOutput<D, R>>(settings_.dir, desc_, info_);
@@ -63,6 +70,22 @@ RunDriver<D, R>::RunDriver(SceneDesc desc, CheckpointReader& checkpoint, RunSett
 
 template <int D, std::floating_point R>
 RunDriver<D, R>::~RunDriver() = default;
+
+template <int D, std::floating_point R>
+void RunDriver<D, R>::write_new_surface() {
+  if (!settings_.surface || !output_ || output_->frames_written() == surfaces_written_) return;
+  const std::size_t index = output_->frames_written() - 1;
+  const ParticleSet<D, R>& ps = sim_.particles();
+  std::vector<double> xyz(3 * ps.size(), 0.0);
+  parallel_for(ps.size(), [&](std::size_t i) {
+    for (int d = 0; d < D; ++d) xyz[3 * i + static_cast<std::size_t>(d)] = static_cast<double>(ps.position[i][d]);
+  });
+  const SurfaceMesh mesh = extract_surface(xyz, D, settings_.surface->settings);
+  const std::filesystem::path dir = settings_.dir / "surface";
+  make_writable_directory(dir, "the surfaces");
+  write_surface_frame(dir, index, mesh, sim_.time(), settings_.surface->formats);
+  surfaces_written_ = output_->frames_written();
+}
 
 template <int D, std::floating_point R>
 void RunDriver<D, R>::advance(std::int64_t n) {
@@ -101,6 +124,10 @@ RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver
   };
   const std::int64_t steps = desc_.steps;
   if (output_ && !resumed_) output_->begin(sim_);  // (a failure here is thrown: nothing has run)
+  if (output_) {
+    surfaces_written_ = resumed_ ? output_->frames_written() : 0;  // a resumed run's earlier frames have theirs
+    write_new_surface();
+  }
   try {
     for (std::int64_t s = sim_.steps_done(); s < steps; ++s) {
       const StepInfo& step = sim_.step();
@@ -115,7 +142,10 @@ RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver
         }
       }
       if (on_step) on_step(sim_, step);
-      if (output_) output_->after_step(sim_, step, last);
+      if (output_) {
+        output_->after_step(sim_, step, last);
+        write_new_surface();
+      }
       if (callbacks.progress) callbacks.progress(sim_.steps_done(), step.particles);
       if (callbacks.stop_requested && !last) {
         if (std::string cause = callbacks.stop_requested(sim_.steps_done()); !cause.empty()) {

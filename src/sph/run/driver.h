@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -21,6 +22,7 @@
 #include <sph/io/run_output.h>
 #include <sph/scene/scene_desc.h>
 #include <sph/solver/simulation.h>
+#include <sph/surface/mesh_files.h>
 
 namespace sph {
 
@@ -46,6 +48,10 @@ struct RunSettings {
   /// Health warnings fail the run (`sph run --strict`): the step that raises the first one ends
   /// it, status "failed: WARNING (--strict)".
   bool strict = false;
+  /// Also the free surface of every frame written (`sph run --surface`): DIR/surface/
+  /// surface_NNNNNN.ply, .obj, .vdb (sph/surface/mesh_files.h). Its spacing is taken from the
+  /// scene (2 Configuration.particleRadius). Needs `dir`.
+  std::optional<SurfaceOutput> surface;
 };
 
 /// What the caller hears during the run. Each is called between steps; any may be empty.
@@ -141,6 +147,9 @@ class RunDriver {
   std::int64_t first_step_ = 0;
   std::string resume_warning_;
   bool resumed_ = false, ran_ = false;
+  std::size_t surfaces_written_ = 0;  ///< frames whose surface is written (settings_.surface)
+  /// Writes the surface of the newest frame if it has none yet (settings_.surface).
+  void write_new_surface();
 };
 
 extern template class RunDriver<2, float>;

@@ -1,0 +1,198 @@
+#include <sph/surface/surface.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <sph/core/error.h>
+#include <sph/core/parallel.h>
+
+namespace sph {
+namespace {
+
+constexpr double kS = 0.1;  // particle spacing
+
+/// A lattice block of nx x ny x nz particles (nz = 1 in 2D, z = 0), cell-centered from `lo`.
+std::vector<double> block(int nx, int ny, int nz, double lo = 0.0) {
+  std::vector<double> p;
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x) {
+        p.push_back(lo + (x + 0.5) * kS);
+        p.push_back(lo + (y + 0.5) * kS);
+        p.push_back(nz == 1 ? 0.0 : lo + (z + 0.5) * kS);
+      }
+  return p;
+}
+
+SurfaceSettings settings() {
+  SurfaceSettings s;
+  s.spacing = kS;
+  return s;
+}
+
+/// Every undirected edge is shared by exactly two triangles, and each directed edge occurs once
+/// (the two triangles run along it in opposite directions: consistent orientation).
+void expect_closed_and_oriented(const SurfaceMesh& m) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed;
+  for (const auto& t : m.triangles) {
+    ASSERT_TRUE(t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
+    for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
+  }
+  std::size_t open = 0, doubled = 0;
+  for (const auto& [e, n] : directed) {
+    if (n != 1) ++doubled;
+    if (!directed.count({e.second, e.first})) ++open;
+  }
+  EXPECT_EQ(open, 0u) << "edges with one face";
+  EXPECT_EQ(doubled, 0u) << "directed edges used twice (inconsistent orientation or non-manifold)";
+}
+
+TEST(Surface, RestingBlockIsClosedAndEnclosesItsVolume) {
+  // A resting tank's water: its edges and corners are rounded by about a spacing, so smaller
+  // blocks lose more (a 10^3 block encloses 0.97 of its volume).
+  const auto p = block(20, 16, 12);
+  const SurfaceMesh m = extract_surface(p, 3, settings());
+  ASSERT_GT(m.triangles.size(), 100u);
+  expect_closed_and_oriented(m);
+  const double fluid = 20 * 16 * 12 * std::pow(kS, 3);
+  EXPECT_NEAR(enclosed_measure(m) / fluid, 1.0, 0.03);
+  ASSERT_EQ(m.normals.size(), m.vertices.size());
+}
+
+TEST(Surface, CalmTopHasNoParticleSizedBumps) {
+  // The top face, away from the edges: all vertices at one height within 2 % of a spacing.
+  const int n = 16;
+  const auto p = block(n, n, 6);
+  const SurfaceMesh m = extract_surface(p, 3, settings());
+  float lo = 1e9f, hi = -1e9f;
+  const double top = 6 * kS;
+  for (const auto& v : m.vertices)
+    if (v[2] > top - 0.25 * kS && v[0] > 4 * kS && v[0] < (n - 4) * kS && v[1] > 4 * kS && v[1] < (n - 4) * kS)
+      lo = std::min(lo, v[2]), hi = std::max(hi, v[2]);
+  ASSERT_LT(lo, hi + 1);  // found some
+  EXPECT_LT(hi - lo, 0.02 * kS);
+  EXPECT_NEAR(0.5 * (hi + lo), top, 0.1 * kS);  // half a spacing above the top particles' centers
+}
+
+TEST(Surface, SphereOfParticlesLiesWithinHalfASpacing) {
+  std::vector<double> p;
+  const double r = 8 * kS;
+  std::size_t n = 0;
+  for (int z = -10; z <= 10; ++z)
+    for (int y = -10; y <= 10; ++y)
+      for (int x = -10; x <= 10; ++x) {
+        const double px = x * kS, py = y * kS, pz = z * kS;
+        if (px * px + py * py + pz * pz <= r * r) p.insert(p.end(), {px, py, pz}), ++n;
+      }
+  const SurfaceMesh m = extract_surface(p, 3, settings());
+  expect_closed_and_oriented(m);
+  // The sphere the particles fill: volume N s^3.
+  const double radius = std::cbrt(3.0 * static_cast<double>(n) * std::pow(kS, 3) / (4 * std::numbers::pi));
+  double worst = 0;
+  for (const auto& v : m.vertices) worst = std::max(worst, std::abs(std::hypot(v[0], v[1], v[2]) - radius));
+  EXPECT_LT(worst, 0.5 * kS);
+  // Normals point outwards (within the lattice sphere's own facets).
+  for (std::size_t i = 0; i < m.vertices.size(); i += 97) {
+    const auto& v = m.vertices[i];
+    const auto& nn = m.normals[i];
+    EXPECT_GT(v[0] * nn[0] + v[1] * nn[1] + v[2] * nn[2], 0.7 * std::hypot(v[0], v[1], v[2]));
+  }
+}
+
+TEST(Surface, LoneDropKeepsAClosedSphereOfItsRadius) {
+  auto p = block(6, 6, 6);
+  p.insert(p.end(), {2.0, 2.0, 2.0});  // far from the block
+  const SurfaceMesh m = extract_surface(p, 3, settings());
+  expect_closed_and_oriented(m);
+  double worst = 0;
+  std::size_t near = 0;
+  for (const auto& v : m.vertices) {
+    const double d = std::hypot(v[0] - 2.0, v[1] - 2.0, v[2] - 2.0);
+    if (d < kS) worst = std::max(worst, std::abs(d - 0.4 * kS)), ++near;
+  }
+  EXPECT_GT(near, 10u);
+  EXPECT_LT(worst, 0.1 * kS);
+}
+
+TEST(Surface, TwoDimensionalBlockGivesOneCounterClockwiseLoop) {
+  const auto p = block(20, 12, 1);
+  const SurfaceMesh m = extract_surface(p, 2, settings());
+  EXPECT_TRUE(m.triangles.empty());
+  std::vector<int> in(m.vertices.size(), 0), out(m.vertices.size(), 0);
+  for (const auto& s : m.segments) ++out[s[0]], ++in[s[1]];
+  for (std::size_t v = 0; v < m.vertices.size(); ++v) EXPECT_TRUE(in[v] == 1 && out[v] == 1) << v;
+  EXPECT_NEAR(enclosed_measure(m) / (20 * 12 * kS * kS), 1.0, 0.03);
+  const auto lines = surface_polylines(m);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_EQ(lines[0].front(), lines[0].back());
+  EXPECT_EQ(lines[0].size(), m.segments.size() + 1);
+}
+
+TEST(Surface, SameBitsForAnyThreadCount) {
+  // A splashy frame: a block, a sheet and scattered drops.
+  auto p = block(14, 9, 7);
+  for (int k = 0; k < 300; ++k) {
+    const double a = 0.37 * k, b = 0.11 * k;
+    p.insert(p.end(), {2.2 + 0.6 * std::sin(a), 1.0 + 0.5 * std::cos(b), 0.4 + 0.3 * std::sin(a + b)});
+  }
+  for (int dim : {2, 3}) {
+    std::vector<SurfaceMesh> runs;
+    for (int t : {1, 2, 3}) {
+      set_num_threads(t);
+      runs.push_back(extract_surface(p, dim, settings()));
+    }
+    set_num_threads(1);
+    for (const SurfaceMesh& r : runs) {
+      EXPECT_EQ(r.vertices, runs[0].vertices);
+      EXPECT_EQ(r.normals, runs[0].normals);
+      EXPECT_EQ(r.triangles, runs[0].triangles);
+      EXPECT_EQ(r.segments, runs[0].segments);
+    }
+  }
+}
+
+TEST(Surface, FinerResolutionConvergesOnTheSameVolume) {
+  const auto p = block(16, 12, 10);
+  SurfaceSettings s = settings();
+  const double fluid = 16 * 12 * 10 * std::pow(kS, 3);
+  for (double res : {2.0, 3.0, 4.0}) {
+    s.resolution = res;
+    const SurfaceMesh m = extract_surface(p, 3, s);
+    expect_closed_and_oriented(m);
+    EXPECT_NEAR(enclosed_measure(m) / fluid, 1.0, 0.03) << "resolution " << res;
+  }
+}
+
+TEST(Surface, RefusesBadSettingsAndPositions) {
+  const auto p = block(3, 3, 3);
+  SurfaceSettings s = settings();
+  s.resolution = 0.1;
+  EXPECT_THROW(extract_surface(p, 3, s), Error);
+  s = settings();
+  s.smoothing = 9;
+  EXPECT_THROW(extract_surface(p, 3, s), Error);
+  s = settings();
+  s.spacing = 0;
+  EXPECT_THROW(extract_surface(p, 3, s), Error);
+  auto bad = p;
+  bad[4] = std::nan("");
+  EXPECT_THROW(extract_surface(bad, 3, settings()), Error);
+  auto far = p;
+  far.insert(far.end(), {1e7, 0, 0});
+  try {
+    extract_surface(far, 3, settings());
+    FAIL() << "a frame spanning 1e8 spacings was meshed";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("spacings"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(extract_surface(std::vector<double>{}, 3, settings()).triangles.empty());
+}
+
+}  // namespace
+}  // namespace sph

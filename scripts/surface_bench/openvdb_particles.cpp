@@ -27,7 +27,7 @@ struct PL {
 };
 int main(int argc, char** argv) {
   if (argc != 5) {
-    std::fstd::printf(stderr, "usage: openvdb_particles N RES RADIUS THREADS\n");
+    std::fprintf(stderr, "usage: openvdb_particles N RES RADIUS THREADS\n");
     return 2;
   }
   openvdb::initialize();

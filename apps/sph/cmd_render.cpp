@@ -45,7 +45,7 @@ struct RenderCliOptions {
   std::string size;
   std::string format;
   double azimuth = 30, elevation = 20;
-  bool mp4 = false, no_png = false, flat = false, no_progress = false;
+  bool mp4 = false, no_png = false, flat = false, surface = false, no_progress = false;
   double video_fps = 30;
   int threads = 0;
 };
@@ -119,6 +119,7 @@ int render(const RenderCliOptions& opt) {
   style.view = default_particle_view(runs[0].dimension, w, h);
   if (runs[0].dimension == 3) style.view.azimuth_deg = opt.azimuth, style.view.elevation_deg = opt.elevation;
   style.view.shaded = !opt.flat;
+  style.surface = opt.surface;
   style.color.by = *by;
   style.color.map = map.value_or(default_colormap(*by));
   if (!opt.range.empty()) {
@@ -136,10 +137,13 @@ int render(const RenderCliOptions& opt) {
   prepare_render_directory(out);
   std::unique_ptr<VideoWriter> video;
   Stopwatch wall;
-  fmt::print(stderr, "sph: render {} frame{} of {} ({}, colored by {}) -> {}\n", frames.size(),
-             frames.size() == 1 ? "" : "s", opt.dir,
+  fmt::print(stderr, "sph: render {} frame{} of {} ({}, {}) -> {}\n", frames.size(), frames.size() == 1 ? "" : "s",
+             opt.dir,
              several ? fmt::format("{} runs side by side", runs.size()) : fmt::format("{}D", runs[0].dimension),
-             opt.color_by, out.string());
+             opt.surface && runs[0].dimension == 3 ? std::string("the shaded free surface")
+             : opt.surface                         ? fmt::format("colored by {}, with the free surface", opt.color_by)
+                                                   : fmt::format("colored by {}", opt.color_by),
+             out.string());
   Progress progress(
       static_cast<std::int64_t>(frames.size()),
       opt.no_progress ? Progress::Mode::Off : (::isatty(STDERR_FILENO) ? Progress::Mode::Bar : Progress::Mode::Lines),
@@ -214,6 +218,9 @@ std::function<int()> add_render_command(CLI::App& app) {
       ->check(CLI::Range(-90.0, 90.0))
       ->default_str("20");
   cmd->add_flag("--flat", opt->flat, "Flat discs instead of shaded spheres");
+  cmd->add_flag("--surface", opt->surface,
+                "Draw the fluid's free surface (sph surface's mesh, shaded) instead of particles; 2D: the surface "
+                "lines over the particles");
   cmd->add_option("--format", opt->format,
                   "Which frames to read when the run wrote several formats: " + frame_format_list());
   cmd->add_flag("--mp4", opt->mp4, "Also encode the images as movie.mp4 in the output directory (needs ffmpeg)");

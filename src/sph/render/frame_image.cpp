@@ -1,18 +1,22 @@
 #include <sph/render/frame_image.h>
 
 #include <algorithm>
+#include <utility>
 
 #include <fmt/format.h>
 
 #include <sph/core/error.h>
 #include <sph/render/compose.h>
 #include <sph/render/font.h>
+#include <sph/surface/surface.h>
 
 namespace sph {
 
 namespace {
 
 constexpr Rgb kInk{40, 40, 40};
+/// The 2D surface lines: dark blue, apart from every colormap's particles.
+constexpr Rgb kSurfaceLine{20, 40, 120};
 
 /// `t = 0.125 s` with enough digits to tell frames apart at usual frame rates.
 std::string time_label(double t) { return fmt::format("t = {:.3f} s", t); }
@@ -71,19 +75,41 @@ Image render_frame(std::span<const RunDirectory> runs, std::span<const FrameData
     const RunDirectory& run = runs[k];
     const FrameData& frame = frames[k];
     SPH_CHECK(frame.position.size() == 3 * frame.size, "3 coordinates per particle");
-    const std::vector<Rgb> colors = particle_colors(frame, style.color, run);
-    const std::vector<double> xy = run.dimension == 2 ? xy_of(frame) : std::vector<double>();
-    const std::span<const double> xyz = run.dimension == 2 ? std::span<const double>(xy) : frame.position;
     const std::vector<SolidBox> obstacles = run_obstacles(run);
-    panels.push_back(render_particles(xyz, run.dimension, colors, run.particle_radius, run.box_lo, run.box_hi,
-                                      style.view, obstacles));
+    SurfaceMesh mesh;
+    if (style.surface) {
+      SurfaceSettings settings = style.surface_settings;
+      settings.spacing = 2 * run.particle_radius;
+      mesh = extract_surface(frame.position, run.dimension, settings);
+    }
+    if (style.surface && run.dimension == 3) {
+      panels.push_back(render_surface(mesh, run.particle_radius, run.box_lo, run.box_hi, style.view, obstacles));
+    } else {
+      const std::vector<Rgb> colors = particle_colors(frame, style.color, run);
+      const std::vector<double> xy = run.dimension == 2 ? xy_of(frame) : std::vector<double>();
+      const std::span<const double> xyz = run.dimension == 2 ? std::span<const double>(xy) : frame.position;
+      Image panel = render_particles(xyz, run.dimension, colors, run.particle_radius, run.box_lo, run.box_hi,
+                                     style.view, obstacles);
+      if (style.surface) {  // 2D: the surface lines over the particles, in the same camera
+        const ParticleCamera cam(2, run.box_lo, run.box_hi, run.particle_radius, style.view);
+        for (const auto& seg : mesh.segments) {
+          const auto& u = mesh.vertices[seg[0]];
+          const auto& v = mesh.vertices[seg[1]];
+          const auto p = cam.project({u[0], u[1], 0.0});
+          const auto q = cam.project({v[0], v[1], 0.0});
+          panel.draw_line(p[0], p[1], q[0], q[1], kSurfaceLine, 2.0);
+        }
+      }
+      panels.push_back(std::move(panel));
+    }
     // The time in a caption row above the panel, where it never covers particles or the box.
     captions.push_back(runs.size() > 1 ? fmt::format("{}, {}", run.label, time_label(frame.time))
                                        : time_label(frame.time));
   }
   Image img = hstack(panels, captions, style.view.background);
-  if (!style.legend) return img;
   const int dim = runs[0].dimension;
+  // A 3D surface shows no particle colors, so a color bar or key would describe nothing.
+  if (!style.legend || (style.surface && dim == 3)) return img;
   if (color_by_is_scalar(style.color.by))
     return add_colorbar(img, style.color.map, style.color.lo, style.color.hi, color_by_label(style.color.by, dim),
                         style.view.background);

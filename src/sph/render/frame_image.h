@@ -19,6 +19,11 @@ struct FrameStyle {
   ParticleView view;  ///< size and camera of each panel
   ColorSpec color;
   bool legend = true;  ///< a color bar for scalar quantities, a key for initial position
+  /// Draw the fluid's free surface (extract_surface, spacing 2 particleRadius of each run): in 3D
+  /// the shaded mesh instead of the particles (render_surface; no legend), in 2D the surface
+  /// lines over the particles.
+  bool surface = false;
+  SurfaceSettings surface_settings;  ///< for `surface`; its spacing is set per run
 };
 
 /// The scene's obstacles (its Obstacles, static solid boxes) as render_particles draws them, in

@@ -214,6 +214,50 @@ std::vector<Face> solid_faces(const SolidBox& box, int dim, const ParticleCamera
   return faces;
 }
 
+/// Throws sph::Error for a solid with non-finite corners or lo > hi.
+void check_solids(std::span<const SolidBox> solids, int dim) {
+  for (std::size_t k = 0; k < solids.size(); ++k)
+    for (int a = 0; a < dim; ++a)
+      if (!std::isfinite(solids[k].lo[a]) || !std::isfinite(solids[k].hi[a]) || solids[k].lo[a] > solids[k].hi[a])
+        throw Error(fmt::format("obstacle {} must have finite corners with lo <= hi (axis {}: {} .. {})", k + 1,
+                                "xyz"[a], solids[k].lo[a], solids[k].hi[a]));
+}
+
+/// A projected edge of the container box; `front` if it bounds a face turned to the camera (always in 2D).
+struct BoxEdge {
+  std::array<double, 3> p0, p1;
+  bool front;
+};
+
+/// The container box's edges: corners k and k ^ (1 << a) differ along axis a.
+std::vector<BoxEdge> box_edges(const ParticleCamera& cam, int dim, const Vec3& box_lo, const Vec3& box_hi) {
+  std::vector<BoxEdge> edges;
+  const int corners = dim == 3 ? 8 : 4;
+  auto corner = [&](int k) {
+    Vec3 p{};
+    for (int a = 0; a < dim; ++a) p[a] = (k >> a) & 1 ? box_hi[a] : box_lo[a];
+    return p;
+  };
+  for (int k = 0; k < corners; ++k)
+    for (int a = 0; a < dim; ++a) {
+      const int j = k ^ (1 << a);
+      if (j < k) continue;
+      bool front = true;  // 2D: the outline goes over the particles
+      if (dim == 3) {
+        // The edge bounds the two faces normal to the other two axes, on the corner's sides;
+        // it is in front if either face turns towards the camera.
+        front = false;
+        for (int b = 0; b < 3; ++b) {
+          if (b == a) continue;
+          const double sign = (k >> b) & 1 ? 1.0 : -1.0;
+          if (sign * cam.axes()[2][b] > 1e-9) front = true;
+        }
+      }
+      edges.push_back({cam.project(corner(k)), cam.project(corner(j)), front});
+    }
+  return edges;
+}
+
 }  // namespace
 
 ParticleView default_particle_view(int dim, int width, int height) {
@@ -284,44 +328,12 @@ Image render_particles(std::span<const double> xyz, int dim, std::span<const Rgb
   const std::size_t n = xyz.size() / static_cast<std::size_t>(dim);
   SPH_CHECK(colors.size() <= 1 || colors.size() == n, "colors must hold 0, 1 or one color per particle");
   const ParticleCamera cam(dim, box_lo, box_hi, radius, view);
-  for (std::size_t k = 0; k < solids.size(); ++k)
-    for (int a = 0; a < dim; ++a)
-      if (!std::isfinite(solids[k].lo[a]) || !std::isfinite(solids[k].hi[a]) || solids[k].lo[a] > solids[k].hi[a])
-        throw Error(fmt::format("obstacle {} must have finite corners with lo <= hi (axis {}: {} .. {})", k + 1,
-                                "xyz"[a], solids[k].lo[a], solids[k].hi[a]));
+  check_solids(solids, dim);
   Image img(view.width, view.height, view.background);
 
-  // Box edges: corners k and k ^ (1 << a) differ along axis a.
-  struct Edge {
-    std::array<double, 3> p0, p1;
-    bool front;
-  };
-  std::vector<Edge> edges;
-  const int corners = dim == 3 ? 8 : 4;
-  auto corner = [&](int k) {
-    Vec3 p{};
-    for (int a = 0; a < dim; ++a) p[a] = (k >> a) & 1 ? box_hi[a] : box_lo[a];
-    return p;
-  };
-  for (int k = 0; k < corners; ++k)
-    for (int a = 0; a < dim; ++a) {
-      const int j = k ^ (1 << a);
-      if (j < k) continue;
-      bool front = true;  // 2D: the outline goes over the particles
-      if (dim == 3) {
-        // The edge bounds the two faces normal to the other two axes, on the corner's sides;
-        // it is in front if either face turns towards the camera.
-        front = false;
-        for (int b = 0; b < 3; ++b) {
-          if (b == a) continue;
-          const double sign = (k >> b) & 1 ? 1.0 : -1.0;
-          if (sign * cam.axes()[2][b] > 1e-9) front = true;
-        }
-      }
-      edges.push_back({cam.project(corner(k)), cam.project(corner(j)), front});
-    }
+  const std::vector<BoxEdge> edges = box_edges(cam, dim, box_lo, box_hi);
   auto draw_edges = [&](bool front) {
-    for (const Edge& e : edges)
+    for (const BoxEdge& e : edges)
       if (e.front == front) img.draw_line(e.p0[0], e.p0[1], e.p1[0], e.p1[1], kBoxColor, 1.0);
   };
   draw_edges(false);
@@ -401,6 +413,129 @@ Image render_particles(std::span<const double> xyz, int dim, std::span<const Rgb
     for (const SolidBox& s : solids)
       for (const Face& f : solid_faces(s, dim, cam)) fill_face(img, f, solid_edge_width(img), nullptr, painted);
   }
+  return img;
+}
+
+namespace {
+
+constexpr Rgb kWater{70, 130, 200};
+constexpr Rgb kFloorColor{222, 222, 222};
+
+Vec3 unit(const Vec3& v) {
+  const double n = std::sqrt(dot(v, v));
+  return {v[0] / n, v[1] / n, v[2] / n};
+}
+
+/// The surface's lights in camera space (x right, y up, z towards the viewer): a key light from
+/// the upper left in front, and a weaker fill from the right so that the side turned away from
+/// the key still shows its shape instead of a flat ambient tone.
+const Vec3 kKeyLight = unit({-0.8, 1.0, 1.0});
+const Vec3 kFillLight = unit({1.0, 0.2, 0.6});
+/// Half vector of the key light and the viewing direction (+z), for the highlight.
+const Vec3 kKeyHalf = unit({kKeyLight[0], kKeyLight[1], kKeyLight[2] + 1.0});
+constexpr double kSurfaceAmbient = 0.30, kKeyDiffuse = 0.62, kFillDiffuse = 0.22, kSpecular = 0.35;
+
+/// The shaded water color for a camera-space normal.
+Rgb water_shade(Vec3 n) {
+  const double len = std::sqrt(dot(n, n));
+  if (!(len > 0)) return scaled(kWater, kSurfaceAmbient);
+  n = {n[0] / len, n[1] / len, n[2] / len};
+  const double diffuse = kSurfaceAmbient + kKeyDiffuse * std::max(0.0, dot(n, kKeyLight)) +
+                         kFillDiffuse * std::max(0.0, dot(n, kFillLight));
+  const double spec = kSpecular * std::pow(std::max(0.0, dot(n, kKeyHalf)), 48.0) * 255.0;
+  auto ch = [&](std::uint8_t c) { return static_cast<std::uint8_t>(std::clamp(c * diffuse + spec + 0.5, 0.0, 255.0)); };
+  return {ch(kWater.r), ch(kWater.g), ch(kWater.b)};
+}
+
+}  // namespace
+
+Image render_surface(const SurfaceMesh& mesh, double radius, const Vec3& box_lo, const Vec3& box_hi,
+                     const ParticleView& view, std::span<const SolidBox> solids) {
+  SPH_CHECK(mesh.dimension == 3, "render_surface draws 3D surfaces");
+  SPH_CHECK(mesh.normals.size() == mesh.vertices.size(), "one normal per vertex");
+  const ParticleCamera cam(3, box_lo, box_hi, radius, view);
+  check_solids(solids, 3);
+  Image img(view.width, view.height, view.background);
+  const std::vector<BoxEdge> edges = box_edges(cam, 3, box_lo, box_hi);
+  for (const BoxEdge& e : edges)
+    if (!e.front) img.draw_line(e.p0[0], e.p0[1], e.p1[0], e.p1[1], kBoxColor, 1.0);
+
+  std::vector<float> depth(static_cast<std::size_t>(img.width()) * img.height(), -HUGE_VALF);
+  PixelBounds painted;
+  // The floor: the box's bottom face, depth-tested like a solid's face so that the fluid on it
+  // (and the obstacles standing on it) cover it where they are nearer.
+  {
+    Face f;
+    const Vec3 corners[4] = {{box_lo[0], box_lo[1], box_lo[2]},
+                             {box_hi[0], box_lo[1], box_lo[2]},
+                             {box_hi[0], box_lo[1], box_hi[2]},
+                             {box_lo[0], box_lo[1], box_hi[2]}};
+    std::array<double, 4> w{};
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 s = cam.project(corners[k]);
+      f.q[k] = {s[0], s[1]};
+      w[k] = s[2];
+    }
+    const double ax = f.q[1][0] - f.q[0][0], ay = f.q[1][1] - f.q[0][1];
+    const double bx = f.q[3][0] - f.q[0][0], by = f.q[3][1] - f.q[0][1];
+    const double det = ax * by - ay * bx;
+    if (std::abs(det) > 1e-12) {  // edge-on at elevation 0: nothing to fill
+      f.w0 = w[0];
+      f.gx = ((w[1] - w[0]) * by - (w[3] - w[0]) * ay) / det;
+      f.gy = ((w[3] - w[0]) * ax - (w[1] - w[0]) * bx) / det;
+      f.color = kFloorColor;
+      fill_face(img, f, 0.0, &depth, painted);
+    }
+  }
+  for (const SolidBox& s : solids)
+    for (const Face& f : solid_faces(s, 3, cam)) fill_face(img, f, solid_edge_width(img), &depth, painted);
+
+  // Vertices in pixel coordinates and normals in camera space, once each.
+  const auto& axes = cam.axes();
+  std::vector<Vec3> screen(mesh.vertices.size()), normal(mesh.vertices.size());
+  std::vector<char> finite(mesh.vertices.size());
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const auto& v = mesh.vertices[i];
+    const auto& nw = mesh.normals[i];
+    finite[i] = std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+    if (!finite[i]) continue;
+    screen[i] = cam.project({v[0], v[1], v[2]});
+    const Vec3 n{nw[0], nw[1], nw[2]};
+    normal[i] = {dot(n, axes[0]), dot(n, axes[1]), dot(n, axes[2])};
+  }
+  for (const auto& t : mesh.triangles) {
+    if (!finite[t[0]] || !finite[t[1]] || !finite[t[2]]) continue;
+    const Vec3 &a = screen[t[0]], &b = screen[t[1]], &c = screen[t[2]];
+    const double area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    if (!(std::abs(area) > 1e-12)) continue;
+    const int xa = detail::floor_clamped(std::min({a[0], b[0], c[0]}), 0, img.width());
+    const int xb = detail::ceil_clamped(std::max({a[0], b[0], c[0]}), -1, img.width() - 1);
+    const int ya = detail::floor_clamped(std::min({a[1], b[1], c[1]}), 0, img.height());
+    const int yb = detail::ceil_clamped(std::max({a[1], b[1], c[1]}), -1, img.height() - 1);
+    const double inv = 1.0 / area;
+    for (int y = ya; y <= yb; ++y) {
+      const double py = y + 0.5;
+      const std::span<Rgb> row = img.row(y);
+      for (int x = xa; x <= xb; ++x) {
+        const double px = x + 0.5;
+        // Barycentric weights of a, b, c; a pixel center on a shared edge belongs to both
+        // triangles, which is harmless with the depth test (same depth, first one kept).
+        const double wa = ((b[0] - px) * (c[1] - py) - (b[1] - py) * (c[0] - px)) * inv;
+        const double wb = ((c[0] - px) * (a[1] - py) - (c[1] - py) * (a[0] - px)) * inv;
+        const double wc = 1.0 - wa - wb;
+        if (wa < 0.0 || wb < 0.0 || wc < 0.0) continue;
+        const float w = static_cast<float>(wa * a[2] + wb * b[2] + wc * c[2]);
+        float& held = depth[static_cast<std::size_t>(y) * img.width() + x];
+        if (!(w > held)) continue;
+        held = w;
+        const Vec3 &na = normal[t[0]], &nb = normal[t[1]], &nc = normal[t[2]];
+        row[x] = water_shade({wa * na[0] + wb * nb[0] + wc * nc[0], wa * na[1] + wb * nb[1] + wc * nc[1],
+                              wa * na[2] + wb * nb[2] + wc * nc[2]});
+      }
+    }
+  }
+  for (const BoxEdge& e : edges)
+    if (e.front) img.draw_line(e.p0[0], e.p0[1], e.p1[0], e.p1[1], kBoxColor, 1.0);
   return img;
 }
 

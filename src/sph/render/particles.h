@@ -7,6 +7,7 @@
 #include <span>
 
 #include <sph/render/image.h>
+#include <sph/surface/surface.h>
 
 namespace sph {
 
@@ -84,5 +85,19 @@ class ParticleCamera {
 Image render_particles(std::span<const double> xyz, int dim, std::span<const Rgb> colors, double radius,
                        const std::array<double, 3>& box_lo, const std::array<double, 3>& box_hi,
                        const ParticleView& view, std::span<const SolidBox> solids = {});
+
+/// Renders the free surface of a 3D fluid (extract_surface's mesh) seen by the same camera as
+/// render_particles with this `radius`, box and view: triangles rasterized with a per-pixel depth
+/// test, shaded per pixel from the interpolated vertex normals (Lambert, a key light from the
+/// upper left and a weaker fill light fixed in camera space, ambient, a small highlight) in a
+/// water blue. The container's bottom face is filled light gray as a floor, the box outline and
+/// the `solids` are drawn as render_particles draws them in 3D, all depth-tested against the
+/// fluid. Triangles with a non-finite vertex are skipped. Deterministic.
+///
+/// Throws sph::Error as render_particles does. Precondition: mesh.dimension is 3 and its
+/// triangles index its vertices and normals.
+Image render_surface(const SurfaceMesh& mesh, double radius, const std::array<double, 3>& box_lo,
+                     const std::array<double, 3>& box_hi, const ParticleView& view,
+                     std::span<const SolidBox> solids = {});
 
 }  // namespace sph

@@ -293,6 +293,56 @@ TEST(BoundaryForces, TheExitTestFlagsAParticleForItsBoundaryPairs) {
   EXPECT_EQ(flags[0], 0);
 }
 
+TEST(BoundaryForces, ExtrapolatedPressureAddsEachSamplesHydrostaticHead) {
+  // A particle at rest next to the floor, its pressure set by hand: with the extrapolated
+  // boundary pressure each sample b pushes with p_b = p_i + rho_i g . (x_b - x_i) instead of p_i,
+  // so the difference between the two is exactly sum_b psi_b (g . x_ib / rho_i) grad W_ib (the
+  // symmetric form's weight 1), and it points up (the samples below carry more pressure).
+  for (const KernelKind kernel : {KernelKind::Cubic, KernelKind::Paper}) {
+    SimulationParams<2> p = filled_box_params<2>(10, kernel);
+    p.fluid.pressure_force = PressureForce::Symmetric;
+    ParticleSet<2, double> ps;
+    ps.add(V2{0.05, 0.006}, V2{}, p.particle_mass);
+    const BoundarySet<2, double> b = make_boundary<2, double>(p);
+    StandardNeighbors<2, double> s(p.kernel_radius);
+    s.set_boundary(b.position);
+    s.update(ps);
+    const V2 g{0, -9.81};
+    BoundaryView<2, double> view{b.position, b.psi, &s.boundary_lists(), 0};
+    compute_density_pressure(ps, s.lists(), p.kernel_radius, p.fluid, view);
+    ps.pressure[0] = 500;
+    const WallContact<2, double> none(p.container, p.obstacles, p.particle_radius, p.walls, false);
+    compute_accelerations(ps, s.lists(), p.kernel_radius, p.fluid, V2{}, none, {}, 0.0, view);
+    const V2 mirrored = ps.acceleration[0];
+    view.extrapolate = true;
+    view.extrapolation = g;
+    compute_accelerations(ps, s.lists(), p.kernel_radius, p.fluid, V2{}, none, {}, 0.0, view);
+    const V2 extrapolated = ps.acceleration[0];
+    const SmoothingKernels<2, double> kernels(p.fluid, p.kernel_radius);
+    V2 expected{};
+    const double rho = ps.density[0];
+    ASSERT_GT(s.boundary_lists().of(0).size(), 0u);
+    for (const std::uint32_t k : s.boundary_lists().of(0)) {
+      const V2 xib = ps.position[0] - b.position[k];
+      expected += b.psi[k] * (dot(g, xib) / rho) * kernels.gradient(xib);
+    }
+    for (int d = 0; d < 2; ++d)
+      EXPECT_NEAR(extrapolated[d] - mirrored[d], expected[d], 1e-9 * std::abs(expected[1])) << d;
+    EXPECT_GT(extrapolated[1], mirrored[1]);
+    EXPECT_GT(expected[1], 0);
+    // With no pressure of its own, a particle under the lid is not pulled up: the samples above
+    // it would extrapolate to negative pressure, which is clamped like the fluid's.
+    ps.position[0] = V2{0.05, 0.094};
+    s.update(ps);
+    ps.pressure[0] = 0;
+    compute_accelerations(ps, s.lists(), p.kernel_radius, p.fluid, V2{}, none, {}, 0.0, view);
+    EXPECT_EQ(ps.acceleration[0][1], 0);
+    view.clamp = false;  // negative pressure allowed: the lid's samples pull
+    compute_accelerations(ps, s.lists(), p.kernel_radius, p.fluid, V2{}, none, {}, 0.0, view);
+    EXPECT_GT(ps.acceleration[0][1], 0);
+  }
+}
+
 TEST(ArtificialViscosity, ActsOnApproachingPairsOnlyEqualAndOpposite) {
   FluidParams fluid;
   fluid.stiffness = 100;

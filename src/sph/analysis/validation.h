@@ -223,7 +223,13 @@ struct HydrostaticRun {
   std::vector<double> time, kinetic, surface;  ///< sampled history
   std::vector<EnergyParts> energy;             ///< at the same samples
   double initial_surface = 0, settling_time = 0, surface_drift = 0, predicted_ratio = 0;
+  /// The profiles (`profile`, `whole`) are of each particle's position and pressure averaged over
+  /// the samples of the run's last tenth (`averaged_samples` of them): the tank's lowest acoustic
+  /// mode still rings, and a single frame catches it at one phase. `whole_last_frame`: the
+  /// whole tank's max bin error in the last frame alone, for comparison.
   HydrostaticProfile profile;
+  int averaged_samples = 0;
+  double whole_last_frame = 0;
   /// The boundaries case: the boundary handling and kernel (scene names), the profile over the
   /// whole tank (wall_margin 0), and the most particles outside the container in any step.
   std::string boundary, kernel;

@@ -24,11 +24,14 @@ namespace sph::detail {
 inline const std::vector<std::string> kRootKeys{"version",     "name",          "description", "units",
                                                 "dimension",   "Configuration", "Fluid",       "Container",
                                                 "FluidBlocks", "Obstacles",     "Emitters"};
-inline const std::vector<std::string> kConfigurationKeys{
-    "precision",        "timeStepSize",   "numberOfSteps",     "stopAt",     "particleRadius",    "kernelRadius",
-    "gravitation",      "neighbors",      "fullRebuildPeriod", "verletSkin", "trackedSkin",       "reorderPeriod",
-    "boundaryHandling", "boundaryVolume", "boundaryFriction",  "kernel",     "outputEveryNSteps", "outputFps",
-    "outputFormats",    "outputFields",   "outputBoundary"};
+inline const std::vector<std::string> kConfigurationKeys{"precision",        "timeStepSize",   "numberOfSteps",
+                                                         "stopAt",           "particleRadius", "kernelRadius",
+                                                         "gravitation",      "neighbors",      "fullRebuildPeriod",
+                                                         "verletSkin",       "trackedSkin",    "reorderPeriod",
+                                                         "boundaryHandling", "boundaryVolume", "boundaryPressure",
+                                                         "boundaryFriction", "kernel",         "outputEveryNSteps",
+                                                         "outputFps",        "outputFormats",  "outputFields",
+                                                         "outputBoundary"};
 inline const std::vector<std::string> kFluidKeys{
     "density0",         "stiffness",     "viscosity",          "viscosityModel", "artificialViscosityAlpha",
     "negativePressure", "pressureForce", "gradientCorrection", "particleMass"};
@@ -64,6 +67,8 @@ inline constexpr Named<BoundaryHandling> kBoundaryHandlingNames[] = {{BoundaryHa
                                                                      {BoundaryHandling::Particles, "particles"}};
 inline constexpr Named<BoundaryVolume> kBoundaryVolumeNames[] = {{BoundaryVolume::RestFluid, "rest_fluid"},
                                                                  {BoundaryVolume::Akinci, "akinci"}};
+inline constexpr Named<BoundaryPressure> kBoundaryPressureNames[] = {{BoundaryPressure::Extrapolate, "extrapolate"},
+                                                                     {BoundaryPressure::Mirror, "mirror"}};
 inline constexpr Named<KernelKind> kKernelNames[] = {
     {KernelKind::Paper, "paper"}, {KernelKind::Cubic, "cubic"}, {KernelKind::Wendland, "wendland"}};
 inline constexpr Named<ViscosityModel> kViscosityModelNames[] = {{ViscosityModel::Paper, "paper"},

@@ -142,6 +142,9 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
                   c.choice("boundaryHandling", names_of(detail::kBoundaryHandlingNames), kDefaultBoundaryHandling));
   sim.boundary.volume = value_named(detail::kBoundaryVolumeNames,
                                     c.choice("boundaryVolume", names_of(detail::kBoundaryVolumeNames), "rest_fluid"));
+  sim.boundary.pressure =
+      value_named(detail::kBoundaryPressureNames,
+                  c.choice("boundaryPressure", names_of(detail::kBoundaryPressureNames), "extrapolate"));
   sim.boundary.friction =
       c.positive("boundaryFriction", "a boundary friction sigma >= 0 (Akinci et al. 2012; 0: free slip)",
                  sim.boundary.friction, true);

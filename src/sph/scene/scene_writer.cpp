@@ -60,6 +60,7 @@ OrderedJson configuration_json(const SceneDesc& desc, const SimulationParams<D>&
       .put("reorderPeriod", sim.reorder_period)
       .put("boundaryHandling", detail::name_of(detail::kBoundaryHandlingNames, sim.boundary.handling))
       .put("boundaryVolume", detail::name_of(detail::kBoundaryVolumeNames, sim.boundary.volume))
+      .put("boundaryPressure", detail::name_of(detail::kBoundaryPressureNames, sim.boundary.pressure))
       .put("boundaryFriction", sim.boundary.friction)
       .put("kernel", detail::name_of(detail::kKernelNames, sim.fluid.kernel))
       .put("outputEveryNSteps", out.every_steps)

@@ -105,10 +105,24 @@ enum class BoundaryVolume {
   Akinci,
 };
 
+/// The pressure a boundary sample b takes in its pair with fluid particle i.
+enum class BoundaryPressure {
+  /// p_b = p_i + rho_i g . (x_b - x_i) (clamped at 0 when negative pressure is clamped): the
+  /// fluid's pressure carried to the sample along the hydrostatic gradient, a one-neighbor form
+  /// of Adami et al. 2012's extrapolation. A resting fluid's pressure then grows with depth into
+  /// the walls as it does in the fluid, and the layers next to the floor and the walls are not
+  /// squeezed (default).
+  Extrapolate,
+  /// p_b = p_i (Akinci et al. 2012's mirroring): the sample below a resting particle has the
+  /// particle's pressure, less than the fluid's at its depth.
+  Mirror,
+};
+
 /// Boundary particles' settings.
 struct BoundaryParams {
   BoundaryHandling handling = BoundaryHandling::Penalty;
   BoundaryVolume volume = BoundaryVolume::RestFluid;
+  BoundaryPressure pressure = BoundaryPressure::Extrapolate;
   /// Akinci et al. 2012's boundary viscosity sigma: nu = sigma h c0 / (2 rho_i) on approaching
   /// fluid-boundary pairs (0: free slip). It is also what damps sound waves at the walls
   /// (boundary particles reflect them): below about 0.2 a resting tank keeps ringing

@@ -337,6 +337,13 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
       // Akinci's friction, nu = sigma h c0 / (2 rho_i).
       const R pii = kForm == PressureForce::Paper ? prs[i] * inv_rhoi * inv_rhoi : R(2) * prs[i] * inv_rhoi * inv_rhoi;
       const P pii_v = P::set1(kPressure ? pii : R(0));
+      // Extrapolated: P_ib = w (p_i + p_b) / rho_i^2 with w = 1/2 (paper's form) or 1, and
+      // p_b / rho_i^2 = p_i / rho_i^2 - (a . x_ib) / rho_i, clamped at 0 like p.
+      const bool extrapolate = kPressure && boundary.extrapolate;
+      const R w = kForm == PressureForce::Paper ? R(0.5) : R(1);
+      const P w_v = P::set1(w), pi_sym_b = P::set1(prs[i] * inv_rhoi * inv_rhoi);
+      P ext_v[D];
+      for (int d = 0; d < D; ++d) ext_v[d] = P::set1(boundary.extrapolation[d] * inv_rhoi);
       const P nu_i = P::set1(fc.friction * h * fc.c0 * R(0.5) * inv_rhoi);
       const auto bnb = boundary.lists->of(i);
       const std::uint32_t* bidx = bnb.data();
@@ -351,7 +358,14 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
         P vr = zero;
         for (int d = 0; d < D; ++d) vr = vr + vi[d] * rib[d];
         const P pi_ib = minus_one * nu_i * select(vr < zero, vr, zero) / (r2 + eps_h2);
-        const P fb = minus_one * psib * (pii_v + pi_ib) * f;
+        P pterm = pii_v;
+        if (extrapolate) {
+          P ax = zero;
+          for (int d = 0; d < D; ++d) ax = ax + ext_v[d] * rib[d];
+          const P pb = pi_sym_b - ax;
+          pterm = w_v * (pi_sym_b + (boundary.clamp ? select(pb > zero, pb, zero) : pb));
+        }
+        const P fb = minus_one * psib * (pterm + pi_ib) * f;
         P q2 = zero;
         for (int d = 0; d < D; ++d) {
           acc[d] = acc[d] + rib[d] * fb;
@@ -421,7 +435,7 @@ std::vector<R> gradient_corrections(const ParticleSet<D, R>& ps, const NeighborL
 
 /// Adds the pressure accelerations with corrected gradients: each pair's term of the plain
 /// force (in its form) with grad W_ij replaced by (L_i + L_j) / 2 grad W_ij; a boundary sample's
-/// (pressure mirrored) by L_i grad W_ib.
+/// (its pressure extrapolated or mirrored, as in the force pass) by L_i grad W_ib.
 template <int D, std::floating_point R>
 void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                              const BoundaryView<D, R>& boundary) {
@@ -448,12 +462,20 @@ void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, 
     }
     if (solid) {
       const R pii = (paper ? R(1) : R(2)) * ps.pressure[i] * inv_rhoi * inv_rhoi;
+      const R w = paper ? R(0.5) : R(1), pi_sym = ps.pressure[i] * inv_rhoi * inv_rhoi;
       for (const std::uint32_t b : boundary.lists->of(i)) {
-        const Vec<D, R> g = kernels.gradient(ps.position[i] - boundary.position[b]);
+        const Vec<D, R> xib = ps.position[i] - boundary.position[b];
+        const Vec<D, R> g = kernels.gradient(xib);
+        R pib = pii;
+        if (boundary.extrapolate) {
+          R pb = pi_sym - dot(boundary.extrapolation, xib) * inv_rhoi;
+          if (boundary.clamp) pb = std::max(pb, R(0));
+          pib = w * (pi_sym + pb);
+        }
         for (int r = 0; r < D; ++r) {
           R gc = 0;
           for (int c = 0; c < D; ++c) gc += li[r * D + c] * g[c];
-          acc[r] -= boundary.psi[b] * pii * gc;
+          acc[r] -= boundary.psi[b] * pib * gc;
         }
       }
     }

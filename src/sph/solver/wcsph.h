@@ -20,6 +20,12 @@ struct BoundaryView {
   std::span<const R> psi;
   const NeighborLists* lists = nullptr;
   R friction = 0;
+  /// BoundaryPressure::Extrapolate: the acceleration along which a sample's pressure is carried
+  /// from the fluid particle's, p_b = p_i - rho_i extrapolation . (x_i - x_b) (gravity, for walls
+  /// at rest), and whether p_b is clamped at 0. Mirror: `extrapolate` false, p_b = p_i.
+  bool extrapolate = false;
+  bool clamp = true;
+  Vec<D, R> extrapolation{};
   bool active() const { return lists != nullptr && lists->particle_count() > 0 && !position.empty(); }
 };
 
@@ -113,8 +119,10 @@ class WallContact {
 /// al. 1997's, 2 mu m_j / (rho_i rho_j) (x_ij . grad W_ij) / (|x_ij|^2 + 0.01 h^2) (v_i - v_j).
 /// ViscosityModel::Artificial replaces Eq. 6 by Monaghan's -m_j Pi_ij grad W_ij (params.h).
 ///
-/// Boundary samples b (Akinci et al. 2012): the pressure term of the pair with the pressure
-/// mirrored (p_b = p_i, rho_b = rho_i, psi_b for m_j: -psi_b P_ii grad W_ib), and the boundary
+/// Boundary samples b (Akinci et al. 2012): the pressure term of the pair with rho_b = rho_i and
+/// p_b the fluid's pressure extrapolated to the sample (BoundaryView::extrapolate:
+/// p_b = p_i + rho_i g . (x_b - x_i)) or mirrored (p_b = p_i), psi_b for m_j:
+/// -psi_b P_ib grad W_ib), and the boundary
 /// friction -psi_b Pi_ib grad W_ib with Pi_ib = -nu min(v_i . x_ib, 0) / (|x_ib|^2 + 0.01 h^2),
 /// nu = sigma h c0 / (2 rho_i). The Eq. 7 test covers fluid-boundary pairs (the samples do not
 /// move: |x_i - x_b + dt u_i| > h flags i).

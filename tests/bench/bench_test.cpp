@@ -180,6 +180,22 @@ TEST_F(SmallSuites, StepsResultsHaveTimingsThroughputAndMemory) {
     EXPECT_GT(r["ns_per_particle_step"].get<double>(), 0);
     // A lattice block: the first lists hold the ~30 neighbors within h = 2 dx (verlet more).
     EXPECT_GT(r["neighbors_per_particle"].get<double>(), 15);
+    // The pair loops' figures: standard's lists hold exactly the pairs within h when the passes
+    // run; verlet's skin (0.1 h) adds the lattice's shell at 2 dx = h (26 of 32 entries within h
+    // in the interior, more at the block's faces, 0.90 measured); both passes' visits per
+    // core-second follow from the visits and the two phases' times.
+    const double visits = r["pair_visits_per_particle"].get<double>();
+    const double within = r["within_h_fraction"].get<double>();
+    if (r["mode"] == "standard") {
+      EXPECT_EQ(within, 1.0);
+      EXPECT_NEAR(visits, r["neighbors_per_particle"].get<double>(), 0.5);
+    } else {
+      EXPECT_GT(within, 0.7);
+      EXPECT_LT(within, 0.95);
+    }
+    const double pass_s = 1e-3 * (r["ms_per_step"]["density"].get<double>() + r["ms_per_step"]["forces"].get<double>());
+    EXPECT_NEAR(r["pair_visits_per_core_second"].get<double>() * pass_s / r["threads"].get<double>(),
+                2 * visits * r["particles"].get<double>(), 1e-6 * visits * r["particles"].get<double>());
     const json& mem = r["memory"];
     EXPECT_GT(mem["peak_rss_bytes"].get<std::int64_t>(), 0);
     EXPECT_GT(mem["baseline_rss_bytes"].get<std::int64_t>(), 0);

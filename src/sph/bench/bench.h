@@ -100,10 +100,18 @@ struct StepsRow {
   double ns_per_particle_step = 0;          ///< the scaling figure: wall ns per particle and step
   double lists_rebuilt_per_step = 0;        ///< mean over the timed steps
   double neighbors_per_particle = 0;        ///< entries stored / particles after the last step
-  std::int64_t baseline_rss_bytes = -1;     ///< VmRSS before the simulation was built
-  std::int64_t peak_rss_bytes = -1;         ///< VmHWM after the run
-  bool peak_reset = false;                  ///< the peak counter was reset before the build
-  double bytes_per_particle = 0;            ///< (peak - baseline) / particles
+  /// Where the pair loops stand against the machine (docs/performance.md, "The pair loops against
+  /// the machine"): the list entries (fluid and boundary) each of the two pair passes (density,
+  /// forces) visits per particle and step, the share of the fluid entries closer than h (1 for
+  /// lists of exactly the pairs within h; less with a skin), and the pair visits both passes
+  /// achieve per second of their own time and per thread.
+  double pair_visits_per_particle = 0;
+  double within_h_fraction = 0;
+  double pair_visits_per_core_second = 0;
+  std::int64_t baseline_rss_bytes = -1;  ///< VmRSS before the simulation was built
+  std::int64_t peak_rss_bytes = -1;      ///< VmHWM after the run
+  bool peak_reset = false;               ///< the peak counter was reset before the build
+  double bytes_per_particle = 0;         ///< (peak - baseline) / particles
   double heap_bytes_per_particle =
       -1;  ///< malloc'd bytes held by the simulation after the run / particles (-1: unknown)
 };

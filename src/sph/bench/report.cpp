@@ -36,21 +36,22 @@ std::string neighbors_table_row(const NeighborsRow& r) {
 
 std::string steps_table_header() {
   return fmt::format(
-      "{:>8} {:<9} {:<6} {:>4} {:>6} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>17} {:>10} {:>9} {:>9} {:>8} {:>7}",
+      "{:>8} {:<9} {:<6} {:>4} {:>6} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>17} {:>10} {:>9} {:>9} {:>8} {:>7} "
+      "{:>8} {:>6} {:>10}",
       "N", "mode", "prec", "thr", "steps", "grid", "lists", "density", "forces", "integr", "total", "wall",
-      "[min .. max]", "Mpart-st/s", "ns/pt-st", "rebuilt/st", "peak MB", "B/part");
+      "[min .. max]", "Mpart-st/s", "ns/pt-st", "rebuilt/st", "peak MB", "B/part", "visits/p", "<h", "Mvisit/c-s");
 }
 
 std::string steps_table_row(const StepsRow& r) {
   return fmt::format(
       "{:>8} {:<9} {:<6} {:>4} {:>6} {:>8.3f} {:>8.3f} {:>8.3f} {:>8.3f} {:>8.3f} {:>8.3f} {:>8.3f} {:>17} {:>10.3f} "
-      "{:>9.1f} {:>9.0f} {:>8.1f} {:>7.0f}",
+      "{:>9.1f} {:>9.0f} {:>8.1f} {:>7.0f} {:>8.1f} {:>6.3f} {:>10.1f}",
       r.particles, to_string(r.mode), precision_name(r.precision), threads_cell(r.threads, r.oversubscribed),
       r.timed_steps, r.ms_per_step.grid, r.ms_per_step.lists, r.ms_per_step.density, r.ms_per_step.forces,
       r.ms_per_step.integrate, r.ms_per_step.total(), r.wall_ms_per_step,
       fmt::format("[{:.3f} .. {:.3f}]", r.wall_ms_min, r.wall_ms_max), 1e-6 * r.particle_steps_per_second,
       r.ns_per_particle_step, r.lists_rebuilt_per_step, mb(r.peak_rss_bytes - r.baseline_rss_bytes),
-      r.bytes_per_particle);
+      r.bytes_per_particle, r.pair_visits_per_particle, r.within_h_fraction, 1e-6 * r.pair_visits_per_core_second);
 }
 
 std::string scaling_table(const std::vector<StepsRow>& rows) {
@@ -206,6 +207,9 @@ json steps_json(const BenchResult& r) {
                        {"ns_per_particle_step", x.ns_per_particle_step},
                        {"lists_rebuilt_per_step", x.lists_rebuilt_per_step},
                        {"neighbors_per_particle", x.neighbors_per_particle},
+                       {"pair_visits_per_particle", x.pair_visits_per_particle},
+                       {"within_h_fraction", x.within_h_fraction},
+                       {"pair_visits_per_core_second", x.pair_visits_per_core_second},
                        {"memory",
                         {{"baseline_rss_bytes", x.baseline_rss_bytes},
                          {"peak_rss_bytes", x.peak_rss_bytes},
@@ -284,17 +288,17 @@ std::string steps_csv(const BenchResult& r) {
       "particles,side,mode,precision,threads,oversubscribed,warmup_steps,timed_steps,ms_grid,ms_lists,ms_density,"
       "ms_forces,ms_integrate,ms_total,ms_wall,particle_steps_per_s,ns_per_particle_step,lists_rebuilt_per_step,"
       "neighbors_per_particle,baseline_rss_bytes,peak_rss_bytes,bytes_per_particle,heap_bytes_per_particle,runs,"
-      "ms_wall_min,ms_wall_max\n";
+      "ms_wall_min,ms_wall_max,pair_visits_per_particle,within_h_fraction,pair_visits_per_core_second\n";
   for (const StepsRow& x : r.steps)
     s += fmt::format(
         "{},{},{},{},{},{},{},{},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.1f},{:.3f},{:.1f},"
-        "{:.4f},{},{},{:.1f},{:.1f},{},{:.6f},{:.6f}\n",
+        "{:.4f},{},{},{:.1f},{:.1f},{},{:.6f},{:.6f},{:.4f},{:.6f},{:.6g}\n",
         x.particles, x.side, to_string(x.mode), precision_name(x.precision), x.threads, x.oversubscribed ? 1 : 0,
         x.warmup_steps, x.timed_steps, x.ms_per_step.grid, x.ms_per_step.lists, x.ms_per_step.density,
         x.ms_per_step.forces, x.ms_per_step.integrate, x.ms_per_step.total(), x.wall_ms_per_step,
         x.particle_steps_per_second, x.ns_per_particle_step, x.lists_rebuilt_per_step, x.neighbors_per_particle,
         x.baseline_rss_bytes, x.peak_rss_bytes, x.bytes_per_particle, x.heap_bytes_per_particle, x.runs, x.wall_ms_min,
-        x.wall_ms_max);
+        x.wall_ms_max, x.pair_visits_per_particle, x.within_h_fraction, x.pair_visits_per_core_second);
   return s;
 }
 

@@ -44,13 +44,16 @@ StepsRow run_workload(const SceneDesc& desc, int side, NeighborMode mode, int th
     SPH_CHECK(sim.particles().size() == row.particles, "the dam break block does not hold side^3 particles");
     SPH_CHECK(desc.steps == warmup + timed, "the workload's scene runs the warm-up and the timed steps");
     PhaseTimes sum;
-    std::uint64_t rebuilt = 0;
+    std::uint64_t rebuilt = 0, entries = 0, fluid_entries = 0, within = 0;
     double wall = 0;
     run.advance(warmup);
     Stopwatch watch;
     const RunResult result = run.run({}, [&](Simulation<3, R>&, const StepInfo& info) {
       sum += info.seconds;
       rebuilt += info.neighbors.lists_rebuilt;
+      fluid_entries += info.neighbors.pairs_stored;
+      entries += info.neighbors.pairs_stored + info.neighbors.boundary_pairs_stored;
+      within += info.pairs_within_h;
     });
     wall = watch.elapsed();
     if (result.status == RunStatus::Failed) throw Error(result.error);
@@ -63,6 +66,11 @@ StepsRow run_workload(const SceneDesc& desc, int side, NeighborMode mode, int th
     row.lists_rebuilt_per_step = static_cast<double>(rebuilt) / static_cast<double>(timed);
     row.neighbors_per_particle =
         static_cast<double>(sim.last_step().neighbors.pairs_stored) / static_cast<double>(row.particles);
+    // Each of the density and force passes visits every list entry once per step.
+    row.pair_visits_per_particle = static_cast<double>(entries) / particle_steps;
+    row.within_h_fraction = fluid_entries > 0 ? static_cast<double>(within) / static_cast<double>(fluid_entries) : 0;
+    const double pair_seconds = (sum.density + sum.forces) * static_cast<double>(threads);
+    row.pair_visits_per_core_second = pair_seconds > 0 ? 2.0 * static_cast<double>(entries) / pair_seconds : 0;
     const std::int64_t heap_after = heap_bytes_in_use();
     if (heap_before >= 0 && heap_after >= 0)
       row.heap_bytes_per_particle = static_cast<double>(heap_after - heap_before) / static_cast<double>(row.particles);

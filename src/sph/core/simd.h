@@ -40,6 +40,8 @@ template <>
 struct Pack<float> {
   __m512 v;
   static Pack set1(float x) { return {_mm512_set1_ps(x)}; }
+  /// Lane l = p[l] (contiguous, unaligned).
+  static Pack load(const float* p) { return {_mm512_loadu_ps(p)}; }
   /// Lane l = base[stride * idx[l] + offset].
   template <int kStride>
   static Pack gather(const float* base, const std::uint32_t* idx, int offset) {
@@ -64,6 +66,7 @@ template <>
 struct Pack<double> {
   __m512d v;
   static Pack set1(double x) { return {_mm512_set1_pd(x)}; }
+  static Pack load(const double* p) { return {_mm512_loadu_pd(p)}; }
   template <int kStride>
   static Pack gather(const double* base, const std::uint32_t* idx, int offset) {
     __m256i i = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(idx));
@@ -88,6 +91,11 @@ struct Pack {
   static Pack set1(R x) {
     Pack p;
     for (int l = 0; l < W; ++l) p.v[l] = x;
+    return p;
+  }
+  static Pack load(const R* src) {
+    Pack p;
+    std::memcpy(p.v, src, sizeof(p.v));
     return p;
   }
   template <int kStride>

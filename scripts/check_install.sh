@@ -31,7 +31,7 @@ mv "$tmp/installed" "$tmp/prefix"
 prefix=$tmp/prefix
 for f in bin/sph include/sph/core/version.h include/sph/solver/simulation.h lib/cmake/sph/sphConfig.cmake \
   lib/cmake/sph/sphConfigVersion.cmake lib/cmake/sph/sphTargets.cmake share/sph/scenes/paper/tank_fill_3d.json \
-  share/sph/scenes/validation/martin_moyce_2d.json; do
+  share/sph/scenes/validation/martin_moyce_2d.json share/sph/scenes/validation/martin_moyce_2d_particles.json; do
   [ -f "$prefix/$f" ] || fail "the install has no $f"
 done
 layers=$(sed -n 's/^ *set( *SPH_LAYERS \(.*\))/\1/p' CMakeLists.txt)

@@ -298,6 +298,32 @@ TEST_F(Cli, MissingSceneFileNamesThePath) {
   EXPECT_FALSE(fs::exists(work_ / "o"));
 }
 
+TEST_F(Cli, ValidateBoundariesNeedsTheBoundaryParticleDamBreakBeforeRunning) {
+  // The boundaries case reads martin_moyce_2d_particles.json before it runs anything: missing,
+  // or not a boundary-particle scene, it is refused with exit code 2 and no output directory.
+  const fs::path scenes = work_ / "scenes";
+  fs::create_directories(scenes);
+  for (const auto& e : fs::directory_iterator(SPH_SOURCE_DIR "/scenes/validation"))
+    if (e.path().extension() == ".json") fs::copy_file(e.path(), scenes / e.path().filename());
+  const fs::path dam = scenes / "martin_moyce_2d_particles.json";
+  const std::string text = read_file(dam);
+  fs::remove(dam);
+  Result r = sph({"validate", "--cases", "boundaries", "--scenes", "scenes", "--no-progress", "-o", "v"});
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_CONTAINS(r.err, "martin_moyce_2d_particles.json");
+  EXPECT_EQ(count(r.err, "sph: error:"), 1u) << r.err;
+  EXPECT_FALSE(fs::exists(work_ / "v"));
+
+  const std::string key = "\"boundaryHandling\": \"particles\"";
+  const std::size_t at = text.find(key);
+  ASSERT_NE(at, std::string::npos) << "the scene says boundary particles as " << key;
+  write_file(dam, std::string(text).replace(at, key.size(), "\"boundaryHandling\": \"penalty\""));
+  r = sph({"validate", "--cases", "boundaries", "--scenes", "scenes", "--no-progress", "-o", "v"});
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_CONTAINS(r.err, "must say \"boundaryHandling\": \"particles\"");
+  EXPECT_FALSE(fs::exists(work_ / "v"));
+}
+
 TEST_F(Cli, SceneThatIsADirectory) {
   fs::create_directory(work_ / "scenes");
   const Result r = sph({"run", "scenes", "-o", "o"});

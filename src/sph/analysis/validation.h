@@ -274,6 +274,10 @@ using ValidationProgress = std::function<void(const std::string&)>;
 /// unknown case or a missing or invalid scene; a run that blows up is recorded (its checks miss).
 ValidationResult run_validation(const ValidationOptions& options, const ValidationProgress& progress = {});
 
+/// Reads every scene the selected cases need (run_validation does it first too), so that an unknown
+/// case or a missing or invalid scene is refused before anything is run or written.
+void check_validation_scenes(const ValidationOptions& options);
+
 /// Files write_validation writes (relative to the output directory).
 std::vector<std::string> validation_files(const ValidationResult& result);
 

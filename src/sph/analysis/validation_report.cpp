@@ -152,11 +152,12 @@ std::string report_boundaries(const ValidationResult& res) {
       "tank | max compression | outside | settling | whole tank, last frame |\n";
   md += "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
   for (const HydrostaticRun& h : res.boundaries)
-    md +=
-        fmt::format("| {}D{} | {} | {} | {:g} | {:.1f} | {:.3f} | {:.3f} | {:.3f} | {:.2f} % | {} | {} s | {:.3f} |\n",
-                    h.dimension, h.failure.empty() ? "" : " (failed)", h.boundary, h.kernel, h.h / h.spacing, h.seconds,
-                    h.whole.mean_ratio, h.profile.max_bin_error, h.whole.max_bin_error, 100 * h.whole.max_compression,
-                    h.max_outside, g(h.settling_time), h.whole_last_frame);
+    md += fmt::format("| {}D{} | {} | {} | {:g} | {:.1f} | {:.3f} | {:.3f} | {:.3f} | {:.2f} % | {} | {} | {:.3f} |\n",
+                      h.dimension, h.failure.empty() ? "" : " (failed)", h.boundary, h.kernel, h.h / h.spacing,
+                      h.seconds, h.whole.mean_ratio, h.profile.max_bin_error, h.whole.max_bin_error,
+                      100 * h.whole.max_compression, h.max_outside,
+                      std::isfinite(h.settling_time) ? g(h.settling_time) + " s" : std::string("does not settle"),
+                      h.whole_last_frame);
   md += "\n" + checks_table(res, "boundaries");
   return md;
 }

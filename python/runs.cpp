@@ -217,6 +217,7 @@ py::dict compare_scene(const Scene& scene, const py::object& output, const py::o
     run["speedup"] = r.totals.total() > 0 ? ref / r.totals.total() : 0.0;
     run["steps"] = r.steps.size();
     run["missed_pairs"] = r.missed_pairs();
+    run["boundary_missed_pairs"] = r.boundary_missed_pairs();
     run["final_rms_divergence"] =
         k > 0 && !result.divergence[k].empty() ? py::cast(result.divergence[k].back().rms) : py::none();
     run["failure"] = r.failure;
@@ -315,8 +316,8 @@ reference, is always run); output: the report's directory (report.md, CSVs, imag
 run_frames, each mode's frames), or None for no files; frames, perturbation (of h: the chaos
 floor) and audit as the flags. progress: True, or a callable progress(label, index, count,
 steps_done, steps). Returns {"scene", "steps", "threads", "audited", "runs": [{"label", "mode",
-"perturbed", "seconds", "speedup", "steps", "missed_pairs", "final_rms_divergence",
-"failure"}], "output", "report"}.)doc");
+"perturbed", "seconds", "speedup", "steps", "missed_pairs", "boundary_missed_pairs" (fluid-boundary
+pairs, 0 without boundary particles), "final_rms_divergence", "failure"}], "output", "report"}.)doc");
   m.def("read_frame", &read_frame_dict, py::arg("path"),
         R"doc(Reads a frame file written by sph (.vtu, .vtk, .ply) into a dict of arrays: "time" (s),
 "position" (particles, 3; z = 0 in 2D, float64) and each point field the file holds, by its

@@ -113,6 +113,8 @@ int compare(const CompareCliOptions& opt) {
     if (k > 0 && !result.divergence[k].empty())
       line += fmt::format("  RMS divergence at end {:.3g} h", result.divergence[k].back().rms);
     if (co.audit) line += fmt::format("  missed pairs {}", r.missed_pairs());
+    if (co.audit && result.has_boundary_particles)
+      line += fmt::format(" (fluid-boundary {})", r.boundary_missed_pairs());
     if (!r.failure.empty()) line += "  FAILED: " + r.failure;
     fmt::print(stderr, "{}\n", line);
   }

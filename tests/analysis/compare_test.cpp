@@ -160,5 +160,38 @@ TEST_F(Compare, ModesCanBeChosenAndTheChaosRunSwitchedOff) {
   EXPECT_NE(row.find(",,\""), std::string::npos) << "missed_pairs cell should be empty: " << row;
 }
 
+TEST_F(Compare, BoundaryParticleSceneReportsFluidBoundaryMissesApart) {
+  // The small dam with boundary particles: standard and verlet miss no fluid-boundary pair;
+  // adaptive, whose Eq. 7 cannot see the floor's samples come into range as the column spreads,
+  // misses some, and the report, the console figures and the CSVs carry them apart from the
+  // fluid pairs.
+  CompareOptions opt;
+  opt.modes = {NeighborMode::Adaptive, NeighborMode::Verlet};
+  opt.perturbation = 0;
+  opt.audit = true;
+  opt.frames = 1;
+  SceneDesc desc = read_scene_file(SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json",
+                                   {"FluidBlocks[0].end=[0.2,0.4]", "Configuration.numberOfSteps=400",
+                                    "Configuration.boundaryHandling=particles", "Configuration.kernel=cubic"});
+  const CompareResult res = run_comparison(desc, opt);
+  ASSERT_TRUE(res.has_boundary_particles);
+  ASSERT_EQ(res.runs.size(), 3u);
+  for (const RunRecord& r : res.runs) ASSERT_TRUE(r.failure.empty()) << r.label << ": " << r.failure;
+  EXPECT_EQ(res.runs[0].boundary_missed_pairs(), 0u) << "standard rebuilds every boundary list";
+  EXPECT_EQ(res.runs[2].mode, NeighborMode::Verlet);
+  EXPECT_EQ(res.runs[2].boundary_missed_pairs(), 0u) << "verlet's skin covers the samples";
+  EXPECT_EQ(res.runs[1].mode, NeighborMode::Adaptive);
+  EXPECT_GT(res.runs[1].boundary_missed_pairs(), 0u) << "adaptive misses samples coming into range";
+  write_comparison(dir_, res);
+  EXPECT_NE(read_file(dir_ / "report.md").find("fluid-boundary missed pairs"), std::string::npos);
+  std::istringstream phases(read_file(dir_ / "phases.csv"));
+  std::string header, row;
+  std::getline(phases, header);
+  EXPECT_NE(header.find("missed_pairs,boundary_missed_pairs,failure"), std::string::npos) << header;
+  std::getline(phases, row);  // standard
+  std::getline(phases, row);  // adaptive
+  EXPECT_NE(row.find("," + std::to_string(res.runs[1].boundary_missed_pairs()) + ",\""), std::string::npos) << row;
+}
+
 }  // namespace
 }  // namespace sph

@@ -58,6 +58,7 @@ def test_compare(small_2d, tmp_path):
         assert run["failure"] == "" and run["steps"] == 10
     verlet = r["runs"][labels.index("verlet")]
     assert verlet["missed_pairs"] == 0  # exact lists (adaptive's approximation misses a few)
+    assert all(run["boundary_missed_pairs"] == 0 for run in r["runs"])  # penalty walls: no samples
     assert verlet["final_rms_divergence"] is not None and r["runs"][0]["final_rms_divergence"] is None
     assert os.path.isfile(r["report"])
     assert sph.compare(small_2d, modes=["verlet"], steps=5, audit=False)["output"] is None

@@ -74,6 +74,7 @@ StepRecord step_record(const StepInfo& info, double kinetic_energy) {
   r.pairs_stored = info.neighbors.pairs_stored;
   r.pairs_within_h = info.pairs_within_h;
   r.missed_pairs = info.audit.missed_pairs;
+  r.boundary_missed_pairs = info.boundary_audit.missed_pairs;
   r.max_missed_penetration = info.audit.max_penetration;
   return r;
 }
@@ -183,6 +184,7 @@ CompareResult run_all(const SceneDesc& desc, const CompareOptions& opt, const Co
     res.obstacles.push_back(s);
   }
   res.has_emitters = !p.emitters.empty();
+  res.has_boundary_particles = p.boundary.handling == BoundaryHandling::Particles;
   res.audited = opt.audit;
   res.steps = opt.steps > 0 ? opt.steps : desc.steps;
   res.image_steps = image_steps(res.steps, std::max(1, opt.frames));

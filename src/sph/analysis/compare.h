@@ -40,7 +40,8 @@ struct StepRecord {
   double seconds = 0;         ///< wall seconds of the step's phases (audit excluded)
   double kinetic_energy = 0;  ///< J (J/m in 2D)
   std::uint64_t particles = 0, lists_rebuilt = 0, pairs_stored = 0, pairs_within_h = 0;
-  std::uint64_t missed_pairs = 0;  ///< audit (0 without audit: see CompareResult::audited)
+  std::uint64_t missed_pairs = 0;           ///< audit (0 without audit: see CompareResult::audited)
+  std::uint64_t boundary_missed_pairs = 0;  ///< fluid-boundary pairs the lists missed (audit)
   double max_missed_penetration = 0;
 };
 
@@ -70,6 +71,12 @@ struct RunRecord {
     for (const StepRecord& s : steps) n += s.missed_pairs;
     return n;
   }
+  /// Fluid-boundary missed pairs summed over the steps (0 without audit or boundary particles).
+  std::uint64_t boundary_missed_pairs() const {
+    std::uint64_t n = 0;
+    for (const StepRecord& s : steps) n += s.boundary_missed_pairs;
+    return n;
+  }
 };
 
 /// Divergence of one run from the reference at one sampled step, in units of h, over the
@@ -89,7 +96,8 @@ struct CompareResult {
   std::array<double, 3> box_lo{}, box_hi{};
   std::vector<SolidBox> obstacles;  ///< the scene's obstacles, drawn in the report's pictures
   bool has_emitters = false;
-  bool audited = false;  ///< missed-pair figures exist (CompareOptions::audit)
+  bool has_boundary_particles = false;  ///< Configuration.boundaryHandling: "particles"
+  bool audited = false;                 ///< missed-pair figures exist (CompareOptions::audit)
   std::int64_t steps = 0;
   std::vector<std::int64_t> image_steps;
   std::vector<RunRecord> runs;  ///< runs[0] is the standard reference

@@ -269,10 +269,16 @@ std::string report_missed_pairs(const CompareResult& res) {
         "The audit compares each step's lists with exact lists. A missed pair is a pair closer than h that a\n"
         "particle's list lacks (counted once per list). Eq. 7 only watches listed pairs leaving the radius;\n"
         "it cannot see particles coming into range, which is what the adaptive mode misses.\n\n";
+    if (res.has_boundary_particles)
+      md +=
+          "The scene has boundary particles: the first columns count fluid pairs; the last, the fluid-boundary\n"
+          "pairs (a fluid particle and a wall or obstacle sample closer than h) missing from the boundary lists.\n\n";
     md +=
         "| run | missed pairs (all steps) | per step | as % of pairs within h | steps with misses | largest "
-        "penetration (h - r) / h |\n";
-    md += "| --- | ---: | ---: | ---: | ---: | ---: |\n";
+        "penetration (h - r) / h |";
+    md += res.has_boundary_particles ? " fluid-boundary missed pairs (all steps) |\n" : "\n";
+    md += res.has_boundary_particles ? "| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n"
+                                     : "| --- | ---: | ---: | ---: | ---: | ---: |\n";
     for (const RunRecord& r : res.runs) {
       std::uint64_t missed = 0, within = 0, steps_with = 0;
       double pen = 0;
@@ -282,10 +288,11 @@ std::string report_missed_pairs(const CompareResult& res) {
         steps_with += s.missed_pairs > 0;
         pen = std::max(pen, s.max_missed_penetration);
       }
-      md += fmt::format("| {} | {} | {:.1f} | {:.3f} % | {} | {:.3f} |\n", r.label, missed,
+      md += fmt::format("| {} | {} | {:.1f} | {:.3f} % | {} | {:.3f} |", r.label, missed,
                         static_cast<double>(missed) / static_cast<double>(std::max<std::size_t>(1, r.steps.size())),
                         within ? 100.0 * static_cast<double>(missed) / static_cast<double>(within) : 0.0, steps_with,
                         pen);
+      md += res.has_boundary_particles ? fmt::format(" {} |\n", r.boundary_missed_pairs()) : "\n";
     }
   }
   return md;
@@ -339,37 +346,41 @@ std::string timing_csv(const CompareResult& res, const std::vector<std::vector<d
 
 /// neighbors.csv: each run's list counters per step.
 std::string neighbors_csv(const CompareResult& res) {
-  return per_step_csv(
-      res, {"particles", "lists_rebuilt", "pairs_stored", "pairs_within_h", "missed_pairs", "max_missed_penetration"},
-      [&res](const RunRecord& r, std::size_t s) {
-        const StepRecord& x = r.steps[s];
-        // Without the audit the missed-pair cells are empty, not 0.
-        return std::vector<std::string>{std::to_string(x.particles),
-                                        std::to_string(x.lists_rebuilt),
-                                        std::to_string(x.pairs_stored),
-                                        std::to_string(x.pairs_within_h),
-                                        res.audited ? std::to_string(x.missed_pairs) : std::string(),
-                                        res.audited ? fmt::format("{:.6g}", x.max_missed_penetration) : std::string()};
-      });
+  return per_step_csv(res,
+                      {"particles", "lists_rebuilt", "pairs_stored", "pairs_within_h", "missed_pairs",
+                       "max_missed_penetration", "boundary_missed_pairs"},
+                      [&res](const RunRecord& r, std::size_t s) {
+                        const StepRecord& x = r.steps[s];
+                        // Without the audit the missed-pair cells are empty, not 0.
+                        return std::vector<std::string>{
+                            std::to_string(x.particles),
+                            std::to_string(x.lists_rebuilt),
+                            std::to_string(x.pairs_stored),
+                            std::to_string(x.pairs_within_h),
+                            res.audited ? std::to_string(x.missed_pairs) : std::string(),
+                            res.audited ? fmt::format("{:.6g}", x.max_missed_penetration) : std::string(),
+                            res.audited ? std::to_string(x.boundary_missed_pairs) : std::string()};
+                      });
 }
 
 /// phases.csv: one row per run with its phase totals and means.
 std::string phases_csv(const CompareResult& res) {
   std::string out =
       "run,steps,grid_s,lists_s,density_s,forces_s,integrate_s,total_s,ms_per_step,speed_vs_standard,"
-      "mean_lists_rebuilt,mean_pairs_stored,mean_pairs_within_h,missed_pairs,failure\n";
+      "mean_lists_rebuilt,mean_pairs_stored,mean_pairs_within_h,missed_pairs,boundary_missed_pairs,failure\n";
   const double ref = standard_seconds(res);
   for (const auto& r : res.runs) {
     const double t = r.totals.total();
     const std::uint64_t missed = r.missed_pairs();
     std::string failure = r.failure;
     std::replace(failure.begin(), failure.end(), '"', '\'');
-    out += fmt::format("{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{},\"{}\"\n",
-                       r.label, r.steps.size(), r.totals.grid, r.totals.lists, r.totals.density, r.totals.forces,
-                       r.totals.integrate, t, r.steps.empty() ? 0.0 : 1e3 * t / static_cast<double>(r.steps.size()),
-                       t > 0 ? ref / t : kNaN, mean_of(r.steps, &StepRecord::lists_rebuilt),
-                       mean_of(r.steps, &StepRecord::pairs_stored), mean_of(r.steps, &StepRecord::pairs_within_h),
-                       res.audited ? std::to_string(missed) : std::string(), failure);
+    out += fmt::format(
+        "{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{},{},\"{}\"\n", r.label,
+        r.steps.size(), r.totals.grid, r.totals.lists, r.totals.density, r.totals.forces, r.totals.integrate, t,
+        r.steps.empty() ? 0.0 : 1e3 * t / static_cast<double>(r.steps.size()), t > 0 ? ref / t : kNaN,
+        mean_of(r.steps, &StepRecord::lists_rebuilt), mean_of(r.steps, &StepRecord::pairs_stored),
+        mean_of(r.steps, &StepRecord::pairs_within_h), res.audited ? std::to_string(missed) : std::string(),
+        res.audited ? std::to_string(r.boundary_missed_pairs()) : std::string(), failure);
   }
   return out;
 }

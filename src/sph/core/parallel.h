@@ -36,7 +36,7 @@ inline std::size_t chunk_count(std::size_t n) { return (n + kChunkSize - 1) / kC
 /// chunk order give thread-count-independent results. Each thread takes one contiguous run of
 /// chunks (a static schedule), as parallel_for takes one contiguous run of indices: the loops of
 /// a step then hand every particle to the same core, whose cache still holds what the previous
-/// loop wrote (dealt out one chunk at a time, the 8k tank ran 1.3x slower on 2 threads:
+/// loop wrote (dealt out one chunk at a time, the paper scenes ran 1.13x slower on 2 threads:
 /// docs/performance.md, "Static chunk schedule").
 template <class F>
 void parallel_chunks(std::size_t n, F&& f) {

@@ -1,6 +1,7 @@
 // `sph run SCENE.json`: runs a scene and writes frames, stats and a summary.
 
 #include <algorithm>
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <memory>
@@ -208,16 +209,29 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesyste
   const Simulation<D, R>& sim = run->simulation();
   const RunInfo& info = run->info();
   const std::int64_t first = run->first_step();
-  fmt::print(stderr, "sph: {} ({}D, {}, {} neighbors, {} thread{}): {} particles{}, {} steps of {:.4g} s{} -> {}\n",
-             desc.name, D, std::is_same_v<R, float> ? "float" : "double", info.mode, info.threads,
-             info.threads == 1 ? "" : "s", sim.particles().size(),
-             sim.params().emitters.empty() ? "" : " (emitters add more)", desc.steps, sim.params().time_step,
+  // A run of CFL steps that ends at a time counts its progress in milliseconds of simulated time.
+  const bool by_time = desc.end_time > 0;
+  const auto sim_ms = [&] { return static_cast<std::int64_t>(std::llround(sim.time() * 1e3)); };
+  const std::int64_t first_ms = sim_ms();
+  const std::string length =
+      by_time ? fmt::format("to t = {:.6g} s in CFL steps of {:.4g} to {:.4g} s", desc.end_time,
+                            sim.params().cfl.min_dt, sim.params().cfl.max_dt)
+              : fmt::format(
+                    "{} {}steps of {:.4g} s", desc.steps, sim.params().time_stepping == TimeStepping::Cfl ? "CFL " : "",
+                    sim.params().time_stepping == TimeStepping::Cfl ? sim.params().cfl.max_dt : sim.params().time_step);
+  fmt::print(stderr, "sph: {} ({}D, {}, {} neighbors, {} thread{}): {} particles{}, {}{} -> {}\n", desc.name, D,
+             std::is_same_v<R, float> ? "float" : "double", info.mode, info.threads, info.threads == 1 ? "" : "s",
+             sim.particles().size(), sim.params().emitters.empty() ? "" : " (emitters add more)", length,
              checkpoint ? fmt::format(", resumed at step {}", first) : std::string(), dir.string());
   const Progress::Mode mode =
       opt.no_progress ? Progress::Mode::Off : (::isatty(STDERR_FILENO) ? Progress::Mode::Bar : Progress::Mode::Lines);
-  Progress progress(desc.steps - first, mode, stderr);
+  Progress progress(
+      by_time ? static_cast<std::int64_t>(std::llround(desc.end_time * 1e3)) - first_ms : desc.steps - first, mode,
+      stderr, by_time ? "ms of simulated time" : "step");
   RunCallbacks callbacks;
-  callbacks.progress = [&](std::int64_t done, std::size_t particles) { progress.update(done - first, particles); };
+  callbacks.progress = [&](std::int64_t done, std::size_t particles) {
+    progress.update(by_time ? sim_ms() - first_ms : done - first, particles);
+  };
   callbacks.warning = [&](const std::string& w) {
     fmt::print(stderr, "{}sph: warning: {}\n", mode == Progress::Mode::Bar ? "\n" : "", w);
   };

@@ -42,7 +42,8 @@ json every_key_3d() {
       "precision": "float", "timeStepSize": 1.25e-4, "numberOfSteps": 77, "particleRadius": 0.011,
       "kernelRadius": 0.0451, "gravitation": [0.1, -9.7, 0.3], "neighbors": "verlet", "fullRebuildPeriod": 7,
       "verletSkin": 0.0061, "reorderPeriod": 5, "outputEveryNSteps": 0, "outputFps": 333.3,
-      "outputFormats": ["ply", "vtk"], "outputFields": ["id", "pressure"]
+      "outputFormats": ["ply", "vtk"], "outputFields": ["id", "pressure"], "cflMethod": "cfl",
+      "cflFactor": 0.35, "cflMinTimeStepSize": 2.5e-6, "cflMaxTimeStepSize": 0.0021
     },
     "Fluid": { "density0": 998.2, "stiffness": 1234.5, "viscosity": 0.7, "negativePressure": "allow",
                "pressureForce": "variational", "gradientCorrection": "renormalize", "particleMass": 0.0011 },
@@ -114,6 +115,34 @@ TEST(SceneWriter, ASceneThatSetsEveryKeyReadsBackEqual) {
   EXPECT_NE(sim.reorder_period, sim.full_rebuild_period);
   EXPECT_EQ(d.output.fields, (std::vector<std::string>{"pressure", "id"}));
   EXPECT_EQ(sim.emitters.at(0).end_time, 0.5);
+  EXPECT_EQ(sim.time_stepping, sph::TimeStepping::Cfl);
+  EXPECT_NE(sim.cfl, defaults.cfl);
+}
+
+TEST(SceneWriter, ARunOfCflStepsToATimeWritesItsStopAt) {
+  // CFL steps and stopAt: the run ends at that time (numberOfSteps is then only the most steps
+  // the smallest step could take), so the writer gives stopAt, and frames by time by default.
+  json j = every_key_2d();
+  j["Configuration"].erase("numberOfSteps");
+  j["Configuration"].erase("outputEveryNSteps");
+  j["Configuration"].erase("outputFps");
+  j["Configuration"]["stopAt"] = 0.25;
+  j["Configuration"]["cflMethod"] = "cfl";
+  j["Configuration"]["cflMinTimeStepSize"] = 1e-5;
+  expect_round_trip(j.dump(), "cfl_stop_at.json");
+  const sph::SceneDesc d = sph::parse_scene(j.dump(), "cfl_stop_at.json");
+  EXPECT_EQ(d.end_time, 0.25);
+  EXPECT_EQ(d.steps, 25000) << "stopAt / cflMinTimeStepSize";
+  EXPECT_EQ(d.output.fps, 400.0) << "100 frames by default";
+  EXPECT_EQ(d.output.every_steps, 0);
+  const json w = json::parse(sph::scene_text(d));
+  EXPECT_EQ(w["Configuration"]["stopAt"], 0.25);
+  EXPECT_FALSE(w["Configuration"].contains("numberOfSteps"));
+  // Fixed steps: stopAt is still turned into steps, and written as numberOfSteps.
+  j["Configuration"]["cflMethod"] = "none";
+  const sph::SceneDesc fixed = sph::parse_scene(j.dump(), "fixed_stop_at.json");
+  EXPECT_EQ(fixed.end_time, 0.0);
+  EXPECT_EQ(fixed.steps, 2500);
 }
 
 TEST(SceneWriter, WritesEveryDeclaredKeyOfEveryObject) {

@@ -24,7 +24,9 @@
 
 namespace sph {
 
-/// The format version this build writes and reads. Version 7 changes no byte but the meaning of
+/// The format version this build writes and reads. Version 8 stores the simulated time and the
+/// last CFL step after the step count, and each emitter's next batch time (TimeStepping::Cfl).
+/// Version 7 changes no byte but the meaning of
 /// the scene text it carries: a boundary-particle scene without Configuration.boundaryPressure
 /// now runs with the extrapolated pressure, where version 6's ran with the mirrored one, so a
 /// version 6 checkpoint would not resume the run it saved. Version 6 stores each neighbor list's capacity
@@ -34,7 +36,7 @@ namespace sph {
 /// name and kind, in kParticleFields order, then the fields a run added (ParticleSet::save);
 /// version 2 kept the frames' times and the schedule's next tick instead of version 1's .vtu
 /// file list.
-inline constexpr std::uint32_t kCheckpointVersion = 7;
+inline constexpr std::uint32_t kCheckpointVersion = 8;
 /// The checkpoint's file name in a run's output directory.
 inline constexpr const char* kCheckpointFile = "checkpoint.sphc";
 

@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <vector>
 
 #include <sph/core/state_stream.h>
@@ -41,6 +42,11 @@ class FrameSchedule {
   /// The next frame index k of an fps schedule (state a checkpoint keeps).
   std::int64_t next_tick() const { return next_tick_; }
   void set_next_tick(std::int64_t k) { next_tick_ = k; }
+  /// The time of the next frame of an fps schedule, s (infinity without one): a run with CFL
+  /// steps ends a step on it (Simulation::set_time_barrier).
+  double next_time() const {
+    return fps_ > 0 ? static_cast<double>(next_tick_) / fps_ : std::numeric_limits<double>::infinity();
+  }
 
  private:
   std::int64_t every_;
@@ -61,6 +67,8 @@ class FrameWriter {
   void write(const Simulation<D, R>& sim);
 
   std::size_t frames_written() const { return times_.size(); }
+  /// FrameSchedule::next_time of the schedule.
+  double next_frame_time() const { return schedule_.next_time(); }
   /// The simulated time of each frame written so far.
   const std::vector<double>& times() const { return times_; }
   const OutputDesc& output() const { return output_; }

@@ -74,7 +74,7 @@ constexpr StatsColumn real_column(std::string_view name, StatsFormat format, dou
 /// the fluid-boundary pairs within h they missed (0 and empty with penalty walls). Last, the work
 /// of the step's list building: entries written by (re)builds and insertions, the tracked modes'
 /// insertions into and removals from other particles' lists and lists that outgrew their room,
-/// and the lists' skin (m; 0 in the modes without one).
+/// and the lists' skin (m; 0 in the modes without one). Last, the step's time step (s).
 inline constexpr StatsColumn kStatsColumns[] = {
     detail::count_column("step", [](const StepStats& s) { return static_cast<std::uint64_t>(s.info.step + 1); }),
     detail::real_column("time", StatsFormat::Real9, [](const StepStats& s) { return s.info.time; }),
@@ -122,6 +122,7 @@ inline constexpr StatsColumn kStatsColumns[] = {
     detail::count_column("list_removals", [](const StepStats& s) { return s.info.neighbors.removals; }),
     detail::count_column("list_overflows", [](const StepStats& s) { return s.info.neighbors.overflows; }),
     detail::real_column("skin", StatsFormat::Real6, [](const StepStats& s) { return s.info.neighbors.skin; }),
+    detail::real_column("dt", StatsFormat::Real9, [](const StepStats& s) { return s.info.dt; }),
 };
 
 /// The header line of stats.csv: the column names, comma-separated.
@@ -177,6 +178,8 @@ class RunOutput {
   void finish(const Simulation<D, R>& sim, const std::string& status, double wall_seconds);
 
   std::size_t frames_written() const { return frames_.frames_written(); }
+  /// The time of the next frame on the outputFps schedule, s (infinity without one).
+  double next_frame_time() const { return frames_.next_frame_time(); }
   /// The run's id and scene fingerprint, as run.json, summary.json and checkpoints record them.
   const RunIdentity& identity() const { return identity_; }
   /// Audit totals over the steps so far: missed pairs summed, deepest penetration (zero

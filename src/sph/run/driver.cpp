@@ -90,13 +90,31 @@ void RunDriver<D, R>::write_new_surface() {
 template <int D, std::floating_point R>
 void RunDriver<D, R>::advance(std::int64_t n) {
   SPH_CHECK(!output_ && !ran_, "RunDriver::advance: only before run() of a run that writes nothing");
-  for (std::int64_t k = 0; k < n && sim_.steps_done() < desc_.steps; ++k) sim_.step();
+  for (std::int64_t k = 0; k < n && !finished(); ++k) {
+    set_barrier();
+    sim_.step();
+  }
 }
 
 template <int D, std::floating_point R>
 const StepInfo& RunDriver<D, R>::step() {
   SPH_CHECK(!output_ && !ran_, "RunDriver::step: only for a run that writes nothing, outside run()");
+  set_barrier();
   return sim_.step();
+}
+
+template <int D, std::floating_point R>
+bool RunDriver<D, R>::finished() const {
+  // (a relative 1e-12: a time that lands on the end by a barrier is the end)
+  return sim_.steps_done() >= desc_.steps || (desc_.end_time > 0 && sim_.time() >= desc_.end_time * (1 - 1e-12));
+}
+
+template <int D, std::floating_point R>
+void RunDriver<D, R>::set_barrier() {
+  // CFL steps end on the next frame's time and on the run's end (fixed steps ignore it).
+  double barrier = desc_.end_time > 0 ? desc_.end_time : kNoLimit;
+  if (output_) barrier = std::min(barrier, output_->next_frame_time());
+  sim_.set_time_barrier(barrier);
 }
 
 template <int D, std::floating_point R>
@@ -129,9 +147,10 @@ RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver
     write_new_surface();
   }
   try {
-    for (std::int64_t s = sim_.steps_done(); s < steps; ++s) {
+    while (!finished()) {
+      set_barrier();
       const StepInfo& step = sim_.step();
-      const bool last = s + 1 == steps;
+      const bool last = finished();
       if (step.health.new_warnings != 0) {
         for (const std::string& w : new_warnings(step)) {
           if (callbacks.warning) callbacks.warning(w);
@@ -153,7 +172,10 @@ RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver
             write_checkpoint(settings_.dir, desc_, sim_, *output_, wall_.elapsed(), settings_.checkpoint_every);
           result.stop_cause = cause;
           return end(RunStatus::Interrupted,
-                     fmt::format("interrupted by {} after step {} of {}", cause, sim_.steps_done(), steps));
+                     desc_.end_time > 0
+                         ? fmt::format("interrupted by {} after step {} (t = {:.6g} s of {:.6g} s)", cause,
+                                       sim_.steps_done(), sim_.time(), desc_.end_time)
+                         : fmt::format("interrupted by {} after step {} of {}", cause, sim_.steps_done(), steps));
         }
       }
       // A resumed run also checkpoints its last step, so that its checkpoint is never behind its end.

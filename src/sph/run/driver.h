@@ -150,6 +150,10 @@ class RunDriver {
   std::size_t surfaces_written_ = 0;  ///< frames whose surface is written (settings_.surface)
   /// Writes the surface of the newest frame if it has none yet (settings_.surface).
   void write_new_surface();
+  /// The scene's steps are done, or its end time reached (SceneDesc::end_time).
+  bool finished() const;
+  /// Tells the simulation where CFL steps must end: the next frame's time, the run's end.
+  void set_barrier();
 };
 
 extern template class RunDriver<2, float>;

@@ -63,7 +63,10 @@ struct SceneDesc {
   /// 2 or 3: the dimension of the body; set together with it by set_body().
   int dimension = 3;
   Precision precision = Precision::Double;
-  std::int64_t steps = 0;             ///< number of time steps to run
+  std::int64_t steps = 0;  ///< number of time steps to run (with end_time: the most it may take)
+  /// A run of CFL steps (TimeStepping::Cfl) given by Configuration.stopAt ends at this simulated
+  /// time, s; 0: the run ends after `steps` steps.
+  double end_time = 0;
   OutputDesc output;                  ///< frame formats, fields and schedule
   std::vector<std::string> warnings;  ///< non-fatal problems found while reading (e.g. dt close to a limit)
 

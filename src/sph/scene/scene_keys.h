@@ -20,18 +20,36 @@ namespace sph::detail {
 /// The keys of each object of a scene, in the order the writer writes them. The reader refuses
 /// any other key; the writer writes every one (emitEndTime only when an emitter stops), except
 /// Configuration.stopAt, the alternative to numberOfSteps: the writer writes the numberOfSteps it
-/// gave (kWriterResolvedKeys).
+/// gave (kWriterResolvedKeys), or, for a run of CFL steps that ends at a time, stopAt instead.
 inline const std::vector<std::string> kRootKeys{"version",     "name",          "description", "units",
                                                 "dimension",   "Configuration", "Fluid",       "Container",
                                                 "FluidBlocks", "Obstacles",     "Emitters"};
-inline const std::vector<std::string> kConfigurationKeys{"precision",        "timeStepSize",   "numberOfSteps",
-                                                         "stopAt",           "particleRadius", "kernelRadius",
-                                                         "gravitation",      "neighbors",      "fullRebuildPeriod",
-                                                         "verletSkin",       "trackedSkin",    "reorderPeriod",
-                                                         "boundaryHandling", "boundaryVolume", "boundaryPressure",
-                                                         "boundaryFriction", "kernel",         "outputEveryNSteps",
-                                                         "outputFps",        "outputFormats",  "outputFields",
-                                                         "outputBoundary"};
+inline const std::vector<std::string> kConfigurationKeys{"precision",
+                                                         "timeStepSize",
+                                                         "numberOfSteps",
+                                                         "stopAt",
+                                                         "particleRadius",
+                                                         "kernelRadius",
+                                                         "gravitation",
+                                                         "neighbors",
+                                                         "fullRebuildPeriod",
+                                                         "verletSkin",
+                                                         "trackedSkin",
+                                                         "reorderPeriod",
+                                                         "boundaryHandling",
+                                                         "boundaryVolume",
+                                                         "boundaryPressure",
+                                                         "boundaryFriction",
+                                                         "kernel",
+                                                         "outputEveryNSteps",
+                                                         "outputFps",
+                                                         "outputFormats",
+                                                         "outputFields",
+                                                         "outputBoundary",
+                                                         "cflMethod",
+                                                         "cflFactor",
+                                                         "cflMinTimeStepSize",
+                                                         "cflMaxTimeStepSize"};
 inline const std::vector<std::string> kFluidKeys{
     "density0",         "stiffness",     "viscosity",          "viscosityModel", "artificialViscosityAlpha",
     "negativePressure", "pressureForce", "gradientCorrection", "particleMass"};
@@ -71,6 +89,7 @@ inline constexpr Named<BoundaryPressure> kBoundaryPressureNames[] = {{BoundaryPr
                                                                      {BoundaryPressure::Mirror, "mirror"}};
 inline constexpr Named<KernelKind> kKernelNames[] = {
     {KernelKind::Paper, "paper"}, {KernelKind::Cubic, "cubic"}, {KernelKind::Wendland, "wendland"}};
+inline constexpr Named<TimeStepping> kCflMethodNames[] = {{TimeStepping::Fixed, "none"}, {TimeStepping::Cfl, "cfl"}};
 inline constexpr Named<ViscosityModel> kViscosityModelNames[] = {{ViscosityModel::Paper, "paper"},
                                                                  {ViscosityModel::Artificial, "artificial"}};
 

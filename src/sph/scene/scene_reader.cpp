@@ -76,8 +76,10 @@ Box<D> read_box(ObjectReader& r, const char* what) {
 /// Configuration.outputEveryNSteps, outputFps, outputFormats, outputFields.
 void read_output(ObjectReader& c, SceneDesc& desc) {
   OutputDesc& out = desc.output;
+  // A run that ends at a time (CFL steps) writes 100 frames by default, on the fps schedule.
+  const bool by_time = desc.end_time > 0 && !c.find("outputEveryNSteps");
   out.fps = c.positive("outputFps", "a frame rate >= 0 in frames per simulated second (0: frames by outputEveryNSteps)",
-                       0.0, true);
+                       by_time ? 100.0 / desc.end_time : 0.0, true);
   // Frames by time replace the default frames by steps; both given is a contradiction.
   out.every_steps = c.integer("outputEveryNSteps", "a frame interval in steps (0: no frames)", 0, 1'000'000'000'000LL,
                               out.fps > 0 ? 0 : std::max<std::int64_t>(1, desc.steps / 100));
@@ -99,6 +101,27 @@ void read_output(ObjectReader& c, SceneDesc& desc) {
       if (std::find(fields->begin(), fields->end(), name) != fields->end()) out.fields.push_back(name);
   }
   out.boundary = c.boolean("outputBoundary", "whether to write the boundary particles as boundary.vtu", false);
+}
+
+/// The time stepping: Configuration.cflMethod and its settings.
+template <int D>
+void read_time_stepping(ObjectReader& c, SimulationParams<D>& sim) {
+  using detail::names_of, detail::value_named;
+  sim.time_stepping =
+      value_named(detail::kCflMethodNames, c.choice("cflMethod", names_of(detail::kCflMethodNames), "none"));
+  CflParams& cfl = sim.cfl;
+  cfl.factor = c.positive(
+      "cflFactor", "a positive CFL factor (a step moves a particle at most 0.4 cflFactor diameters)", cfl.factor);
+  if (cfl.factor > 1)
+    c.ctx().fail(c.child("cflFactor"), fmt::format("a CFL factor of {:g} lets a particle cross {:g} diameters in a "
+                                                   "step; expected at most 1 (typical: 0.5)",
+                                                   cfl.factor, 0.4 * cfl.factor));
+  cfl.min_dt = c.positive("cflMinTimeStepSize", "the smallest CFL step, a positive time in s", cfl.min_dt);
+  cfl.max_dt = c.positive("cflMaxTimeStepSize", "the largest CFL step, a positive time in s", cfl.max_dt);
+  if (cfl.max_dt < cfl.min_dt)
+    c.ctx().fail(
+        c.child("cflMaxTimeStepSize"),
+        fmt::format("cflMaxTimeStepSize = {:g} s is below cflMinTimeStepSize = {:g} s", cfl.max_dt, cfl.min_dt));
 }
 
 /// The Configuration object: time step, steps, particle and kernel radii, gravity, the neighbor
@@ -149,6 +172,7 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
       c.positive("boundaryFriction", "a boundary friction sigma >= 0 (Akinci et al. 2012; 0: free slip)",
                  sim.boundary.friction, true);
   sim.fluid.kernel = value_named(detail::kKernelNames, c.choice("kernel", names_of(detail::kKernelNames), "paper"));
+  read_time_stepping<D>(c, sim);
   sim.verlet_skin = c.positive("verletSkin", "a positive verlet skin in metres (default 0.1 h)",
                                kDefaultSkinFraction * sim.kernel_radius);
   sim.tracked_skin = c.positive(
@@ -171,7 +195,7 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
 
 /// Configuration.numberOfSteps or stopAt (an end time, turned into steps of dt), and the output
 /// (whose default frame interval depends on the steps).
-void read_run_length(ObjectReader& c, SceneDesc& desc, double dt) {
+void read_run_length(ObjectReader& c, SceneDesc& desc, double dt, bool cfl, double min_dt) {
   constexpr std::int64_t kMaxSteps = 1'000'000'000'000LL;
   const char* what_steps = "a number of steps between 1 and 1e12 (or stopAt, an end time in s)";
   const char* what_stop = "a positive end time in seconds";
@@ -192,7 +216,12 @@ void read_run_length(ObjectReader& c, SceneDesc& desc, double dt) {
   } else {
     const double stop = c.positive("stopAt", what_stop);
     // The first step whose end reaches stopAt (an end time that is a whole number of steps,
-    // up to rounding, is that number).
+    // up to rounding, is that number). CFL steps: the run ends at stopAt, in at most as many
+    // steps as the smallest step needs.
+    if (cfl) {
+      desc.end_time = stop;
+      dt = min_dt;
+    }
     const double steps = std::max(1.0, std::ceil(stop / dt * (1 - 1e-12)));
     if (!(steps <= static_cast<double>(kMaxSteps)))
       c.ctx().fail(c.child("stopAt"), fmt::format("stopAt = {:g} s is {:.3g} steps of {:.4g} s; at most 1e12 steps are "
@@ -432,8 +461,9 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
 
   const SceneScales scales = scene_scales<D>(body);
   resolve_defaults<D>(root.ctx(), body, derived, scales);
-  root.object("Configuration", detail::kConfigurationKeys,
-              [&](ObjectReader& c) { read_run_length(c, desc, sim.time_step); });
+  root.object("Configuration", detail::kConfigurationKeys, [&](ObjectReader& c) {
+    read_run_length(c, desc, sim.time_step, sim.time_stepping == TimeStepping::Cfl, sim.cfl.min_dt);
+  });
   check_emitter_travel<D>(root.ctx(), sim, derived.time_step);
   warn_from_scales<D>(desc, sim, derived, scales);
   try {

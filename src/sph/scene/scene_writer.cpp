@@ -47,10 +47,12 @@ OrderedJson configuration_json(const SceneDesc& desc, const SimulationParams<D>&
   OrderedJson formats = OrderedJson::array();
   for (FrameFormat f : out.formats) formats.push_back(frame_format_name(f));
   ObjectWriter w(detail::kConfigurationKeys);
-  w.put("precision", detail::name_of(detail::kPrecisionNames, desc.precision))
-      .put("timeStepSize", sim.time_step)
-      .put("numberOfSteps", desc.steps)
-      .put("particleRadius", sim.particle_radius)
+  w.put("precision", detail::name_of(detail::kPrecisionNames, desc.precision)).put("timeStepSize", sim.time_step);
+  if (desc.end_time > 0)
+    w.put("stopAt", desc.end_time);
+  else
+    w.put("numberOfSteps", desc.steps);
+  w.put("particleRadius", sim.particle_radius)
       .put("kernelRadius", sim.kernel_radius)
       .put("gravitation", vec_json<D>(sim.gravity))
       .put("neighbors", std::string(to_string(sim.neighbors)))
@@ -67,7 +69,11 @@ OrderedJson configuration_json(const SceneDesc& desc, const SimulationParams<D>&
       .put("outputFps", out.fps)
       .put("outputFormats", std::move(formats))
       .put("outputFields", out.fields)
-      .put("outputBoundary", out.boundary);
+      .put("outputBoundary", out.boundary)
+      .put("cflMethod", detail::name_of(detail::kCflMethodNames, sim.time_stepping))
+      .put("cflFactor", sim.cfl.factor)
+      .put("cflMinTimeStepSize", sim.cfl.min_dt)
+      .put("cflMaxTimeStepSize", sim.cfl.max_dt);
   return w.take();
 }
 

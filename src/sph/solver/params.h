@@ -152,9 +152,32 @@ struct EmitterParams {
   friend bool operator==(const EmitterParams&, const EmitterParams&) = default;
 };
 
+/// How the time step is chosen.
+enum class TimeStepping {
+  Fixed,  ///< every step takes SimulationParams::time_step
+  /// Each step takes the Courant-Friedrichs-Lewy step of the state it starts from (CflParams),
+  /// shortened to land exactly on emission times, frame times and the end of the run.
+  Cfl,
+};
+
+/// The CFL step (TimeStepping::Cfl, Simulation::next_time_step): the advective limit
+/// dt <= factor 0.4 d / u (d the particle diameter, u the largest of |v| + dt_last |a|: a
+/// particle moves at most 0.4 factor diameters, SPlisHSPlasH's rule), the acoustic limit with
+/// the flow's speed, dt <= 0.8 * 0.4 h / (c0 + u), the scene's other limits as timeStepSize
+/// "auto" takes them (time_step.h), at most twice the last step, clamped to [min_dt, max_dt].
+struct CflParams {
+  double factor = 0.5;   ///< Configuration.cflFactor
+  double min_dt = 1e-5;  ///< s, Configuration.cflMinTimeStepSize
+  double max_dt = 5e-3;  ///< s, Configuration.cflMaxTimeStepSize
+
+  friend bool operator==(const CflParams&, const CflParams&) = default;
+};
+
 template <int D>
 struct SimulationParams {
-  double time_step = 1e-4;        ///< dt, s (fixed)
+  double time_step = 1e-4;  ///< dt, s (fixed; with TimeStepping::Cfl the first step's largest)
+  TimeStepping time_stepping = TimeStepping::Fixed;
+  CflParams cfl;
   double particle_radius = 0.01;  ///< m; particles are spaced 2 radii apart initially
   double kernel_radius = 0.04;    ///< h, m
   double particle_mass = 0;       ///< kg (same for all particles)

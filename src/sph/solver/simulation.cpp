@@ -12,6 +12,7 @@
 #include <sph/core/timer.h>
 #include <sph/solver/nozzle.h>
 #include <sph/solver/smoothing.h>
+#include <sph/solver/time_step.h>
 #include <sph/solver/wcsph.h>
 
 namespace sph {
@@ -110,8 +111,17 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
   opt.full_rebuild_period = params_.full_rebuild_period;
   opt.verlet_skin = params_.verlet_skin;
   opt.tracked_skin = params_.tracked_skin;
-  opt.time_step = params_.time_step;
+  // (CFL: the largest step, which sizes the tracked modes' automatic skin generously)
+  opt.time_step = cfl() ? std::max(params_.time_step, params_.cfl.max_dt) : params_.time_step;
   SPH_CHECK(params_.reorder_period >= 0, "reorder period must be >= 0");
+  if (cfl()) {
+    SPH_CHECK(params_.cfl.factor > 0 && params_.cfl.min_dt > 0 && params_.cfl.max_dt >= params_.cfl.min_dt,
+              "CFL parameters out of range");
+    last_cfl_dt_ = 0.5 * params_.time_step;  // (the first step takes at most timeStepSize)
+    // The limits but the acoustic one (which next_time_step() takes with the flow's speed).
+    for (const TimeStepLimit& l : time_step_limits(params_))
+      if (!l.acoustic) cfl_limit_ = std::min(cfl_limit_, kAutoTimeStepFraction * l.dt_warn);
+  }
   neighbors_ = make_neighbor_strategy<D, R>(params_.neighbors, opt);
   neighbors_->set_boundary(boundary_.position);
   if (params_.audit) auditor_ = std::make_unique<ListAuditor<D, R>>();
@@ -164,12 +174,20 @@ std::size_t Simulation<D, R>::emit() {
     const EmitterParams<D>& e = params_.emitters[k];
     EmitterState& s = emitters_[k];
     if (s.emitted >= e.max_particles || t > e.end_time) continue;
-    if (s.next_step < 0) {
+    if (cfl()) {
+      // Batches every emitEveryNSteps * timeStepSize seconds from the start time; steps end on them.
+      const double period = e.every_steps * params_.time_step;
+      if (s.next_time < 0) s.next_time = e.start_time;
+      if (t + 1e-9 * period < s.next_time) continue;
+      s.next_time += period;
+    } else if (s.next_step < 0) {
       if (t + 0.5 * params_.time_step < e.start_time) continue;
       s.next_step = steps_;
     }
-    if (steps_ != s.next_step) continue;
-    s.next_step += e.every_steps;
+    if (!cfl()) {
+      if (steps_ != s.next_step) continue;
+      s.next_step += e.every_steps;
+    }
     const auto [u, w] = nozzle_axes<D>(e.direction);
     const int rows = D == 3 ? e.height : 1;
     const Vec<D, R> vel = vec_cast<R>(e.direction * e.speed);
@@ -184,11 +202,61 @@ std::size_t Simulation<D, R>::emit() {
 }
 
 template <int D, std::floating_point R>
+double Simulation<D, R>::next_time_step() const {
+  if (!cfl()) return params_.time_step;
+  const CflParams& c = params_.cfl;
+  // The fastest particle, with what the last step's acceleration adds in a step.
+  const std::size_t n = particles_.size();
+  const double last = last_cfl_dt_;
+  partial_.assign(chunk_count(n), 0.0);
+  parallel_chunks(n, [&](std::size_t k, std::size_t b, std::size_t e) {
+    double m = 0;
+    for (std::size_t i = b; i < e; ++i)
+      m = std::max(m, std::sqrt(static_cast<double>(norm2(particles_.velocity[i]))) +
+                          last * std::sqrt(static_cast<double>(norm2(particles_.acceleration[i]))));
+    partial_[k] = m;
+  });
+  double u = 0;
+  for (double p : partial_) u = std::max(u, p);
+  // Advective CFL: a particle moves at most 0.4 factor diameters (SPlisHSPlasH's rule).
+  double dt = u > 0 ? c.factor * 0.4 * (2.0 * params_.particle_radius) / u : kNoLimit;
+  // The scene's other limits (time_step.h's warning levels, as "auto" takes them: cfl_limit_),
+  // and the acoustic one with the flow's speed added to the sound's.
+  dt = std::min(dt, cfl_limit_);
+  const double c0 = std::sqrt(std::max(params_.fluid.stiffness, 0.0));
+  if (c0 + u > 0) dt = std::min(dt, kAutoTimeStepFraction * 0.4 * params_.kernel_radius / (c0 + u));
+  dt = std::min({dt, c.max_dt, 2.0 * last});
+  return std::max(dt, c.min_dt);
+}
+
+template <int D, std::floating_point R>
+typename Simulation<D, R>::StepTime Simulation<D, R>::choose_time_step() const {
+  StepTime st;
+  st.dt = st.cfl_dt = next_time_step();
+  if (!cfl()) return st;
+  // The nearest barrier ahead: the caller's (frames, the end), the emitters' next batches.
+  double end = barrier_;
+  for (std::size_t k = 0; k < emitters_.size(); ++k) {
+    const EmitterParams<D>& e = params_.emitters[k];
+    if (emitters_[k].emitted >= e.max_particles) continue;
+    const double next = emitters_[k].next_time < 0 ? e.start_time : emitters_[k].next_time;
+    if (next > time_) end = std::min(end, next);
+  }
+  const double left = end - time_;
+  if (!(left > 0) || !std::isfinite(left)) return st;
+  if (left <= st.dt * (1 + 1e-9)) {
+    st.dt = left, st.end = end, st.lands = true;
+  } else if (left < 2.0 * st.dt) {
+    st.dt = 0.5 * left;  // two equal steps rather than a full one and a sliver
+  }
+  return st;
+}
+
+template <int D, std::floating_point R>
 const StepInfo& Simulation<D, R>::step() {
   StepInfo info;
   info.step = steps_;
 
-  const R dt = static_cast<R>(params_.time_step);
   const R h = static_cast<R>(params_.kernel_radius);
   double reorder_seconds = 0;
   if (params_.reorder_period > 0 && steps_ % params_.reorder_period == 0 && particles_.size() > 1) {
@@ -218,12 +286,19 @@ const StepInfo& Simulation<D, R>::step() {
   Stopwatch watch;
   info.pairs_within_h = compute_density_pressure(particles_, lists, h, params_.fluid, solid);
   info.seconds.density = watch.lap();
+  const StepTime st = choose_time_step();
+  const R dt = static_cast<R>(st.dt);
+  info.dt = st.dt;
   const WallContact<D, R> walls(params_.container, params_.obstacles, static_cast<R>(params_.particle_radius),
                                 params_.walls, params_.boundary.handling == BoundaryHandling::Penalty);
   compute_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity), walls,
                         neighbors_->pair_exit_flags(), dt, solid, neighbors_->pair_exit_radius());
   info.seconds.forces = watch.lap();
   ++steps_;  // counted even if the checks below throw (as before the passes were fused)
+  if (cfl()) {
+    time_ = st.lands ? st.end : time_ + st.dt;
+    last_cfl_dt_ = st.cfl_dt;
+  }
   info.health = integrate_and_check<true>(dt);
   monitor_.check(info.health, steps_ - 1, time(), particles_.size());
   info.seconds.integrate = watch.lap();
@@ -368,6 +443,8 @@ template <int D, std::floating_point R>
 void Simulation<D, R>::save_state(StateWriter& out) const {
   out.put(static_cast<std::uint8_t>(params_.neighbors));
   out.put(steps_);
+  out.put(time_);
+  out.put(last_cfl_dt_);
   out.put(emitters_);
   particles_.save(out);
   neighbors_->save_state(out);
@@ -379,6 +456,10 @@ void Simulation<D, R>::load_state(StateReader& in) {
   in.expect(in.get<std::uint8_t>() == static_cast<std::uint8_t>(params_.neighbors), "written in another neighbor mode");
   in.get(steps_);
   in.expect(steps_ >= 0, "a negative step count");
+  in.get(time_);
+  in.get(last_cfl_dt_);
+  in.expect(std::isfinite(time_) && time_ >= 0 && std::isfinite(last_cfl_dt_) && last_cfl_dt_ >= 0,
+            "a bad time or time step");
   in.get(emitters_);
   in.expect(emitters_.size() == params_.emitters.size(), "a different number of emitters");
   for (std::size_t k = 0; k < emitters_.size(); ++k)

@@ -29,6 +29,7 @@ struct PhaseTimes {
 struct StepInfo {
   std::int64_t step = 0;  ///< index of the step just taken (0-based)
   double time = 0;        ///< simulated time after the step, s
+  double dt = 0;          ///< the step's time step, s
   std::size_t particles = 0;
   std::size_t emitted = 0;  ///< particles added by emitters at the start of this step
   bool reordered = false;   ///< particles were reordered in memory (Morton curve) this step
@@ -56,7 +57,10 @@ struct HealthChunk {
 /// Progress of one emitter (part of the simulation state).
 struct EmitterState {
   std::int64_t emitted = 0;
-  std::int64_t next_step = -1;  ///< step of the next batch; -1 before start time
+  std::int64_t next_step = -1;  ///< step of the next batch; -1 before start time (fixed time step)
+  /// TimeStepping::Cfl: time of the next batch, s (-1 before the first); batches come every
+  /// emitEveryNSteps * timeStepSize seconds, and steps end on their times
+  double next_time = -1;
 };
 
 /// A running simulation. Each step():
@@ -70,6 +74,8 @@ struct EmitterState {
 ///      pass gathers every neighbor's velocity anyway),
 ///   5. symplectic Euler integration, then a check that every value is finite; the same pass
 ///      measures the health statistics (StepInfo::health), which the health monitor judges.
+/// With TimeStepping::Cfl each step chooses its time step (next_time_step(), shortened to end on
+/// a barrier) before the force pass, whose Eq. 7 test predicts with it.
 template <int D, std::floating_point R>
 class Simulation {
  public:
@@ -100,7 +106,14 @@ class Simulation {
   /// The boundary particles (empty with penalty walls).
   const BoundarySet<D, R>& boundary() const { return boundary_; }
   std::int64_t steps_done() const { return steps_; }
-  double time() const { return static_cast<double>(steps_) * params_.time_step; }
+  /// Simulated time, s: steps times the time step (fixed), or the sum of the steps' (CFL).
+  double time() const { return cfl() ? time_ : static_cast<double>(steps_) * params_.time_step; }
+  /// The next steps end no later than `t` (s): the step that would pass it is shortened to end
+  /// on it exactly (TimeStepping::Cfl; a fixed step is never changed). The run driver sets the
+  /// next frame's time and the end of the run.
+  void set_time_barrier(double t) { barrier_ = t; }
+  /// The time step the next step would take (without barriers), s.
+  double next_time_step() const;
   const StepInfo& last_step() const { return info_; }
   const std::vector<EmitterState>& emitter_states() const { return emitters_; }
 
@@ -128,6 +141,15 @@ class Simulation {
   void load_state(StateReader& in);
 
  private:
+  bool cfl() const { return params_.time_stepping == TimeStepping::Cfl; }
+  /// A step's time step: dt (shortened by a barrier), the CFL step before that, and whether the
+  /// step ends on the barrier `end` (the time is then set to it exactly).
+  struct StepTime {
+    double dt = 0, cfl_dt = 0, end = 0;
+    bool lands = false;
+  };
+  /// The step's time step: fixed, or CFL with the barriers (frames, emitters, the end).
+  StepTime choose_time_step() const;
   std::size_t emit();
   void reserve_for_emitters();
   /// What the passes see of the boundary particles, with `lists` as their lists.
@@ -150,6 +172,10 @@ class Simulation {
   std::vector<detail::HealthChunk> health_chunks_;  // per-chunk health statistics (kept)
   std::vector<EmitterState> emitters_;
   std::int64_t steps_ = 0;
+  double time_ = 0;         // TimeStepping::Cfl: simulated time, s
+  double last_cfl_dt_ = 0;  // the last step's CFL step before barriers shortened it (its growth limit), s
+  double barrier_ = kNoLimit;
+  double cfl_limit_ = kNoLimit;  // TimeStepping::Cfl: the scene's limits but the acoustic one, s
   HealthMonitor monitor_;
   StepInfo info_;
 };

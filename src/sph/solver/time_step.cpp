@@ -17,7 +17,10 @@ std::vector<TimeStepLimit> time_step_limits(const SimulationParams<D>& p) {
   const double h = p.kernel_radius;
   auto add = [&](const char* name, double warn, double refuse) { out.push_back({name, dt / warn, warn, refuse}); };
   const double c = std::sqrt(p.fluid.stiffness);
-  if (c > 0) add("acoustic CFL (dt <= 0.4 h / sqrt(stiffness))", 0.4 * h / c, 1.0 * h / c);
+  if (c > 0) {
+    add("acoustic CFL (dt <= 0.4 h / sqrt(stiffness))", 0.4 * h / c, 1.0 * h / c);
+    out.back().acoustic = true;
+  }
   const double nu = p.fluid.viscosity / p.fluid.rest_density;
   if (p.fluid.viscosity_model == ViscosityModel::Paper && nu > 0)
     add("viscous diffusion (dt <= 0.125 h^2 rho0 / viscosity)", 0.125 * h * h / nu, 0.5 * h * h / nu);

@@ -10,10 +10,11 @@ namespace sph {
 
 /// One stability criterion evaluated for a scene.
 struct TimeStepLimit {
-  std::string name;  ///< what limits the step, e.g. "acoustic CFL"
-  double ratio;      ///< dt relative to the limit: dt / dt_limit
-  double dt_warn;    ///< largest dt that passes without a warning, s
-  double dt_refuse;  ///< dt above this is refused, s
+  std::string name;       ///< what limits the step, e.g. "acoustic CFL"
+  double ratio;           ///< dt relative to the limit: dt / dt_limit
+  double dt_warn;         ///< largest dt that passes without a warning, s
+  double dt_refuse;       ///< dt above this is refused, s
+  bool acoustic = false;  ///< the acoustic CFL limit (CFL steps take it with the flow's speed)
 };
 
 /// Evaluates the stability limits of explicit WCSPH with penalty walls for these params:

@@ -134,12 +134,12 @@ TEST(RunOutput, WritesFramesStatsAndSummary) {
   const auto rows = lines(slurp(dir / "stats.csv"));
   ASSERT_EQ(rows.size(), 6u);
   // The header the readers of stats.csv know (tests/io/vtk_readback_test.py), from kStatsColumns.
-  EXPECT_EQ(
-      rows[0],
-      "step,time,particles,kinetic_energy,max_speed,mean_neighbors,lists_rebuilt,pairs_stored,pairs_within_h,"
-      "missed_pairs,particles_missing,max_missed_penetration,t_grid,t_lists,t_density,t_forces,t_integrate,"
-      "t_output,outside,outside_depth,inside_solid,inside_depth,max_mach,rho_min,rho_max,energy,"
-      "boundary_pairs_stored,boundary_missed_pairs,entries_rebuilt,list_insertions,list_removals,list_overflows,skin,dt");
+  EXPECT_EQ(rows[0],
+            "step,time,particles,kinetic_energy,max_speed,mean_neighbors,lists_rebuilt,pairs_stored,pairs_within_h,"
+            "missed_pairs,particles_missing,max_missed_penetration,t_grid,t_lists,t_density,t_forces,t_integrate,"
+            "t_output,outside,outside_depth,inside_solid,inside_depth,max_mach,rho_min,rho_max,energy,"
+            "boundary_pairs_stored,boundary_missed_pairs,entries_rebuilt,list_insertions,list_removals,list_overflows,"
+            "skin,dt");
   EXPECT_EQ(rows[0], stats_header());
   // step: the steps done after the row's step (1 to 5), as summary.json's steps counts them
   for (int i = 0; i < 5; ++i)

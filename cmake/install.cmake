@@ -6,7 +6,7 @@
 #   bin/sph                                   the program (finds share/sph from its own location)
 #   lib/libsph_<layer>.a                      one library per layer of SPH_LAYERS
 #   include/sph/<layer>/*.h                   the headers, include/sph/core/version.h generated
-#   share/sph/scenes/{paper,validation}/      the scenes sph bench and sph validate run
+#   share/sph/scenes/{paper,validation,dfsph}/ the scenes sph bench and sph validate run, and DFSPH's
 #   lib/cmake/sph/sph{Config,ConfigVersion,Targets}.cmake   the package
 include(CMakePackageConfigHelpers)
 
@@ -24,7 +24,7 @@ install(TARGETS ${sph_layer_targets} EXPORT sphTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(TARGETS sph EXPORT sphTargets RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-install(DIRECTORY scenes/paper scenes/validation DESTINATION ${CMAKE_INSTALL_DATADIR}/sph/scenes)
+install(DIRECTORY scenes/paper scenes/validation scenes/dfsph DESTINATION ${CMAKE_INSTALL_DATADIR}/sph/scenes)
 
 install(EXPORT sphTargets NAMESPACE sph:: DESTINATION ${SPH_INSTALL_CMAKEDIR})
 configure_package_config_file(cmake/sphConfig.cmake.in ${PROJECT_BINARY_DIR}/sphConfig.cmake

@@ -77,6 +77,7 @@ int compare(const CompareCliOptions& opt) {
   if (opt.steps > 0) sets.push_back("Configuration.numberOfSteps=" + std::to_string(opt.steps));
   const SceneDesc desc = read_scene_file(opt.scene, sets);
   check_fits_in_memory(desc);  // each mode's run holds one simulation at a time
+  check_comparable(desc);
   for (const auto& w : desc.warnings) fmt::print(stderr, "sph: warning: {}\n", w);
   const fs::path dir = opt.output.empty() ? fs::path("out") / (desc.name + "_compare") : fs::path(opt.output);
   prepare_comparison_directory(dir);

@@ -43,7 +43,7 @@ std::vector<std::string> parse_cases(const std::string& list) {
     }
     if (std::find(kValidationCases.begin(), kValidationCases.end(), item) == kValidationCases.end())
       throw Error("unknown case \"" + item +
-                      "\"; expected martin_moyce, resolution, hydrostatic, boundaries, conservation or all",
+                      "\"; expected martin_moyce, resolution, hydrostatic, boundaries, dfsph, conservation or all",
                   "--cases");
     if (std::find(cases.begin(), cases.end(), item) != cases.end())
       throw Error("case \"" + item + "\" is listed twice", "--cases");
@@ -98,8 +98,9 @@ std::function<int()> add_validate_command(CLI::App& app) {
       "validate",
       "Validate against experiment and physics: dam break vs Martin & Moyce (1952), resolution, hydrostatics, "
       "conservation; exit 1 if a check misses its target");
-  cmd->add_option("--cases", opt->cases,
-                  "Comma-separated cases: martin_moyce, resolution, hydrostatic, boundaries, conservation, or all")
+  cmd->add_option(
+         "--cases", opt->cases,
+         "Comma-separated cases: martin_moyce, resolution, hydrostatic, boundaries, dfsph, conservation, or all")
       ->default_str("all");
   cmd->add_flag("--quick", opt->quick,
                 "Coarse, short versions (under a minute) with regression bounds instead of the targets (CI)");

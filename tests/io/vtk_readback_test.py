@@ -31,7 +31,8 @@ STATS_COLUMNS = ("step,time,particles,kinetic_energy,max_speed,mean_neighbors,li
                  "t_grid,t_lists,t_density,t_forces,t_integrate,t_output,"
                  "outside,outside_depth,inside_solid,inside_depth,max_mach,rho_min,rho_max,energy,"
                  "boundary_pairs_stored,boundary_missed_pairs,"
-                 "entries_rebuilt,list_insertions,list_removals,list_overflows,skin,dt")
+                 "entries_rebuilt,list_insertions,list_removals,list_overflows,skin,dt,solver_iterations,density_error,"
+                 "divergence_iterations,divergence_error,t_solve")
 PHASES = ("grid", "lists", "density", "forces", "integrate", "output")
 POINT_FIELDS = {"velocity": 3, "density": 1, "pressure": 1, "id": 1, "initial_position": 3}
 

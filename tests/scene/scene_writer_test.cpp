@@ -66,7 +66,9 @@ json every_key_2d() {
       "precision": "double", "timeStepSize": 1e-4, "numberOfSteps": 50, "particleRadius": 0.01,
       "kernelRadius": 0.033, "gravitation": [0, -9.81], "neighbors": "adaptive", "fullRebuildPeriod": 13,
       "verletSkin": 0.004, "reorderPeriod": 0, "outputEveryNSteps": 3, "outputFps": 0,
-      "outputFormats": ["vtu", "ply", "vtk"], "outputFields": []
+      "outputFormats": ["vtu", "ply", "vtk"], "outputFields": [], "boundaryHandling": "particles",
+      "simulationMethod": "dfsph", "minIterations": 3, "maxIterations": 77, "maxError": 0.05,
+      "enableDivergenceSolver": false, "maxIterationsV": 33, "maxErrorV": 2.5
     },
     "Fluid": { "density0": 1001, "stiffness": 2000, "viscosity": 0.01, "negativePressure": "clamp",
                "pressureForce": "symmetric", "gradientCorrection": "none", "particleMass": 0.1 },

@@ -100,6 +100,22 @@ TEST(Health, StatisticsAreTheSameForAnyThreadCount) {
   EXPECT_EQ(a.outside_depth, b.outside_depth);
 }
 
+TEST(Health, BoundaryParticleScenesGetStepAndModeAdviceNotWallSprings) {
+  // A particle beyond h outside a container of boundary particles, in the adaptive mode: the advice
+  // names the step and the exact modes (the wall springs do not exist).
+  SimulationParams<2> p = tank_params();
+  p.boundary.handling = BoundaryHandling::Particles;
+  p.neighbors = NeighborMode::Adaptive;
+  ParticleSet<2, double> far = block(10, 10, 0.1, 0.1);
+  far.add(Vec<2, double>{0.45, 0.2}, Vec<2, double>{2.0, 0.0}, far.mass[0]);
+  Simulation<2, double> lost(p, std::move(far));
+  const std::string e = error_of([&] { lost.step(); });
+  EXPECT_NE(e.find("simulation lost its fluid at step 0"), std::string::npos) << e;
+  EXPECT_NE(e.find("boundary particles hold a particle that sees them within h"), std::string::npos) << e;
+  EXPECT_NE(e.find("adaptive_exact"), std::string::npos) << e;
+  EXPECT_EQ(e.find("wallStiffness"), std::string::npos) << e;
+}
+
 TEST(Health, AParticleOutsideTheContainerWarnsOnceAndOneBeyondHFails) {
   // 100 particles and one 1.5 cm past the right wall (tolerance r = 1 cm): under 1 % of them.
   ParticleSet<2, double> ps = block(10, 10, 0.1, 0.1);

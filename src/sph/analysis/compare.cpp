@@ -227,7 +227,21 @@ double standard_seconds(const CompareResult& result) {
   return n ? sum / n : (result.runs.empty() ? 0.0 : result.runs[0].totals.total());
 }
 
+void check_comparable(const SceneDesc& desc) {
+  dispatch(desc, [&]<int D, class R>() {
+    const SimulationParams<D>& p = desc.body<D>().sim;
+    if (p.time_stepping == TimeStepping::Cfl)
+      throw Error(
+          "sph compare runs every neighbor mode with the same fixed time step and compares them step by "
+          "step, and this scene takes CFL steps (each mode would take its own); give it fixed steps: --set "
+          "Configuration.cflMethod=none --set Configuration.timeStepSize=DT (DT: for example a CFL run's "
+          "mean step, from the dt column of sph run's stats.csv)",
+          "Configuration.cflMethod");
+  });
+}
+
 CompareResult run_comparison(const SceneDesc& desc, const CompareOptions& options, const CompareProgress& progress) {
+  check_comparable(desc);
   return dispatch(desc, [&]<int D, class R>() { return run_all<D, R>(desc, options, progress); });
 }
 

@@ -112,6 +112,11 @@ double standard_seconds(const CompareResult& result);
 /// Called as runs progress: (run label, run index, run count, steps done, steps).
 using CompareProgress = std::function<void(const std::string&, int, int, std::int64_t, std::int64_t)>;
 
+/// Throws sph::Error if the modes cannot be compared on `desc`: a scene of CFL steps
+/// (Configuration.cflMethod "cfl") would give each mode its own steps, and the comparison
+/// compares the modes step by step.
+void check_comparable(const SceneDesc& desc);
+
 /// Runs every mode (and the chaos-floor run) on the scene, in this process, one after the
 /// other, and computes the divergences. A run that blows up is recorded with its failure and
 /// the steps it made. Throws sph::Error for a scene the modes cannot run.

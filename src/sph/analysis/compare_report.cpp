@@ -185,16 +185,17 @@ std::string report_speed(const CompareResult& res) {
   md += fmt::format(
       "{}D, {}, h = {:g} m, dt = {:g} s, {} steps, {} particles at the end, {} thread{}; sph {}.\n"
       "Every run is the same scene in the same process, one after the other. Times are the sum of the\n"
-      "step phases (grid, lists, density, forces, integration), measured inside the solver; the list\n"
+      "step phases (grid, lists, density, forces, integration, and DFSPH's solves), measured inside the solver; the "
+      "list\n"
       "audit and output are not timed. One run per mode: repeat the command to see the noise.\n\n",
       res.dimension, res.precision, res.h, res.dt, res.steps, ref.steps.empty() ? 0 : ref.steps.back().particles,
       res.threads, res.threads == 1 ? "" : "s", kVersion);
 
   md += "## Speed\n\n![cumulative time](timing.png)\n\n";
   md +=
-      "| run | total (s) | ms/step | grid | lists | density | forces | integrate | speed vs standard | lists rebuilt "
-      "per step | pairs stored per particle |\n";
-  md += "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+      "| run | total (s) | ms/step | grid | lists | density | forces | integrate | solve | speed vs standard | lists "
+      "rebuilt per step | pairs stored per particle |\n";
+  md += "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
   for (const RunRecord& r : res.runs) {
     const bool is_ref = &r == &ref;  // its ratio to itself is 1 by definition: say what it is instead
     const double total = r.totals.total();
@@ -206,9 +207,9 @@ std::string report_speed(const CompareResult& res) {
     for (const auto& s : r.steps)
       rebuilt_frac += s.particles ? static_cast<double>(s.lists_rebuilt) / static_cast<double>(s.particles) : 0;
     md += fmt::format(
-        "| {}{} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {} | {:.1f} % | {:.1f} |\n", r.label,
-        r.failure.empty() ? "" : " (failed)", total, 1e3 * total / n, r.totals.grid, r.totals.lists, r.totals.density,
-        r.totals.forces, r.totals.integrate,
+        "| {}{} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {} | {:.1f} % | {:.1f} |\n",
+        r.label, r.failure.empty() ? "" : " (failed)", total, 1e3 * total / n, r.totals.grid, r.totals.lists,
+        r.totals.density, r.totals.forces, r.totals.integrate, r.totals.solve,
         is_ref ? std::string("reference") : fmt_ratio(total > 0 ? ref_total / total : kNaN) + "x",
         100.0 * rebuilt_frac / n, per_particle / n);
   }
@@ -366,7 +367,7 @@ std::string neighbors_csv(const CompareResult& res) {
 /// phases.csv: one row per run with its phase totals and means.
 std::string phases_csv(const CompareResult& res) {
   std::string out =
-      "run,steps,grid_s,lists_s,density_s,forces_s,integrate_s,total_s,ms_per_step,speed_vs_standard,"
+      "run,steps,grid_s,lists_s,density_s,forces_s,integrate_s,solve_s,total_s,ms_per_step,speed_vs_standard,"
       "mean_lists_rebuilt,mean_pairs_stored,mean_pairs_within_h,missed_pairs,boundary_missed_pairs,failure\n";
   const double ref = standard_seconds(res);
   for (const auto& r : res.runs) {
@@ -375,11 +376,12 @@ std::string phases_csv(const CompareResult& res) {
     std::string failure = r.failure;
     std::replace(failure.begin(), failure.end(), '"', '\'');
     out += fmt::format(
-        "{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{},{},\"{}\"\n", r.label,
-        r.steps.size(), r.totals.grid, r.totals.lists, r.totals.density, r.totals.forces, r.totals.integrate, t,
-        r.steps.empty() ? 0.0 : 1e3 * t / static_cast<double>(r.steps.size()), t > 0 ? ref / t : kNaN,
-        mean_of(r.steps, &StepRecord::lists_rebuilt), mean_of(r.steps, &StepRecord::pairs_stored),
-        mean_of(r.steps, &StepRecord::pairs_within_h), res.audited ? std::to_string(missed) : std::string(),
+        "{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{},{},\"{}\"\n",
+        r.label, r.steps.size(), r.totals.grid, r.totals.lists, r.totals.density, r.totals.forces, r.totals.integrate,
+        r.totals.solve, t, r.steps.empty() ? 0.0 : 1e3 * t / static_cast<double>(r.steps.size()),
+        t > 0 ? ref / t : kNaN, mean_of(r.steps, &StepRecord::lists_rebuilt),
+        mean_of(r.steps, &StepRecord::pairs_stored), mean_of(r.steps, &StepRecord::pairs_within_h),
+        res.audited ? std::to_string(missed) : std::string(),
         res.audited ? std::to_string(r.boundary_missed_pairs()) : std::string(), failure);
   }
   return out;

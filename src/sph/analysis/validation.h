@@ -137,6 +137,7 @@ struct HydrostaticProfile {
   double max_bin_error = 0;    ///< max |ratio - 1| over bins of at least 3 particles
   double max_compression = 0;  ///< max (rho - rho0) / rho0 over every particle
   double interior_density_min = 0, interior_density_max = 0;  ///< (rho - rho0) / rho0, interior
+  double mean_density_error = 0;                              ///< mean |rho - rho0| / rho0 over the interior particles
 };
 
 struct HydrostaticModel {
@@ -169,8 +170,8 @@ double lattice_gradient_consistency(int dimension, double spacing, double h, boo
 // ---- Running the cases ----------------------------------------------------------------------
 
 /// The cases of `sph validate`.
-inline constexpr std::array<const char*, 5> kValidationCases{"martin_moyce", "resolution", "hydrostatic", "boundaries",
-                                                             "conservation"};
+inline constexpr std::array<const char*, 6> kValidationCases{"martin_moyce", "resolution", "hydrostatic",
+                                                             "boundaries",   "dfsph",      "conservation"};
 
 struct ValidationOptions {
   std::vector<std::string> cases{kValidationCases.begin(), kValidationCases.end()};
@@ -235,6 +236,10 @@ struct HydrostaticRun {
   std::string boundary, kernel;
   HydrostaticProfile whole;
   std::uint64_t max_outside = 0;
+  /// The steps taken, their mean time step (s; CFL steps vary) and DFSPH's mean iterations per
+  /// step (constant-density and divergence solves; 0 with WCSPH).
+  std::int64_t steps_taken = 0;
+  double mean_dt = 0, mean_iterations = 0, mean_iterations_v = 0;
   /// Interior particles' (depth, pressure) at the end, for the plot.
   std::vector<std::array<double, 2>> scatter;
 };
@@ -257,6 +262,7 @@ struct ValidationResult {
   std::vector<FrontRun> front_runs;  ///< martin_moyce (per mode) and resolution runs
   std::vector<HydrostaticRun> hydrostatic;
   std::vector<HydrostaticRun> boundaries;  ///< hydrostatic tanks per (boundary handling, kernel)
+  std::vector<HydrostaticRun> dfsph;       ///< the DFSPH tanks (the dfsph case)
   std::vector<MomentumRun> momentum;
   std::vector<ValidationCheck> checks;
 

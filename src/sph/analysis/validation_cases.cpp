@@ -86,22 +86,37 @@ class RunProgress {
   std::int64_t steps_, shown_ = 0;
 };
 
-/// Runs `run` to its end, calling sample() before the first step, every `every` steps and
-/// after the last. A blow-up ends the run and is recorded in `failure` (the samples so far are
-/// kept). Returns the wall seconds of the run.
+/// Runs `run` to its end, calling sample() before the first step, about `samples` times in
+/// the run (every steps / samples steps; a run of CFL steps to an end time: every end time /
+/// samples seconds) and after the last step. A blow-up ends the run and is recorded in
+/// `failure` (the samples so far are kept). Returns the wall seconds of the run.
 template <int D, std::floating_point R, class Sample>
-double run_sampled(RunDriver<D, R>& run, std::int64_t every, Sample&& sample, const ValidationProgress& progress,
+double run_sampled(RunDriver<D, R>& run, std::int64_t samples, Sample&& sample, const ValidationProgress& progress,
                    std::string label, std::string& failure, const std::function<void()>& each_step = {}) {
   const std::int64_t steps = run.scene().steps;
-  RunProgress rp(progress, std::move(label), steps);
+  const double end_time = run.scene().end_time;
+  const std::int64_t every = std::max<std::int64_t>(1, steps / samples);
+  const double interval = end_time / static_cast<double>(samples);
+  double next_time = interval;
+  RunProgress rp(progress, std::move(label), end_time > 0 ? samples : steps);
   Stopwatch watch;
   sample();
   RunCallbacks callbacks;
-  callbacks.progress = [&](std::int64_t k, std::size_t) { rp.at(k); };
+  callbacks.progress = [&](std::int64_t k, std::size_t) {
+    rp.at(end_time > 0 ? static_cast<std::int64_t>(run.simulation().time() / interval) : k);
+  };
   const RunResult result = run.run(callbacks, [&](Simulation<D, R>& sim, const StepInfo&) {
     const std::int64_t k = sim.steps_done();
     if (each_step) each_step();
-    if (k % every == 0 || k == steps) sample();
+    if (end_time > 0) {
+      const bool last = sim.time() >= end_time * (1 - 1e-12);
+      if (sim.time() >= next_time * (1 - 1e-12) || last) {
+        sample();
+        while (next_time <= sim.time() * (1 + 1e-12)) next_time += interval;
+      }
+    } else if (k % every == 0 || k == steps) {
+      sample();
+    }
   });
   failure = result.error;
   const double seconds = watch.elapsed();
@@ -120,15 +135,18 @@ double run_sampled(RunDriver<D, R>& run, std::int64_t every, Sample&& sample, co
 SceneDesc martin_moyce_scene(const std::filesystem::path& dir, int resolution, const std::string& mode) {
   const std::size_t plus = mode.find('+');
   const std::string variant = plus == std::string::npos ? "" : mode.substr(plus + 1);
-  if (!variant.empty() && variant != "particles")
-    throw Error(fmt::format("unknown Martin & Moyce variant \"{}\"; expected \"particles\"", variant), mode);
+  if (!variant.empty() && variant != "particles" && variant != "dfsph")
+    throw Error(fmt::format("unknown Martin & Moyce variant \"{}\"; expected \"particles\" or \"dfsph\"", variant),
+                mode);
   const std::string path =
-      (dir / (variant.empty() ? "martin_moyce_2d.json" : "martin_moyce_2d_particles.json")).string();
+      (dir / (variant.empty() ? "martin_moyce_2d.json" : fmt::format("martin_moyce_2d_{}.json", variant))).string();
   const SceneDesc base = read_scene_file(path);
   if (base.dimension != 2) throw Error("the Martin & Moyce case is 2D; expected \"dimension\": 2", path);
   const SimulationParams<2>& p = base.body<2>().sim;
   if (!variant.empty() && p.boundary.handling != BoundaryHandling::Particles)
     throw Error("the boundary-particle Martin & Moyce scene must say \"boundaryHandling\": \"particles\"", path);
+  if (variant == "dfsph" && p.method != SimulationMethod::Dfsph)
+    throw Error("the DFSPH Martin & Moyce scene must say \"simulationMethod\": \"dfsph\"", path);
   const double base_res = kMartinMoyceA / (2.0 * p.particle_radius);
   const double f = base_res / resolution;
   std::vector<std::string> sets{"Configuration.neighbors=" + mode.substr(0, plus)};
@@ -136,8 +154,9 @@ SceneDesc martin_moyce_scene(const std::filesystem::path& dir, int resolution, c
     sets.push_back("Configuration.particleRadius=" + num(p.particle_radius * f));
     sets.push_back("Configuration.kernelRadius=" + num(p.kernel_radius * f));
     sets.push_back("Configuration.timeStepSize=" + num(p.time_step * f));
-    sets.push_back("Configuration.numberOfSteps=" +
-                   std::to_string(static_cast<std::int64_t>(std::ceil(static_cast<double>(base.steps) / f - 1e-9))));
+    if (!(base.end_time > 0))  // (a run to an end time keeps it)
+      sets.push_back("Configuration.numberOfSteps=" +
+                     std::to_string(static_cast<std::int64_t>(std::ceil(static_cast<double>(base.steps) / f - 1e-9))));
     if (p.boundary.handling == BoundaryHandling::Penalty)
       sets.push_back("Container.wallStiffness=" + num(p.walls.stiffness / (f * f)));
   }
@@ -164,7 +183,6 @@ FrontRun run_front(const SceneDesc& desc, int resolution, const std::string& mod
       const double g = -p.gravity[1];
       const EnergyModel model = energy_model(p);
       // About 400 samples: T resolution ~0.01, finer than the experiment's spacing of ~0.2.
-      const std::int64_t every = std::max<std::int64_t>(1, desc.steps / 400);
       std::vector<double> xs, ys;
       const auto sample = [&]() {
         const FluidState s = state_of(sim);
@@ -178,7 +196,10 @@ FrontRun run_front(const SceneDesc& desc, int resolution, const std::string& mod
         run.Z.push_back((front - p.container.lo[0]) / kMartinMoyceA);
         run.energy.push_back(energy(s, model));
       };
-      run.seconds = run_sampled(driver, every, sample, progress, case_name + ": " + run.label, run.failure);
+      run.seconds = run_sampled(driver, 400, sample, progress, case_name + ": " + run.label, run.failure);
+      // (CFL steps: the steps taken and their mean)
+      run.steps = sim.steps_done();
+      if (run.steps > 0) run.dt = sim.time() / static_cast<double>(run.steps);
     }
   });
   // A front can be NaN at a sample (no particle with neighbors on the floor: never in practice);
@@ -196,8 +217,8 @@ FrontRun run_front(const SceneDesc& desc, int resolution, const std::string& mod
 /// kernel), `label` names the run ("2D" if empty).
 HydrostaticRun run_hydrostatic(const std::filesystem::path& dir, int dimension, bool quick,
                                const ValidationProgress& progress, const std::vector<std::string>& extra = {},
-                               const std::string& label = "") {
-  const std::string path = (dir / fmt::format("hydrostatic_{}d.json", dimension)).string();
+                               const std::string& label = "", const std::string& suffix = "") {
+  const std::string path = (dir / fmt::format("hydrostatic_{}d{}.json", dimension, suffix)).string();
   std::vector<std::string> sets;
   if (quick) {
     // Twice the spacing, h and dt, a quarter of the wall stiffness, 1.2 s (the coarse tanks
@@ -209,8 +230,11 @@ HydrostaticRun run_hydrostatic(const std::filesystem::path& dir, int dimension, 
       sets.push_back("Configuration.particleRadius=" + num(2 * p.particle_radius));
       sets.push_back("Configuration.kernelRadius=" + num(2 * p.kernel_radius));
       sets.push_back("Configuration.timeStepSize=" + num(2 * p.time_step));
-      sets.push_back("Configuration.numberOfSteps=" +
-                     std::to_string(static_cast<std::int64_t>(std::llround(1.2 / (2 * p.time_step)))));
+      if (base.end_time > 0)
+        sets.push_back("Configuration.stopAt=1.2");
+      else
+        sets.push_back("Configuration.numberOfSteps=" +
+                       std::to_string(static_cast<std::int64_t>(std::llround(1.2 / (2 * p.time_step)))));
       sets.push_back("Container.wallStiffness=" + num(p.walls.stiffness / 4));
     });
   }
@@ -234,12 +258,12 @@ HydrostaticRun run_hydrostatic(const std::filesystem::path& dir, int dimension, 
     run.particles = sim.particles().size();
     run.predicted_ratio =
         1.0 / lattice_gradient_consistency(D, run.spacing, run.h, p.fluid.pressure_force == PressureForce::Variational);
-    const std::int64_t every = std::max<std::int64_t>(1, desc.steps / 500);
     const EnergyModel model = energy_model(p);
     // The profile is taken from each particle's position and pressure averaged over the samples
     // of the run's last tenth (by id: the particles are reordered in memory): a tank at rest
     // still rings with its lowest acoustic mode, and one frame catches it at some phase of it.
-    const double window_start = 0.9 * p.time_step * static_cast<double>(desc.steps);
+    const double window_start =
+        0.9 * (desc.end_time > 0 ? desc.end_time : p.time_step * static_cast<double>(desc.steps));
     FluidState mean = state_of(sim);
     std::vector<std::uint64_t> slot(mean.position.size());  // id -> the averaged state's index
     for (std::size_t i = 0; i < slot.size(); ++i) slot[i] = i;
@@ -269,10 +293,19 @@ HydrostaticRun run_hydrostatic(const std::filesystem::path& dir, int dimension, 
       run.surface.push_back(free_surface_height(s, run.spacing));
       run.energy.push_back(energy(s, model));
     };
+    double iterations = 0, iterations_v = 0;
     const auto sample_all = [&]() {
-      run.max_outside = std::max<std::uint64_t>(run.max_outside, sim.last_step().health.outside);
+      const StepInfo& info = sim.last_step();
+      run.max_outside = std::max<std::uint64_t>(run.max_outside, info.health.outside);
+      iterations += info.density_solve.iterations;
+      iterations_v += info.divergence_solve.iterations;
     };
-    run.seconds = run_sampled(driver, every, sample, progress, "hydrostatic: " + run.label, run.failure, sample_all);
+    run.seconds = run_sampled(driver, 500, sample, progress, "hydrostatic: " + run.label, run.failure, sample_all);
+    run.steps_taken = sim.steps_done();
+    if (run.steps_taken > 0) {
+      const double k = static_cast<double>(run.steps_taken);
+      run.mean_dt = sim.time() / k, run.mean_iterations = iterations / k, run.mean_iterations_v = iterations_v / k;
+    }
     run.boundary = detail::name_of(detail::kBoundaryHandlingNames, p.boundary.handling);
     run.kernel = detail::name_of(detail::kKernelNames, p.fluid.kernel);
     HydrostaticModel m;
@@ -402,7 +435,8 @@ std::vector<std::string> selected_cases(const std::vector<std::string>& cases) {
     if (std::find(kValidationCases.begin(), kValidationCases.end(), c) == kValidationCases.end())
       throw Error(
           fmt::format(
-              "unknown case \"{}\"; expected martin_moyce, resolution, hydrostatic, boundaries, conservation or all",
+              "unknown case \"{}\"; expected martin_moyce, resolution, hydrostatic, boundaries, dfsph, conservation or "
+              "all",
               c),
           "--cases");
     if (std::find(out.begin(), out.end(), c) == out.end()) out.push_back(c);
@@ -570,6 +604,44 @@ void run_boundaries(ValidationResult& res, FrontRuns& fronts, const ValidationOp
     }
 }
 
+/// The dfsph case: the tanks with DFSPH (hydrostatic_2d_dfsph.json, hydrostatic_3d_dfsph.json):
+/// the mean density error at most 0.1 % and the pressure within 1 % of rho0 g d below the second
+/// layer, over the whole tank; no particle outside; settled before the end. Full runs: Martin &
+/// Moyce's front at a/40 within 0.10 with DFSPH (martin_moyce_2d_dfsph.json). Quick: the coarse
+/// 2D tank for 1.2 s, with regression bounds (its mean pressure ratio instead of the bins).
+void run_dfsph(ValidationResult& res, FrontRuns& fronts, const ValidationOptions& opt,
+               const ValidationProgress& progress) {
+  const bool q = res.quick;
+  const std::string c = "dfsph";
+  if (!q) {
+    const FrontRun& r = fronts.get(40, "standard+dfsph", c);
+    add_check(res, c, fmt::format("max |dZ|, {}", r.label), r.error.max, "<= 0.1",
+              r.failure.empty() && r.error.complete && r.error.max <= 0.1, false);
+  }
+  for (int d : q ? std::vector<int>{2} : std::vector<int>{2, 3}) {
+    res.dfsph.push_back(run_hydrostatic(opt.scene_dir, d, q, progress, {}, fmt::format("{}D dfsph", d), "_dfsph"));
+    const HydrostaticRun& h = res.dfsph.back();
+    const bool ok = h.failure.empty();
+    const double density_bound = q ? 0.002 : 0.001;
+    add_check(res, c, fmt::format("{}: mean |rho - rho0| / rho0 below 2 layers, whole tank", h.label),
+              h.whole.mean_density_error, fmt::format("<= {:g}", density_bound),
+              ok && h.whole.mean_density_error <= density_bound, q);
+    // Quick (coarse, 1.2 s): the mean ratio, a regression bound around the measured 1.14.
+    if (q)
+      add_check(res, c, fmt::format("{}: mean p / (rho0 g d) below 2 layers, whole tank", h.label), h.whole.mean_ratio,
+                "in [0.9, 1.3]", ok && h.whole.mean_ratio >= 0.9 && h.whole.mean_ratio <= 1.3, q);
+    else
+      add_check(res, c, fmt::format("{}: max |p / (rho0 g d) - 1| over depth bins below 2 layers, whole tank", h.label),
+                h.whole.max_bin_error, "<= 0.01", ok && h.whole.max_bin_error <= 0.01, q);
+    add_check(res, c, fmt::format("{}: most particles outside the container in a step", h.label),
+              static_cast<double>(h.max_outside), "0", ok && h.max_outside == 0, q);
+    if (q) continue;
+    const double run_time = h.time.empty() ? 0.0 : h.time.back();
+    add_check(res, c, fmt::format("{}: settling time (KE < 1 % of peak), s", h.label), h.settling_time,
+              fmt::format("< {:g} (the run's end)", run_time), ok && h.settling_time < run_time, q);
+  }
+}
+
 void run_conservation(ValidationResult& res, FrontRuns& fronts, const ValidationOptions& opt,
                       const ValidationProgress& progress) {
   const bool q = res.quick;
@@ -608,6 +680,11 @@ void check_validation_scenes(const ValidationOptions& opt) {
     (void)read_scene_file((opt.scene_dir / "hydrostatic_2d.json").string());
     (void)read_scene_file((opt.scene_dir / "hydrostatic_3d.json").string());
   }
+  if (wants("dfsph")) {
+    if (!opt.quick) (void)martin_moyce_scene(opt.scene_dir, 40, "standard+dfsph");
+    (void)read_scene_file((opt.scene_dir / "hydrostatic_2d_dfsph.json").string());
+    (void)read_scene_file((opt.scene_dir / "hydrostatic_3d_dfsph.json").string());
+  }
   if (wants("conservation")) (void)read_scene_file((opt.scene_dir / "momentum_2d.json").string());
 }
 
@@ -630,6 +707,7 @@ ValidationResult run_validation(const ValidationOptions& opt, const ValidationPr
       check_hydrostatic(res, res.hydrostatic.back());
     }
   if (wants("boundaries")) run_boundaries(res, fronts, opt, progress);
+  if (wants("dfsph")) run_dfsph(res, fronts, opt, progress);
   if (wants("conservation")) run_conservation(res, fronts, opt, progress);
   res.seconds = wall.elapsed();
   return res;

@@ -213,6 +213,7 @@ HydrostaticProfile hydrostatic_profile(const FluidState& s, const HydrostaticMod
     if (!interior) continue;
     ++p.particles;
     ratio_sum += s.pressure[i] / (rho_g * depth);
+    p.mean_density_error += std::abs(rel);
     p.interior_density_min = std::min(p.interior_density_min, rel);
     p.interior_density_max = std::max(p.interior_density_max, rel);
     DepthBin& b = bins[static_cast<std::int64_t>(std::floor((depth - top) / bin))];
@@ -221,12 +222,13 @@ HydrostaticProfile hydrostatic_profile(const FluidState& s, const HydrostaticMod
     ++b.count;
   }
   if (p.particles == 0) {
-    p.interior_density_min = p.interior_density_max = kNaN;
+    p.interior_density_min = p.interior_density_max = p.mean_density_error = kNaN;
     p.mean_ratio = kNaN;
     p.max_bin_error = kNaN;
     return p;
   }
   p.mean_ratio = ratio_sum / static_cast<double>(p.particles);
+  p.mean_density_error /= static_cast<double>(p.particles);
   // The deepest bin is cut by the floor's margin and holds a few particles at its top: such a
   // bin (fewer than half the median count) is noise, not a profile, and is not compared.
   std::vector<std::size_t> counts;

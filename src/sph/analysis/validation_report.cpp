@@ -175,6 +175,49 @@ void write_boundaries_csv(const std::filesystem::path& dir, const ValidationResu
   write_file_atomic(dir / "boundaries.csv", csv);
 }
 
+/// report.md's section on the dfsph case: the DFSPH tanks and front.
+std::string report_dfsph(const ValidationResult& res) {
+  std::string md = "## DFSPH: resting tanks and the dam break with the divergence-free solver\n\n";
+  md +=
+      "The tanks of hydrostatic_2d_dfsph.json and hydrostatic_3d_dfsph.json (boundary particles, the cubic\n"
+      "spline, CFL steps), measured as the boundaries case measures its tanks (each particle's pressure,\n"
+      "density and position averaged over the run's last tenth; the whole tank below 2 spacings).\n"
+      "Mean density error: mean |rho - rho0| / rho0 there. Steps, mean dt and the solves' mean iterations\n"
+      "per step over the whole run.\n\n";
+  md +=
+      "| tank | wall s | steps | mean dt (s) | density iterations | divergence iterations | mean density error | "
+      "mean p/(rho0 g d) | max bin error, whole tank | max compression | outside | settling |\n";
+  md += "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  for (const HydrostaticRun& h : res.dfsph)
+    md += fmt::format(
+        "| {}{} | {:.1f} | {} | {:.3g} | {:.2f} | {:.2f} | {:.3f} % | {:.3f} | {:.3f} | {:.2f} % | {} | {} |\n",
+        h.label, h.failure.empty() ? "" : " (failed)", h.seconds, h.steps_taken, h.mean_dt, h.mean_iterations,
+        h.mean_iterations_v, 100 * h.whole.mean_density_error, h.whole.mean_ratio, h.whole.max_bin_error,
+        100 * h.whole.max_compression, h.max_outside,
+        std::isfinite(h.settling_time) ? g(h.settling_time) + " s" : std::string("does not settle"));
+  for (const FrontRun& r : res.front_runs)
+    if (r.mode == "standard+dfsph")
+      md += fmt::format(
+          "\nMartin & Moyce with DFSPH ({}): {} steps, mean dt {:.3g} s, {:.1f} s of wall time; front "
+          "max |dZ| {}, mean {:+.3f}.\n",
+          r.label, r.steps, r.dt, r.seconds, g(r.error.max), r.error.mean);
+  md += "\n" + checks_table(res, "dfsph");
+  return md;
+}
+
+/// dfsph.csv: the table of report_dfsph.
+void write_dfsph_csv(const std::filesystem::path& dir, const ValidationResult& res) {
+  std::string csv =
+      "tank,failed,wall_seconds,steps,mean_dt,mean_iterations,mean_iterations_v,mean_density_error,mean_ratio,"
+      "max_bin_error_whole,max_compression,max_outside,settling_time\n";
+  for (const HydrostaticRun& h : res.dfsph)
+    csv += fmt::format("{},{},{:.3f},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{},{:.6g}\n", h.label,
+                       h.failure.empty() ? 0 : 1, h.seconds, h.steps_taken, h.mean_dt, h.mean_iterations,
+                       h.mean_iterations_v, h.whole.mean_density_error, h.whole.mean_ratio, h.whole.max_bin_error,
+                       h.whole.max_compression, h.max_outside, h.settling_time);
+  write_file_atomic(dir / "dfsph.csv", csv);
+}
+
 /// report.md's section on the hydrostatic tanks.
 std::string report_hydrostatic(const ValidationResult& res) {
   std::string md = "## Hydrostatic tanks\n\n";
@@ -252,6 +295,7 @@ std::string report_md(const ValidationResult& res, const std::vector<std::string
   if (has(res, "resolution")) md += report_resolution(res);
   if (has(res, "hydrostatic")) md += report_hydrostatic(res);
   if (has(res, "boundaries")) md += report_boundaries(res);
+  if (has(res, "dfsph")) md += report_dfsph(res);
   if (has(res, "conservation")) md += report_conservation(res);
   md += "## Files\n\n";
   for (const auto& f : files) md += "- `" + f + "`\n";
@@ -271,6 +315,7 @@ std::vector<std::string> validation_files(const ValidationResult& res) {
     for (const HydrostaticRun& h : res.hydrostatic) f.push_back(fmt::format("hydrostatic_{}d.png", h.dimension));
   }
   if (has(res, "boundaries")) f.push_back("boundaries.csv");
+  if (has(res, "dfsph")) f.push_back("dfsph.csv");
   if (has(res, "conservation"))
     f.insert(f.end(), {"momentum.csv", "energy.csv", "momentum.png", "energy.png", "energy_parts.png"});
   return f;
@@ -494,6 +539,7 @@ void write_validation(const std::filesystem::path& dir, const ValidationResult& 
   if (has(res, "resolution")) write_resolution_plots(dir, res);
   if (has(res, "hydrostatic")) write_hydrostatic_files(dir, res);
   if (has(res, "boundaries")) write_boundaries_csv(dir, res);
+  if (has(res, "dfsph")) write_dfsph_csv(dir, res);
   if (has(res, "conservation")) write_conservation_files(dir, res);
   write_file_atomic(dir / "report.md", report_md(res, validation_files(res)));
 }

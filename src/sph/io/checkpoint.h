@@ -24,7 +24,9 @@
 
 namespace sph {
 
-/// The format version this build writes and reads. Version 8 stores the simulated time and the
+/// The format version this build writes and reads. Version 9 stores DFSPH's last constant-density
+/// solve (iterations, error, converged: the next CFL step depends on it) after the last CFL step.
+/// Version 8 stores the simulated time and the
 /// last CFL step after the step count, and each emitter's next batch time (TimeStepping::Cfl).
 /// Version 7 changes no byte but the meaning of
 /// the scene text it carries: a boundary-particle scene without Configuration.boundaryPressure
@@ -36,7 +38,7 @@ namespace sph {
 /// name and kind, in kParticleFields order, then the fields a run added (ParticleSet::save);
 /// version 2 kept the frames' times and the schedule's next tick instead of version 1's .vtu
 /// file list.
-inline constexpr std::uint32_t kCheckpointVersion = 8;
+inline constexpr std::uint32_t kCheckpointVersion = 9;
 /// The checkpoint's file name in a run's output directory.
 inline constexpr const char* kCheckpointFile = "checkpoint.sphc";
 

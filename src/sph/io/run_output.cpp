@@ -307,7 +307,8 @@ void RunOutput<D, R>::finish(const Simulation<D, R>& sim, const std::string& sta
   if (!resumed_at_.empty()) s["resumed_at_steps"] = resumed_at_;
   if (last_checkpoint_step_ >= 0) s["last_checkpoint_step"] = last_checkpoint_step_;
   s["phase_seconds"] = {{"grid", totals_.grid},     {"lists", totals_.lists},         {"density", totals_.density},
-                        {"forces", totals_.forces}, {"integrate", totals_.integrate}, {"output", output_seconds_}};
+                        {"forces", totals_.forces}, {"integrate", totals_.integrate}, {"solve", totals_.solve},
+                        {"output", output_seconds_}};
   s["lists_rebuilt"] = totals_lists_rebuilt_;
   if (sim.params().audit)
     s["audit"] = {{"missed_pairs", audit_.missed_pairs},

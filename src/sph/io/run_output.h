@@ -74,7 +74,10 @@ constexpr StatsColumn real_column(std::string_view name, StatsFormat format, dou
 /// the fluid-boundary pairs within h they missed (0 and empty with penalty walls). Last, the work
 /// of the step's list building: entries written by (re)builds and insertions, the tracked modes'
 /// insertions into and removals from other particles' lists and lists that outgrew their room,
-/// and the lists' skin (m; 0 in the modes without one). Last, the step's time step (s).
+/// and the lists' skin (m; 0 in the modes without one). Then the step's time step (s), and DFSPH's
+/// solves: the constant-density solve's iterations and final average compression (%), the
+/// divergence solve's iterations and final average divergence error (% per second), and the
+/// wall seconds of the two solves (t_solve); 0 with WCSPH.
 inline constexpr StatsColumn kStatsColumns[] = {
     detail::count_column("step", [](const StepStats& s) { return static_cast<std::uint64_t>(s.info.step + 1); }),
     detail::real_column("time", StatsFormat::Real9, [](const StepStats& s) { return s.info.time; }),
@@ -123,6 +126,17 @@ inline constexpr StatsColumn kStatsColumns[] = {
     detail::count_column("list_overflows", [](const StepStats& s) { return s.info.neighbors.overflows; }),
     detail::real_column("skin", StatsFormat::Real6, [](const StepStats& s) { return s.info.neighbors.skin; }),
     detail::real_column("dt", StatsFormat::Real9, [](const StepStats& s) { return s.info.dt; }),
+    detail::count_column(
+        "solver_iterations",
+        [](const StepStats& s) { return static_cast<std::uint64_t>(s.info.density_solve.iterations); }),
+    detail::real_column("density_error", StatsFormat::Real6,
+                        [](const StepStats& s) { return s.info.density_solve.error; }),
+    detail::count_column(
+        "divergence_iterations",
+        [](const StepStats& s) { return static_cast<std::uint64_t>(s.info.divergence_solve.iterations); }),
+    detail::real_column("divergence_error", StatsFormat::Real6,
+                        [](const StepStats& s) { return s.info.divergence_solve.error; }),
+    detail::real_column("t_solve", StatsFormat::Real6, [](const StepStats& s) { return s.info.seconds.solve; }),
 };
 
 /// The header line of stats.csv: the column names, comma-separated.

@@ -49,7 +49,14 @@ inline const std::vector<std::string> kConfigurationKeys{"precision",
                                                          "cflMethod",
                                                          "cflFactor",
                                                          "cflMinTimeStepSize",
-                                                         "cflMaxTimeStepSize"};
+                                                         "cflMaxTimeStepSize",
+                                                         "simulationMethod",
+                                                         "minIterations",
+                                                         "maxIterations",
+                                                         "maxError",
+                                                         "enableDivergenceSolver",
+                                                         "maxIterationsV",
+                                                         "maxErrorV"};
 inline const std::vector<std::string> kFluidKeys{
     "density0",         "stiffness",     "viscosity",          "viscosityModel", "artificialViscosityAlpha",
     "negativePressure", "pressureForce", "gradientCorrection", "particleMass"};
@@ -89,6 +96,8 @@ inline constexpr Named<BoundaryPressure> kBoundaryPressureNames[] = {{BoundaryPr
                                                                      {BoundaryPressure::Mirror, "mirror"}};
 inline constexpr Named<KernelKind> kKernelNames[] = {
     {KernelKind::Paper, "paper"}, {KernelKind::Cubic, "cubic"}, {KernelKind::Wendland, "wendland"}};
+inline constexpr Named<SimulationMethod> kSimulationMethodNames[] = {{SimulationMethod::Wcsph, "wcsph"},
+                                                                     {SimulationMethod::Dfsph, "dfsph"}};
 inline constexpr Named<TimeStepping> kCflMethodNames[] = {{TimeStepping::Fixed, "none"}, {TimeStepping::Cfl, "cfl"}};
 inline constexpr Named<ViscosityModel> kViscosityModelNames[] = {{ViscosityModel::Paper, "paper"},
                                                                  {ViscosityModel::Artificial, "artificial"}};

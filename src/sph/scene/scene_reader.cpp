@@ -103,12 +103,43 @@ void read_output(ObjectReader& c, SceneDesc& desc) {
   out.boundary = c.boolean("outputBoundary", "whether to write the boundary particles as boundary.vtu", false);
 }
 
-/// The time stepping: Configuration.cflMethod and its settings.
+/// Configuration.simulationMethod and DFSPH's solver settings (after boundaryHandling).
+template <int D>
+void read_solver(ObjectReader& c, SimulationParams<D>& sim) {
+  using detail::names_of, detail::value_named;
+  sim.method = value_named(detail::kSimulationMethodNames,
+                           c.choice("simulationMethod", names_of(detail::kSimulationMethodNames), "wcsph"));
+  if (sim.method == SimulationMethod::Dfsph && sim.boundary.handling != BoundaryHandling::Particles)
+    c.ctx().fail(c.child("simulationMethod"),
+                 "DFSPH needs boundary particles: penalty springs push with forces the pressure solve does not see, "
+                 "and at DFSPH's large time steps they are unstable; set Configuration.boundaryHandling to "
+                 "\"particles\" (or use simulationMethod \"wcsph\")");
+  DfsphParams& p = sim.dfsph;
+  p.min_iterations = static_cast<int>(
+      c.integer("minIterations", "DFSPH's least constant-density iterations, 0 to 10000", 0, 10000, p.min_iterations));
+  p.max_iterations = static_cast<int>(
+      c.integer("maxIterations", "DFSPH's most constant-density iterations, 1 to 10000", 1, 10000, p.max_iterations));
+  if (p.max_iterations < p.min_iterations)
+    c.ctx().fail(c.child("maxIterations"),
+                 fmt::format("maxIterations = {} is below minIterations = {}", p.max_iterations, p.min_iterations));
+  p.max_error = c.positive("maxError", "DFSPH's tolerance on the average compression, a positive % of the rest density",
+                           p.max_error);
+  p.divergence_solver = c.boolean("enableDivergenceSolver", "whether DFSPH runs its divergence solve", true);
+  p.max_iterations_v = static_cast<int>(
+      c.integer("maxIterationsV", "DFSPH's most divergence iterations, 1 to 10000", 1, 10000, p.max_iterations_v));
+  p.max_error_v = c.positive(
+      "maxErrorV", "DFSPH's tolerance on the average divergence error, a positive % of the rest density per second",
+      p.max_error_v);
+}
+
+/// The time stepping: Configuration.cflMethod and its settings (a DFSPH scene takes CFL steps
+/// unless it says "none").
 template <int D>
 void read_time_stepping(ObjectReader& c, SimulationParams<D>& sim) {
   using detail::names_of, detail::value_named;
+  const char* fallback = sim.method == SimulationMethod::Dfsph ? "cfl" : "none";
   sim.time_stepping =
-      value_named(detail::kCflMethodNames, c.choice("cflMethod", names_of(detail::kCflMethodNames), "none"));
+      value_named(detail::kCflMethodNames, c.choice("cflMethod", names_of(detail::kCflMethodNames), fallback));
   CflParams& cfl = sim.cfl;
   cfl.factor = c.positive(
       "cflFactor", "a positive CFL factor (a step moves a particle at most 0.4 cflFactor diameters)", cfl.factor);
@@ -172,6 +203,7 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
       c.positive("boundaryFriction", "a boundary friction sigma >= 0 (Akinci et al. 2012; 0: free slip)",
                  sim.boundary.friction, true);
   sim.fluid.kernel = value_named(detail::kKernelNames, c.choice("kernel", names_of(detail::kKernelNames), "paper"));
+  read_solver<D>(c, sim);
   read_time_stepping<D>(c, sim);
   sim.verlet_skin = c.positive("verletSkin", "a positive verlet skin in metres (default 0.1 h)",
                                kDefaultSkinFraction * sim.kernel_radius);

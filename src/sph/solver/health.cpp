@@ -22,6 +22,15 @@ double suggested_viscosity(const HealthScene& s) {
 /// What walls that hold a particle need: stiffness for the speed v within r and for the head,
 /// critical damping, and the step the springs allow.
 std::string wall_advice(const HealthScene& s, double v) {
+  if (s.boundary_particles)
+    return fmt::format(
+        "boundary particles hold a particle that sees them within h = {:.3g} m; at the run's top speed v = {:.3g} "
+        "m/s a step of {:.3g} s moves it {:.2g} h: take smaller steps (Configuration.timeStepSize, or cflFactor and "
+        "cflMaxTimeStepSize){}",
+        s.kernel_radius, v, s.time_step, v * s.time_step / s.kernel_radius,
+        s.misses_pairs ? ", or a neighbor mode that never misses a pair (standard, verlet, tracked, adaptive_exact): "
+                         "the adaptive mode's lists miss the boundary samples a particle comes to"
+                       : "");
   const double r = s.particle_radius;
   const double ks_speed = (v / r) * (v / r);
   const double ks_head = s.gravity * s.head / (2.0 * r * r);
@@ -64,6 +73,10 @@ HealthScene health_scene(const SimulationParams<D>& p) {
   }
   s.closed = p.emitters.empty();
   s.tension = p.fluid.negative_pressure == NegativePressure::Allow;
+  s.incompressible = p.method == SimulationMethod::Dfsph;
+  s.boundary_particles = p.boundary.handling == BoundaryHandling::Particles;
+  s.misses_pairs = p.neighbors == NeighborMode::Adaptive;
+  if (p.time_stepping == TimeStepping::Cfl) s.time_step = p.cfl.max_dt;
   return s;
 }
 
@@ -100,8 +113,9 @@ void HealthMonitor::check(HealthStats& st, std::int64_t step, double time, std::
     if (fail_) throw Error(what);
   };
 
-  // Supersonic first: it is the cause of most of what follows.
-  if (st.max_mach > watch(HealthKind::Mach).fail)
+  // Supersonic first: it is the cause of most of what follows (DFSPH's fluid is incompressible:
+  // its Mach number against sqrt(Fluid.stiffness) means nothing and is not judged).
+  if (!s.incompressible && st.max_mach > watch(HealthKind::Mach).fail)
     fail(
         fmt::format("simulation went supersonic {}: particle id {} moves at {:.4g} m/s, Mach {:.3g} (sound "
                     "speed sqrt(Fluid.stiffness) = {:.4g} m/s); {}, or lower Configuration.timeStepSize (now {:.3g} s)",
@@ -126,24 +140,33 @@ void HealthMonitor::check(HealthStats& st, std::int64_t step, double time, std::
   contained(HealthKind::InsideSolid, st.inside_solid, st.inside_depth, st.inside_id, st.inside_speed,
             "inside an obstacle");
 
-  if (st.max_mach > watch(HealthKind::Mach).warn)
+  if (!s.incompressible && st.max_mach > watch(HealthKind::Mach).warn)
     warn(st, HealthKind::Mach,
          fmt::format("Mach {:.3g} {}: particle id {} moves at {:.4g} m/s (sound speed {:.4g} m/s); the density "
                      "error of weakly compressible SPH grows as Ma^2; {}",
                      st.max_mach, at(), st.mach_id, top_speed, s.sound_speed, speed_advice(s, top_speed)));
 
   const double stiff_for_1pct = s.stiffness * (st.rho_max - 1.0) / 0.01;
+  // What keeps the density near rest: the EOS's stiffness (WCSPH), or DFSPH's solve.
+  const auto density_advice = [&] {
+    if (s.incompressible)
+      return fmt::format(
+          "DFSPH's constant-density solve did not hold it: lower Configuration.maxError, raise "
+          "Configuration.maxIterations, or take smaller steps (Configuration.cflFactor, "
+          "cflMaxTimeStepSize or timeStepSize, now {:.3g} s)",
+          s.time_step);
+    return fmt::format(
+        "Fluid.stiffness >= {:.3g} (now {:.3g}) keeps the compression near 1 %, or lower "
+        "Configuration.timeStepSize (now {:.3g} s)",
+        stiff_for_1pct, s.stiffness, s.time_step);
+  };
   if (st.rho_max > watch(HealthKind::Compression).fail)
-    fail(
-        fmt::format("simulation collapsed {}: particle id {} is compressed to {:.3g} times the rest density; "
-                    "Fluid.stiffness >= {:.3g} (now {:.3g}) keeps the compression near 1 %, or lower "
-                    "Configuration.timeStepSize (now {:.3g} s)",
-                    at(), st.rho_max_id, st.rho_max, stiff_for_1pct, s.stiffness, s.time_step));
+    fail(fmt::format("simulation collapsed {}: particle id {} is compressed to {:.3g} times the rest density; {}", at(),
+                     st.rho_max_id, st.rho_max, density_advice()));
   if (st.rho_max > watch(HealthKind::Compression).warn)
     warn(st, HealthKind::Compression,
-         fmt::format("density {:.3g} times the rest density {} (particle id {}); Fluid.stiffness >= {:.3g} (now "
-                     "{:.3g}) keeps the compression near 1 %",
-                     st.rho_max, at(), st.rho_max_id, stiff_for_1pct, s.stiffness));
+         fmt::format("density {:.3g} times the rest density {} (particle id {}); {}", st.rho_max, at(), st.rho_max_id,
+                     density_advice()));
   if (s.tension && 1.0 - st.rho_min > watch(HealthKind::Tension).warn)
     warn(st, HealthKind::Tension,
          fmt::format("density {:.3g} times the rest density {} under Fluid.negativePressure \"allow\": the "

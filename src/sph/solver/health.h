@@ -82,10 +82,13 @@ struct HealthScene {
   double sound_speed = 1;  ///< c0 = sqrt(Fluid.stiffness), m/s
   double kernel_radius = 0, particle_radius = 0, rest_density = 1000;
   double stiffness = 0, viscosity = 0, wall_stiffness = 0, wall_damping = 0, time_step = 0;
-  double gravity = 0;    ///< |g|, m/s^2
-  double head = 0;       ///< the container's extent along g (0 without gravity), m
-  bool closed = true;    ///< no emitter (the energy is judged)
-  bool tension = false;  ///< NegativePressure::Allow
+  double gravity = 0;               ///< |g|, m/s^2
+  double head = 0;                  ///< the container's extent along g (0 without gravity), m
+  bool closed = true;               ///< no emitter (the energy is judged)
+  bool tension = false;             ///< NegativePressure::Allow
+  bool incompressible = false;      ///< SimulationMethod::Dfsph: the Mach number is not judged
+  bool boundary_particles = false;  ///< BoundaryHandling::Particles (no wall springs to advise on)
+  bool misses_pairs = false;        ///< NeighborMode::Adaptive: the lists can miss pairs coming into range
 };
 
 template <int D>

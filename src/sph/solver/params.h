@@ -152,6 +152,27 @@ struct EmitterParams {
   friend bool operator==(const EmitterParams&, const EmitterParams&) = default;
 };
 
+/// How the fluid's pressure is computed.
+enum class SimulationMethod {
+  /// Weakly compressible SPH (the paper): pressure from the EOS p = k (rho - rho0), explicit.
+  Wcsph,
+  /// Divergence-free SPH (Bender & Koschier 2015, 2017): pressures solved each step so that the
+  /// velocity field is divergence-free and the predicted density is rho0 (dfsph.h).
+  Dfsph,
+};
+
+/// DFSPH's two solves (Configuration keys of SPlisHSPlasH's names; docs/scene-format.md).
+struct DfsphParams {
+  int min_iterations = 2;         ///< constant-density solve: at least this many iterations
+  int max_iterations = 100;       ///< and at most this many
+  double max_error = 0.01;        ///< its tolerance: average compression (rho* - rho0) / rho0, %
+  bool divergence_solver = true;  ///< run the divergence solve
+  int max_iterations_v = 100;     ///< divergence solve: at most this many iterations
+  double max_error_v = 10;        ///< its tolerance: average (D rho / Dt) / rho0, % per second
+
+  friend bool operator==(const DfsphParams&, const DfsphParams&) = default;
+};
+
 /// How the time step is chosen.
 enum class TimeStepping {
   Fixed,  ///< every step takes SimulationParams::time_step
@@ -176,6 +197,8 @@ struct CflParams {
 template <int D>
 struct SimulationParams {
   double time_step = 1e-4;  ///< dt, s (fixed; with TimeStepping::Cfl the first step's largest)
+  SimulationMethod method = SimulationMethod::Wcsph;
+  DfsphParams dfsph;  ///< SimulationMethod::Dfsph's solves
   TimeStepping time_stepping = TimeStepping::Fixed;
   CflParams cfl;
   double particle_radius = 0.01;  ///< m; particles are spaced 2 radii apart initially

@@ -122,6 +122,15 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
     for (const TimeStepLimit& l : time_step_limits(params_))
       if (!l.acoustic) cfl_limit_ = std::min(cfl_limit_, kAutoTimeStepFraction * l.dt_warn);
   }
+  if (params_.method == SimulationMethod::Dfsph) {
+    if (params_.boundary.handling != BoundaryHandling::Particles)
+      throw Error(
+          "DFSPH needs boundary particles: penalty springs push with forces the pressure solve does not see, and "
+          "at DFSPH's large time steps they are unstable; set Configuration.boundaryHandling to \"particles\"",
+          "Configuration.simulationMethod");
+    dfsph_ =
+        std::make_unique<DfsphSolver<D, R>>(params_.dfsph, particles_, static_cast<R>(2.0 * params_.particle_radius));
+  }
   neighbors_ = make_neighbor_strategy<D, R>(params_.neighbors, opt);
   neighbors_->set_boundary(boundary_.position);
   if (params_.audit) auditor_ = std::make_unique<ListAuditor<D, R>>();
@@ -224,8 +233,19 @@ double Simulation<D, R>::next_time_step() const {
   // and the acoustic one with the flow's speed added to the sound's.
   dt = std::min(dt, cfl_limit_);
   const double c0 = std::sqrt(std::max(params_.fluid.stiffness, 0.0));
-  if (c0 + u > 0) dt = std::min(dt, kAutoTimeStepFraction * 0.4 * params_.kernel_radius / (c0 + u));
-  dt = std::min({dt, c.max_dt, 2.0 * last});
+  if (params_.method == SimulationMethod::Wcsph && c0 + u > 0)
+    dt = std::min(dt, kAutoTimeStepFraction * 0.4 * params_.kernel_radius / (c0 + u));
+  // DFSPH: the pressure solve says whether the last step was too long (SPlisHSPlasH's
+  // iteration-controlled CFL): one that did not converge halves the step, one that took more
+  // than half its iteration limit shortens it by 10 %, one that took more than a quarter holds
+  // it; the others let it grow by 20 % (WCSPH: by 100 %).
+  double growth = 2.0;
+  if (dfsph_ && steps_ > 0) {
+    const SolveStats& d = last_density_solve_;
+    const int most = params_.dfsph.max_iterations;
+    growth = !d.converged ? 0.5 : 2 * d.iterations > most ? 0.9 : 4 * d.iterations > most ? 1.0 : 1.2;
+  }
+  dt = std::min({dt, c.max_dt, growth * last});
   return std::max(dt, c.min_dt);
 }
 
@@ -284,16 +304,33 @@ const StepInfo& Simulation<D, R>::step() {
   }
 
   Stopwatch watch;
+  // (DFSPH: the EOS pressure this pass computes is replaced by the density solve's)
   info.pairs_within_h = compute_density_pressure(particles_, lists, h, params_.fluid, solid);
-  info.seconds.density = watch.lap();
+  const SmoothingKernels<D, R> kernels(params_.fluid, h);
+  const R rho0 = static_cast<R>(params_.fluid.rest_density);
+  if (dfsph_) {
+    dfsph_->compute_factors(particles_, lists, kernels, solid);
+    info.seconds.density = watch.lap();
+    // (its velocity change does not depend on dt: the last step's is as good as any)
+    if (params_.dfsph.divergence_solver)
+      info.divergence_solve =
+          dfsph_->divergence_solve(particles_, rho0, static_cast<R>(cfl() ? last_cfl_dt_ : params_.time_step));
+    info.seconds.solve = watch.lap();
+  } else {
+    info.seconds.density = watch.lap();
+  }
   const StepTime st = choose_time_step();
   const R dt = static_cast<R>(st.dt);
   info.dt = st.dt;
   const WallContact<D, R> walls(params_.container, params_.obstacles, static_cast<R>(params_.particle_radius),
                                 params_.walls, params_.boundary.handling == BoundaryHandling::Penalty);
   compute_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity), walls,
-                        neighbors_->pair_exit_flags(), dt, solid, neighbors_->pair_exit_radius());
+                        neighbors_->pair_exit_flags(), dt, solid, neighbors_->pair_exit_radius(), !dfsph_);
   info.seconds.forces = watch.lap();
+  if (dfsph_) {
+    info.density_solve = last_density_solve_ = dfsph_->density_solve(particles_, rho0, dt);
+    info.seconds.solve += watch.lap();
+  }
   ++steps_;  // counted even if the checks below throw (as before the passes were fused)
   if (cfl()) {
     time_ = st.lands ? st.end : time_ + st.dt;
@@ -445,6 +482,9 @@ void Simulation<D, R>::save_state(StateWriter& out) const {
   out.put(steps_);
   out.put(time_);
   out.put(last_cfl_dt_);
+  out.put(last_density_solve_.iterations);
+  out.put(last_density_solve_.error);
+  out.put(static_cast<std::uint8_t>(last_density_solve_.converged));
   out.put(emitters_);
   particles_.save(out);
   neighbors_->save_state(out);
@@ -460,6 +500,10 @@ void Simulation<D, R>::load_state(StateReader& in) {
   in.get(last_cfl_dt_);
   in.expect(std::isfinite(time_) && time_ >= 0 && std::isfinite(last_cfl_dt_) && last_cfl_dt_ >= 0,
             "a bad time or time step");
+  in.get(last_density_solve_.iterations);
+  in.get(last_density_solve_.error);
+  last_density_solve_.converged = in.get<std::uint8_t>() != 0;
+  in.expect(last_density_solve_.iterations >= 0, "a negative iteration count");
   in.get(emitters_);
   in.expect(emitters_.size() == params_.emitters.size(), "a different number of emitters");
   for (std::size_t k = 0; k < emitters_.size(); ++k)

@@ -9,6 +9,7 @@
 #include <sph/neighbors/reorder.h>
 #include <sph/neighbors/strategy.h>
 #include <sph/solver/boundary.h>
+#include <sph/solver/dfsph.h>
 #include <sph/solver/health.h>
 #include <sph/solver/params.h>
 #include <sph/solver/wcsph.h>
@@ -18,9 +19,11 @@ namespace sph {
 /// Wall seconds spent in each phase of one step.
 struct PhaseTimes {
   double grid = 0, lists = 0, density = 0, forces = 0, integrate = 0;
-  double total() const { return grid + lists + density + forces + integrate; }
+  double solve = 0;  ///< DFSPH's pressure solves (0 with WCSPH)
+  double total() const { return grid + lists + density + forces + integrate + solve; }
   PhaseTimes& operator+=(const PhaseTimes& o) {
     grid += o.grid, lists += o.lists, density += o.density, forces += o.forces, integrate += o.integrate;
+    solve += o.solve;
     return *this;
   }
 };
@@ -40,6 +43,8 @@ struct StepInfo {
   ListAudit boundary_audit;          ///< fluid-boundary pairs within h the boundary lists missed
   PhaseTimes seconds;                ///< (the audit's own time is in none of the phases)
   HealthStats health;                ///< measured in the integrate pass, judged by the health monitor
+  SolveStats density_solve;          ///< DFSPH: the constant-density solve (0 iterations with WCSPH)
+  SolveStats divergence_solve;       ///< DFSPH: the divergence solve
 };
 
 namespace detail {
@@ -175,7 +180,9 @@ class Simulation {
   double time_ = 0;         // TimeStepping::Cfl: simulated time, s
   double last_cfl_dt_ = 0;  // the last step's CFL step before barriers shortened it (its growth limit), s
   double barrier_ = kNoLimit;
-  double cfl_limit_ = kNoLimit;  // TimeStepping::Cfl: the scene's limits but the acoustic one, s
+  double cfl_limit_ = kNoLimit;               // TimeStepping::Cfl: the scene's limits but the acoustic one, s
+  std::unique_ptr<DfsphSolver<D, R>> dfsph_;  // SimulationMethod::Dfsph
+  SolveStats last_density_solve_;             // its last constant-density solve (the CFL step's feedback)
   HealthMonitor monitor_;
   StepInfo info_;
 };

@@ -15,11 +15,13 @@ template <int D, std::floating_point R>
 class SmoothingKernels {
  public:
   SmoothingKernels(KernelKind kind, R h, bool variational = false)
-      : kind_(kind), variational_(variational), poly6_(h), spiky_(h), cubic_(h), wendland_(h) {}
+      : kind_(kind), variational_(variational), h_(h), poly6_(h), spiky_(h), cubic_(h), wendland_(h) {}
   SmoothingKernels(const FluidParams& fluid, R h)
       : SmoothingKernels(fluid.kernel, h, fluid.pressure_force == PressureForce::Variational) {}
 
   KernelKind kind() const { return kind_; }
+  /// The support h, m.
+  R radius() const { return h_; }
   /// The density kernel W (poly6 for the paper's kernels) from the squared distance.
   R w_r2(R r2) const {
     switch (kind_) {
@@ -53,6 +55,7 @@ class SmoothingKernels {
  private:
   KernelKind kind_;
   bool variational_;
+  R h_;
   Poly6Kernel<D, R> poly6_;
   SpikyKernel<D, R> spiky_;
   CubicSplineKernel<D, R> cubic_;

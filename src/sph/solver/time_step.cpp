@@ -17,7 +17,8 @@ std::vector<TimeStepLimit> time_step_limits(const SimulationParams<D>& p) {
   const double h = p.kernel_radius;
   auto add = [&](const char* name, double warn, double refuse) { out.push_back({name, dt / warn, warn, refuse}); };
   const double c = std::sqrt(p.fluid.stiffness);
-  if (c > 0) {
+  // DFSPH solves for its pressure: there is no sound speed to resolve.
+  if (c > 0 && p.method == SimulationMethod::Wcsph) {
     add("acoustic CFL (dt <= 0.4 h / sqrt(stiffness))", 0.4 * h / c, 1.0 * h / c);
     out.back().acoustic = true;
   }
@@ -30,6 +31,12 @@ std::vector<TimeStepLimit> time_step_limits(const SimulationParams<D>& p) {
   if (p.fluid.viscosity_model == ViscosityModel::Artificial && nu_art > 0)
     add("artificial viscosity's diffusion (dt <= 0.125 h^2 / nu, nu = alpha h c0 / (2 (D + 2)))",
         0.125 * h * h / nu_art, 0.5 * h * h / nu_art);
+  // Boundary particles' friction (Akinci et al. 2012) is an artificial viscosity at the walls
+  // with nu = sigma h c0 / (2 (D + 2)): the same diffusion limit.
+  const double nu_wall = p.boundary.friction * h * c / (2.0 * (D + 2));
+  if (p.boundary.handling == BoundaryHandling::Particles && nu_wall > 0)
+    add("boundary friction's diffusion (dt <= 0.125 h^2 / nu, nu = boundaryFriction h c0 / (2 (D + 2)))",
+        0.125 * h * h / nu_wall, 0.5 * h * h / nu_wall);
   // Penalty walls only: boundary particles act through the pressure (the acoustic limit).
   const bool springs = p.boundary.handling == BoundaryHandling::Penalty;
   if (springs && p.walls.stiffness > 0) {

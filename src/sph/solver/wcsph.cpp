@@ -505,7 +505,7 @@ std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborList
 template <int D, std::floating_point R>
 void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                            const Vec<D, R>& gravity, const WallContact<D, R>& walls, std::span<std::uint8_t> exit_flags,
-                           R dt, const BoundaryView<D, R>& boundary, R exit_radius) {
+                           R dt, const BoundaryView<D, R>& boundary, R exit_radius, bool pressure_terms) {
   SPH_CHECK(exit_flags.empty() || exit_flags.size() == ps.size(), "one exit flag per particle");
   if (!(exit_radius > R(0))) exit_radius = h;
   check_pass_inputs(ps, lists);
@@ -521,6 +521,10 @@ void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
   // The kernel's pass for each form; with the cubic spline and Wendland C2 the variational
   // form is the symmetric one (the pressure gradient is the density kernel's anyway).
   const auto run_kernel = [&]<KernelKind kKernel>() {
+    if (!pressure_terms) {
+      run.template operator()<kKernel, PressureForce::Paper, false>();
+      return;
+    }
     if (fluid.gradient_correction == GradientCorrection::Renormalize) {
       // The form only matters to the pressure terms, which the corrected pass adds.
       run.template operator()<kKernel, PressureForce::Paper, false>();
@@ -579,7 +583,7 @@ double lattice_mass(double rest_density, double spacing, double h, KernelKind ke
                                                         const FluidParams&, const BoundaryView<D, R>&);             \
   template void compute_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&,        \
                                             const Vec<D, R>&, const WallContact<D, R>&, std::span<std::uint8_t>, R, \
-                                            const BoundaryView<D, R>&, R);
+                                            const BoundaryView<D, R>&, R, bool);
 SPH_INSTANTIATE(2, float)
 SPH_INSTANTIATE(2, double)
 SPH_INSTANTIATE(3, float)

@@ -134,11 +134,14 @@ class WallContact {
 /// every neighbor's position and velocity anyway, so the test costs a few operations per pair.
 /// `exit_radius` replaces h in the test where it is positive (the adaptive_exact mode's lists
 /// reach h + skin, and a pair is flagged when it is predicted to leave them).
+///
+/// `pressure_terms` false leaves the pressure terms out (fluid pairs and boundary samples): the
+/// non-pressure accelerations that DFSPH's solves start from (dfsph.h).
 template <int D, std::floating_point R>
 void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                            const Vec<D, R>& gravity, const WallContact<D, R>& walls,
                            std::span<std::uint8_t> exit_flags = {}, R dt = 0, const BoundaryView<D, R>& boundary = {},
-                           R exit_radius = 0);
+                           R exit_radius = 0, bool pressure_terms = true);
 
 /// Particle mass such that a particle inside a lattice of spacing dx (square in 2D, cubic in
 /// 3D) has exactly density rho0 under the density kernel's sum of Eq. 4 with support h (poly6

@@ -1,0 +1,353 @@
+#include <sph/solver/dfsph.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string_view>
+
+#include <sph/core/error.h>
+#include <sph/core/parallel.h>
+
+namespace sph {
+
+namespace {
+
+/// beta_i is at least this fraction of a particle's inside a full lattice: a particle with few
+/// neighbours whose kernel gradients nearly cancel (between boundary samples) cannot correct its
+/// density through them, and would take a huge pressure trying.
+constexpr double kBetaFloor = 0.1;
+
+/// Each solve starts from this fraction of its last step's s (the papers' warm start; SPlisHSPlasH
+/// takes half too). A full warm start carries the solve's unconverged, particle-to-particle
+/// oscillations of s from step to step (the conjugate gradients barely see them: they hardly
+/// change the density), and they grow into pairs of particles; half of them decays in a few steps.
+constexpr double kWarmStart = 0.5;
+
+/// A particle with at least this fraction of a lattice site's neighbours within h (fluid and
+/// boundary) has a full neighbourhood (SPlisHSPlasH's divergence solve takes 20 of about 33 in
+/// 3D and 7 of 12 in 2D, with h = 2 spacings).
+constexpr double kFullNeighbourhood = 0.75;
+
+/// The index of the added real field `name` of `ps`, added (zero) if absent.
+template <int D, std::floating_point R>
+std::size_t warm_field(ParticleSet<D, R>& ps, const char* name, const char* what) {
+  const std::ptrdiff_t k = ps.added_field_index(name);
+  if (k >= 0) return static_cast<std::size_t>(k);
+  // s (density solve) and s dt (divergence solve): m^(D+2) / (kg s^2) and m^(D+2) / (kg s).
+  const bool density = std::string_view(name) == DfsphSolver<D, R>::kDensityField;
+  return ps.add_field(
+      {name, FieldKind::Real, density ? "m^4/(kg s^2)" : "m^4/(kg s)", density ? "m^5/(kg s^2)" : "m^5/(kg s)", what});
+}
+
+/// Calls fluid(j, grad W_ij) for every listed neighbour j of i within h and solid(b, grad W_ib)
+/// for every listed boundary sample b within h.
+template <int D, std::floating_point R, class Fluid, class Solid>
+void for_neighbours(const ParticleSet<D, R>& ps, std::size_t i, const NeighborLists& lists,
+                    const SmoothingKernels<D, R>& kernels, const BoundaryView<D, R>& boundary, R h2, Fluid&& fluid,
+                    Solid&& solid) {
+  const Vec<D, R> xi = ps.position[i];
+  for (const std::uint32_t j : lists.of(i)) {
+    const Vec<D, R> rij = xi - ps.position[j];
+    if (norm2(rij) >= h2) continue;
+    fluid(j, kernels.gradient(rij));
+  }
+  if (boundary.active())
+    for (const std::uint32_t b : boundary.lists->of(i)) {
+      const Vec<D, R> rib = xi - boundary.position[b];
+      if (norm2(rib) >= h2) continue;
+      solid(b, kernels.gradient(rib));
+    }
+}
+
+}  // namespace
+
+template <int D, std::floating_point R>
+DfsphSolver<D, R>::DfsphSolver(const DfsphParams& params, ParticleSet<D, R>& ps, R spacing)
+    : params_(params), spacing_(spacing) {
+  warm_field(ps, kDensityField, "DFSPH: the constant-density solve's s = p / rho^2 of the last step");
+  warm_field(ps, kDivergenceField, "DFSPH: the divergence solve's s dt of the last step");
+}
+
+template <int D, std::floating_point R>
+void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const NeighborLists& lists,
+                                        const SmoothingKernels<D, R>& kernels, const BoundaryView<D, R>& boundary) {
+  const std::size_t n = ps.size();
+  beta_.resize(n);
+  const R h = kernels.radius(), h2 = h * h;
+  // The floor of beta: kBetaFloor times a full lattice's (where sum grad W = 0).
+  R floor = 0;
+  int lattice = 0;  // a lattice site's neighbours within h
+  if (n > 0 && spacing_ > R(0)) {
+    const int reach = static_cast<int>(std::ceil(h / spacing_));
+    double squares = 0;
+    Vec<D, R> x{};
+    const auto visit = [&](auto&& self, int d) -> void {
+      if (d == D) {
+        const R r2 = norm2(x);
+        if (r2 > R(0) && r2 < h2) squares += static_cast<double>(norm2(kernels.gradient(x))), ++lattice;
+        return;
+      }
+      for (int k = -reach; k <= reach; ++k) {
+        x[d] = static_cast<R>(k) * spacing_;
+        self(self, d + 1);
+      }
+    };
+    visit(visit, 0);
+    floor = static_cast<R>(kBetaFloor * squares) * ps.mass[0] * ps.mass[0];
+  }
+  full_.resize(n);
+  solid_.resize(n);
+  // The step's pairs within h, once: each solve iteration then reads m_j grad W_ij instead of
+  // evaluating the kernel again (about half the entries of a list are within h).
+  begin_.resize(n + 1);
+  parallel_for(n, [&](std::size_t i) {
+    std::uint32_t count = 0;
+    const Vec<D, R> xi = ps.position[i];
+    for (const std::uint32_t j : lists.of(i)) count += norm2(xi - ps.position[j]) < h2;
+    begin_[i + 1] = count;
+  });
+  begin_[0] = 0;
+  for (std::size_t i = 0; i < n; ++i) begin_[i + 1] += begin_[i];
+  pair_j_.resize(begin_[n]);
+  pair_g_.resize(begin_[n]);
+  const int full = static_cast<int>(std::ceil(kFullNeighbourhood * lattice));
+  parallel_for(n, [&](std::size_t i) {
+    Vec<D, R> sum{}, solid{};
+    R squares = 0;
+    int count = 0;
+    std::size_t k = begin_[i];
+    for_neighbours(
+        ps, i, lists, kernels, boundary, h2,
+        [&](std::uint32_t j, const Vec<D, R>& g) {
+          const Vec<D, R> mg = g * ps.mass[j];
+          pair_j_[k] = j, pair_g_[k] = mg, ++k;
+          sum += mg;
+          squares += ps.mass[j] * norm2(g);
+          ++count;
+        },
+        [&](std::uint32_t b, const Vec<D, R>& g) {
+          solid += g * boundary.psi[b];
+          ++count;
+        });
+    sum += solid;
+    solid_[i] = solid;
+    beta_[i] = std::max(norm2(sum) + ps.mass[i] * squares, floor);
+    full_[i] = count >= full;
+  });
+}
+
+template <int D, std::floating_point R>
+template <class F>
+double DfsphSolver<D, R>::active_sum(std::size_t n, F&& f) {
+  partial_.assign(chunk_count(n), 0.0);
+  parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
+    double sum = 0;
+    for (std::size_t i = b; i < e; ++i)
+      if (active_[i]) sum += f(i);
+    partial_[c] = sum;
+  });
+  double total = 0;
+  for (const double p : partial_) total += p;
+  return total;
+}
+
+template <int D, std::floating_point R>
+template <class V>
+R DfsphSolver<D, R>::density_rate(std::size_t i, V&& v) const {
+  const Vec<D, R> vi = v(i);
+  R rate = dot(vi, solid_[i]);
+  for (std::size_t k = begin_[i]; k < begin_[i + 1]; ++k) rate += dot(vi - v(pair_j_[k]), pair_g_[k]);
+  return rate;
+}
+
+template <int D, std::floating_point R>
+void DfsphSolver<D, R>::apply(const std::vector<R>& x, std::vector<Vec<D, R>>& out, std::vector<R>& ax) {
+  const std::size_t n = beta_.size();
+  parallel_for(n, [&](std::size_t i) {
+    const R xi = x[i];
+    Vec<D, R> a = solid_[i] * (-xi);
+    for (std::size_t k = begin_[i]; k < begin_[i + 1]; ++k) a -= pair_g_[k] * (xi + x[pair_j_[k]]);
+    out[i] = a;
+  });
+  parallel_for(n, [&](std::size_t i) { ax[i] = -density_rate(i, [&](std::size_t j) { return out[j]; }); });
+}
+
+template <int D, std::floating_point R>
+template <typename DfsphSolver<D, R>::Solve kSolve>
+SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
+  constexpr bool kDensity = kSolve == Solve::Density;
+  const std::size_t n = ps.size();
+  SPH_CHECK(beta_.size() == n, "DFSPH: compute_factors before the solves");
+  SolveStats stats;
+  if (n == 0 || !(dt > R(0))) return stats;
+  std::vector<R>& warm =
+      ps.real_field(static_cast<std::size_t>(ps.added_field_index(kDensity ? kDensityField : kDivergenceField)));
+  // Errors are scale (b - A s): a density (scale dt^2) or a density rate (scale dt).
+  const R scale = kDensity ? dt * dt : dt;
+  // The warm start keeps the dt-free quantity: s (density solve), dt s (divergence solve).
+  const R warm_scale = kDensity ? R(1) : dt;
+  const int min_iterations = kDensity ? std::max(params_.min_iterations, 0) : 0;
+  const int max_iterations = kDensity ? params_.max_iterations : params_.max_iterations_v;
+  // Tolerance on the average error over rho0: % and % per second.
+  const double tolerance =
+      0.01 * (kDensity ? params_.max_error : params_.max_error_v) * static_cast<double>(rho0) * static_cast<double>(n);
+  for (auto* v : {&b_, &s_, &r_, &z_, &p_, &as_, &ap_}) v->assign(n, R(0));
+  acc_s_.resize(n);
+  acc_p_.resize(n);
+  active_.assign(n, 0);
+
+  // The right-hand side b (an error over scale), and the active set: the compressed particles
+  // and those under pressure in the last step (inside a resting fluid, about half the particles
+  // expand a little in any step: they keep their pressure, and the solve balances it exactly).
+  parallel_for(n, [&](std::size_t i) {
+    R err;
+    if constexpr (kDensity)
+      err = ps.density[i] - rho0 +
+            dt * density_rate(i, [&](std::size_t j) { return ps.velocity[j] + ps.acceleration[j] * dt; });
+    else
+      err = density_rate(i, [&](std::size_t j) { return ps.velocity[j]; });
+    // (the divergence solve leaves out the particles without a full neighbourhood: at a free
+    // surface or in a splash, their velocity divergence is the kernel's truncation, not a flow
+    // to correct; SPlisHSPlasH does the same)
+    if (!kDensity && !full_[i]) err = 0;
+    b_[i] = err / scale;
+    active_[i] = err > R(0) || warm[i] > R(0);
+    s_[i] = active_[i] ? R(kWarmStart) * std::max(warm[i] / warm_scale, R(0)) : R(0);
+  });
+
+  // The error of the current s: the average compression (as the papers measure it).
+  const auto error_sum = [&] {
+    partial_.assign(chunk_count(n), 0.0);
+    parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
+      double sum = 0;
+      for (std::size_t i = b; i < e; ++i) sum += static_cast<double>(std::max(scale * (b_[i] - as_[i]), R(0)));
+      partial_[c] = sum;
+    });
+    double total = 0;
+    for (const double p : partial_) total += p;
+    return total;
+  };
+  apply(s_, acc_s_, as_);
+  double error = error_sum();
+  int iterations = 0;
+  const auto finished = [&] {
+    return iterations >= max_iterations || (iterations >= min_iterations && error <= tolerance);
+  };
+  if (!finished()) {
+    // Conjugate gradients on the active set, preconditioned by beta, kept feasible (s >= 0): a
+    // step that would take some s below zero is projected (those particles leave the set with
+    // s = 0: no tension; A s and a(s) are applied afresh), and the iteration restarts on the
+    // others. (Clamping only the final result would break up the near-cancelling pairs of large s
+    // of opposite signs that conjugate gradients can build on the way, and throw single particles
+    // at tens of m/s: the 2D dam break's splash did.)
+    double rz = 0;
+    const auto restart = [&] {
+      parallel_for(n, [&](std::size_t i) {
+        r_[i] = active_[i] ? b_[i] - as_[i] : R(0);
+        p_[i] = z_[i] = active_[i] ? r_[i] / beta_[i] : R(0);
+      });
+      rz = active_sum(n, [&](std::size_t i) { return static_cast<double>(r_[i]) * static_cast<double>(z_[i]); });
+    };
+    restart();
+    while (!finished()) {
+      apply(p_, acc_p_, ap_);
+      ++iterations;
+      const double pap =
+          active_sum(n, [&](std::size_t i) { return static_cast<double>(p_[i]) * static_cast<double>(ap_[i]); });
+      if (!(pap > 0)) break;  // (no direction left: A is only semi-definite)
+      const R alpha = static_cast<R>(rz / pap);
+      bool negative = false;
+      for (std::size_t i = 0; i < n && !negative && !kDensity; ++i)
+        negative = active_[i] && s_[i] + alpha * p_[i] < R(0);
+      if (negative) {
+        // Projected: the particles the step takes below zero leave the set with s = 0, the
+        // others take the step; A s and a(s) are applied afresh, and the iteration restarts.
+        for (std::size_t i = 0; i < n; ++i) {
+          if (!active_[i]) continue;
+          s_[i] += alpha * p_[i];
+          if (s_[i] <= R(0)) s_[i] = 0, active_[i] = 0;
+        }
+        apply(s_, acc_s_, as_);
+        ++iterations;
+        error = error_sum();
+        restart();
+        continue;
+      }
+      parallel_for(n, [&](std::size_t i) {
+        s_[i] += alpha * p_[i];
+        acc_s_[i] += acc_p_[i] * alpha;
+        as_[i] += alpha * ap_[i];
+      });
+      parallel_for(n, [&](std::size_t i) {
+        r_[i] = active_[i] ? b_[i] - as_[i] : R(0);
+        z_[i] = active_[i] ? r_[i] / beta_[i] : R(0);
+      });
+      error = error_sum();
+      // The active set's own residual: once it is well below the tolerance, what is left is the
+      // compression of particles outside it, which the projected iterations below take.
+      const double active_error =
+          active_sum(n, [&](std::size_t i) { return std::abs(static_cast<double>(scale * r_[i])); });
+      if (active_error <= 0.5 * tolerance) break;
+      const double rz_new =
+          active_sum(n, [&](std::size_t i) { return static_cast<double>(r_[i]) * static_cast<double>(z_[i]); });
+      const R ratio = static_cast<R>(rz > 0 ? rz_new / rz : 0.0);
+      rz = rz_new;
+      parallel_for(n, [&](std::size_t i) { p_[i] = active_[i] ? z_[i] + ratio * p_[i] : R(0); });
+    }
+    // No tension: a negative s is released.
+    bool negative = false;
+    for (std::size_t i = 0; i < n; ++i) negative = negative || s_[i] < R(0);
+    if (negative) {
+      for (std::size_t i = 0; i < n; ++i) s_[i] = std::max(s_[i], R(0));
+      apply(s_, acc_s_, as_);
+      ++iterations;
+      error = error_sum();
+    }
+  }
+  // The published iteration (projected Jacobi): each compressed particle adds the pressure that
+  // would remove its own compression, ds = e / (scale beta) >= 0.
+  while (!finished()) {
+    parallel_for(n, [&](std::size_t i) { p_[i] = std::max(b_[i] - as_[i], R(0)) / beta_[i]; });
+    apply(p_, acc_p_, ap_);
+    ++iterations;
+    parallel_for(n, [&](std::size_t i) {
+      s_[i] += p_[i];
+      acc_s_[i] += acc_p_[i];
+      as_[i] += ap_[i];
+    });
+    error = error_sum();
+  }
+  stats.iterations = iterations;
+  stats.error = 100.0 * error / static_cast<double>(n) / static_cast<double>(rho0);
+  stats.converged = error <= tolerance;
+  // The pressure of the step: the divergence solve's velocity change dt_v a(s_v) = dt a(s_v dt_v
+  // / dt) at the step's start acts with this solve's, a(s) being linear in s.
+  const std::vector<R>* divergence =
+      kDensity ? &ps.real_field(static_cast<std::size_t>(ps.added_field_index(kDivergenceField))) : nullptr;
+  parallel_for(n, [&](std::size_t i) {
+    warm[i] = s_[i] * warm_scale;
+    if constexpr (kDensity) {
+      ps.acceleration[i] += acc_s_[i];
+      ps.pressure[i] = (s_[i] + (*divergence)[i] / dt) * ps.density[i] * ps.density[i];
+    } else {
+      ps.velocity[i] += acc_s_[i] * dt;
+    }
+  });
+  return stats;
+}
+
+template <int D, std::floating_point R>
+SolveStats DfsphSolver<D, R>::divergence_solve(ParticleSet<D, R>& ps, R rho0, R dt) {
+  return solve<Solve::Divergence>(ps, rho0, dt);
+}
+
+template <int D, std::floating_point R>
+SolveStats DfsphSolver<D, R>::density_solve(ParticleSet<D, R>& ps, R rho0, R dt) {
+  return solve<Solve::Density>(ps, rho0, dt);
+}
+
+template class DfsphSolver<2, float>;
+template class DfsphSolver<2, double>;
+template class DfsphSolver<3, float>;
+template class DfsphSolver<3, double>;
+
+}  // namespace sph

@@ -1,0 +1,123 @@
+#pragma once
+/// \file DFSPH: divergence-free SPH (Bender & Koschier, "Divergence-free smoothed particle
+/// hydrodynamics", SCA 2015; "Divergence-Free SPH for Incompressible and Viscous Fluids", IEEE
+/// TVCG 2017): two pressure solves per step on the step's neighbor lists.
+///
+/// Both solves find per-particle values s_i (a pressure over density squared, p_i / rho_i^2)
+/// whose pressure accelerations
+///   a_i(s) = -sum_j m_j (s_i + s_j) grad W_ij - sum_b psi_b s_i grad W_ib
+/// (fluid neighbours j, boundary samples b with psi_b in place of a mass and the particle's own
+/// s mirrored onto them; the symmetric pair form, so momentum is conserved) cancel a predicted
+/// density error. With the density rate of a velocity field,
+///   (J v)_i = sum_j m_j (v_i - v_j) . grad W_ij + sum_b psi_b v_i . grad W_ib,
+/// the operator A s = -J a(s) is symmetric positive semi-definite (all particles have the same
+/// mass: A = J M^-1 J^T m), and its diagonal is DFSPH's factor
+///   beta_i = |sum_j m_j grad W_ij + sum_b psi_b grad W_ib|^2 + m_i sum_j m_j |grad W_ij|^2
+/// (the papers' alpha_i = rho_i / beta_i).
+///  - The constant-density solve (after the non-pressure forces, with v* = v + dt a): the
+///    predicted error e_i = rho_i + dt (J v*)_i - rho0 must vanish, dt^2 A s = e, and the
+///    accelerations a(s) are added to a.
+///  - The divergence solve (at the start of a step, on the velocities): (J v)_i must vanish,
+///    dt A s = J v, and v changes by dt a(s) (a change that does not depend on dt).
+/// As in the papers, only compression is an error and no s is negative (no tension): the
+/// solution is that of a complementarity problem (s >= 0, error <= 0, one of them 0 for each
+/// particle). The published solves iterate a projected Jacobi step s += max(e, 0) / (dt^2 beta),
+/// which needs many iterations on the smooth, deep modes a hydrostatic column has. Here each
+/// solve first runs conjugate gradients, preconditioned by beta, on the active set: the
+/// particles compressed now or under pressure in the last step, whose errors it drives to zero
+/// both ways (it converges in about the square root of Jacobi's iterations). A negative s is
+/// then released (s = 0), and the published projected Jacobi steps finish the solve: they add
+/// pressure where particles outside the set were left compressed. A solve stops when the
+/// average compression over all particles is below its tolerance (after at least its least
+/// iterations), or at its most iterations.
+///
+/// Each solve starts from its s of the last step (warm start; kept per particle as s for the
+/// density solve and s dt for the divergence solve, the dt-free quantities). beta has a floor, a
+/// tenth of a full lattice's: a particle among few neighbours whose gradients nearly cancel
+/// would otherwise take a huge s. The gradient is the pressure force's (SmoothingKernels::gradient:
+/// spiky with the paper's kernels, the density kernel's own with the cubic spline and Wendland
+/// C2). Sums over particles are summed in fixed chunks: results are the same for any thread
+/// count.
+
+#include <cstdint>
+#include <vector>
+
+#include <sph/core/particle_set.h>
+#include <sph/neighbors/neighbor_lists.h>
+#include <sph/solver/params.h>
+#include <sph/solver/smoothing.h>
+#include <sph/solver/wcsph.h>
+
+namespace sph {
+
+/// What one solve did.
+struct SolveStats {
+  int iterations = 0;     ///< iterations (each one applies A once: two passes over the neighbours)
+  double error = 0;       ///< the average error after them: % (density), % per second (divergence)
+  bool converged = true;  ///< the error reached the tolerance
+};
+
+/// The DFSPH solves of one run. Its warm-start values are particle fields (added to the
+/// ParticleSet by the constructor): they follow reordering, emission and checkpoints.
+template <int D, std::floating_point R>
+class DfsphSolver {
+ public:
+  /// Field names of the warm-start values in the ParticleSet.
+  static constexpr const char* kDensityField = "dfsph_density_s";
+  static constexpr const char* kDivergenceField = "dfsph_divergence_s_dt";
+
+  /// Adds the warm-start fields to `ps` (if absent). `spacing`: the particles' rest spacing
+  /// (2 particleRadius), which sets the floor of beta (a tenth of a full lattice's).
+  DfsphSolver(const DfsphParams& params, ParticleSet<D, R>& ps, R spacing);
+
+  /// Computes beta_i of the particles' positions, and keeps the step's pairs within h (with
+  /// m_j grad W_ij) for the solves.
+  void compute_factors(const ParticleSet<D, R>& ps, const NeighborLists& lists, const SmoothingKernels<D, R>& kernels,
+                       const BoundaryView<D, R>& boundary);
+  /// The divergence solve: changes ps.velocity. Needs compute_factors of this state.
+  SolveStats divergence_solve(ParticleSet<D, R>& ps, R rho0, R dt);
+  /// The constant-density solve: adds the pressure accelerations to ps.acceleration (which holds
+  /// the non-pressure ones) and sets ps.pressure (Pa) to the step's: rho^2 (s + s_v dt_v / dt)
+  /// with the divergence solve's s_v of this step (run before it with the last step dt_v: its
+  /// velocity change dt_v a(s_v) acts with dt a(s), so the two solves share the load of a
+  /// resting column). Needs compute_factors.
+  SolveStats density_solve(ParticleSet<D, R>& ps, R rho0, R dt);
+
+  /// beta_i of the last compute_factors (tests).
+  const std::vector<R>& factors() const { return beta_; }
+
+ private:
+  enum class Solve { Density, Divergence };
+  template <Solve kSolve>
+  SolveStats solve(ParticleSet<D, R>& ps, R rho0, R dt);
+  /// out = a(x) (the pressure accelerations of a field x), then ax = A x = -J out.
+  void apply(const std::vector<R>& x, std::vector<Vec<D, R>>& out, std::vector<R>& ax);
+  /// (J v)_i: the density rate of particle i under the velocities v(j), on the step's pairs.
+  template <class V>
+  R density_rate(std::size_t i, V&& v) const;
+  /// sum over active particles of f(i), in fixed chunks (the same for any thread count).
+  template <class F>
+  double active_sum(std::size_t n, F&& f);
+
+  DfsphParams params_;
+  R spacing_;
+  std::vector<R> beta_;               // per particle: A's diagonal
+  std::vector<std::uint8_t> active_;  // per particle: under pressure in this solve
+  std::vector<std::uint8_t> full_;    // per particle: a full neighbourhood (compute_factors)
+  // The step's fluid pairs within h (compute_factors): particle i's are begin_[i] .. begin_[i+1],
+  // each its neighbour j and m_j grad W_ij; and sum_b psi_b grad W_ib over its boundary samples.
+  std::vector<std::size_t> begin_;
+  std::vector<std::uint32_t> pair_j_;
+  std::vector<Vec<D, R>> pair_g_;
+  std::vector<Vec<D, R>> solid_;
+  std::vector<R> b_, s_, r_, z_, p_, as_, ap_;
+  std::vector<Vec<D, R>> acc_s_, acc_p_;
+  std::vector<double> partial_;  // per-chunk sums
+};
+
+extern template class DfsphSolver<2, float>;
+extern template class DfsphSolver<2, double>;
+extern template class DfsphSolver<3, float>;
+extern template class DfsphSolver<3, double>;
+
+}  // namespace sph

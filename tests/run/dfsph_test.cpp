@@ -1,0 +1,158 @@
+// DFSPH (Configuration.simulationMethod "dfsph"): its solves hold the density at rest where the
+// weakly compressible solver at the same settings does not, the pressure it reports holds the
+// column up, its steps are long, no pressure is negative, and its runs are deterministic and
+// resume bit for bit.
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <sph/core/parallel.h>
+#include <sph/run/driver.h>
+#include <sph/run/resume.h>
+#include <sph/scene/scene_reader.h>
+
+#include "support/temp_dir.h"
+
+namespace sph {
+namespace {
+
+using test::entries;
+using test::slurp;
+using test::TempDir;
+
+/// The validation's 2D DFSPH tank at twice its spacing (20 x 20 particles), to `stop` seconds.
+SceneDesc coarse_tank(double stop, const std::vector<std::string>& more = {}) {
+  std::vector<std::string> sets{"Configuration.particleRadius=0.005", "Configuration.kernelRadius=0.025",
+                                "Configuration.stopAt=" + std::to_string(stop), "Configuration.outputFps=0"};
+  sets.insert(sets.end(), more.begin(), more.end());
+  return read_scene_file(SPH_SOURCE_DIR "/scenes/validation/hydrostatic_2d_dfsph.json", sets);
+}
+
+struct ThreadCount {
+  int saved = num_threads();
+  ~ThreadCount() { set_num_threads(saved); }
+};
+
+struct TankRun {
+  double rho_max = 0;       // the largest density / rho0 of any step
+  double min_pressure = 0;  // the smallest pressure of any particle at any step, Pa
+  double mean_dt = 0;       // s
+  int unconverged = 0;      // density solves that ran out of iterations
+  double bottom_ratio = 0;  // at the end: mean p / (rho0 g depth) of the particles in the lower half
+  double bottom_error = 0;  // and their mean |rho - rho0| / rho0
+  std::int64_t steps = 0;
+};
+
+TankRun run_tank(const SceneDesc& desc) {
+  RunDriver<2, double> run(desc, RunSettings{});
+  const SimulationParams<2>& p = run.simulation().params();
+  TankRun out;
+  out.min_pressure = 1e300;
+  const bool by_time = desc.end_time > 0;  // (WCSPH takes fixed steps: stopAt is a step count)
+  while (by_time ? run.simulation().time() < desc.end_time * (1 - 1e-12) : run.simulation().steps_done() < desc.steps) {
+    const StepInfo& info = run.step();
+    out.rho_max = std::max(out.rho_max, info.health.rho_max);
+    out.unconverged += !info.density_solve.converged;
+    for (const double pr : run.simulation().particles().pressure) out.min_pressure = std::min(out.min_pressure, pr);
+  }
+  const auto& ps = run.simulation().particles();
+  out.steps = run.simulation().steps_done();
+  out.mean_dt = run.simulation().time() / static_cast<double>(out.steps);
+  double top = 0;
+  for (const auto& x : ps.position) top = std::max(top, x[1]);
+  const double surface = top + p.particle_radius, g = -p.gravity[1], rho0 = p.fluid.rest_density;
+  double ratio = 0;
+  int count = 0;
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    const double depth = surface - ps.position[i][1];
+    if (depth < 0.5 * surface) continue;
+    ratio += ps.pressure[i] / (rho0 * g * depth);
+    out.bottom_error += std::abs(ps.density[i] / rho0 - 1);
+    ++count;
+  }
+  out.bottom_ratio = ratio / count;
+  out.bottom_error /= count;
+  return out;
+}
+
+TEST(Dfsph, HoldsARestingTankAtRestDensityWithLongSteps) {
+  const TankRun dfsph = run_tank(coarse_tank(0.6));
+  EXPECT_EQ(dfsph.unconverged, 0) << "every constant-density solve reached maxError";
+  EXPECT_LT(dfsph.rho_max, 1.01) << "no particle is ever compressed by a percent";
+  EXPECT_LT(dfsph.bottom_error, 5e-4) << "the lower half is within 0.05 % of rest density";
+  EXPECT_GE(dfsph.min_pressure, 0.0) << "no tension";
+  // The pressure holds the column up: p near rho0 g depth in the lower half.
+  EXPECT_NEAR(dfsph.bottom_ratio, 1.0, 0.25);
+  // The weakly compressible solver at its acoustic limit (0.4 h / sqrt(stiffness)): DFSPH's CFL
+  // steps are several times longer.
+  const SceneDesc wcsph_desc = coarse_tank(0.6, {"Configuration.simulationMethod=\"wcsph\""});
+  const SimulationParams<2>& w = wcsph_desc.body<2>().sim;
+  const double acoustic = 0.4 * w.kernel_radius / std::sqrt(w.fluid.stiffness);
+  EXPECT_GT(dfsph.mean_dt, 3 * acoustic);
+  // and compresses the lower half more, at its short steps, than DFSPH does at its long ones.
+  const TankRun wcsph = run_tank(wcsph_desc);
+  EXPECT_GT(wcsph.bottom_error, 3 * dfsph.bottom_error);
+}
+
+TEST(Dfsph, PenaltyWallsAreRefused) {
+  try {
+    (void)read_scene_file(SPH_SOURCE_DIR "/scenes/validation/hydrostatic_2d_dfsph.json",
+                          {"Configuration.boundaryHandling=\"penalty\""});
+    FAIL() << "DFSPH with penalty walls was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("DFSPH needs boundary particles"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Dfsph, TheThreadCountChangesNothing) {
+  ThreadCount restore;
+  const SceneDesc desc = coarse_tank(0.1);
+  std::vector<std::vector<Vec<2, double>>> positions;
+  std::vector<std::vector<double>> pressures;
+  std::vector<std::int64_t> steps;
+  for (int threads : {1, 2}) {
+    set_num_threads(threads);
+    RunDriver<2, double> run(desc, RunSettings{});
+    while (run.simulation().time() < 0.1 * (1 - 1e-12)) run.step();
+    positions.push_back(run.simulation().particles().position);
+    pressures.push_back(run.simulation().particles().pressure);
+    steps.push_back(run.simulation().steps_done());
+  }
+  EXPECT_EQ(steps[0], steps[1]);
+  EXPECT_TRUE(positions[0] == positions[1]);
+  EXPECT_TRUE(pressures[0] == pressures[1]);
+}
+
+TEST(Dfsph, AStoppedRunResumesBitForBit) {
+  TempDir tmp;
+  // The paper's tank in DFSPH: an emitter, CFL steps, the warm-start fields in the checkpoint.
+  const SceneDesc desc = read_scene_file(
+      SPH_SOURCE_DIR "/scenes/dfsph/tank_fill_3d.json",
+      {"Configuration.stopAt=0.08", "Configuration.outputFps=100", "Configuration.neighbors=\"adaptive\""});
+  {
+    RunDriver<3, double> full(desc, RunSettings{tmp / "full"});
+    ASSERT_EQ(full.run().status, RunStatus::Completed);
+  }
+  RunCallbacks stop;
+  stop.stop_requested = [](std::int64_t done) { return done == 21 ? std::string("a test") : std::string(); };
+  {
+    RunDriver<3, double> part(desc, RunSettings{tmp / "part"});
+    ASSERT_EQ(part.run(stop).status, RunStatus::Interrupted);
+  }
+  RunToResume r = open_run_to_resume(tmp / "part");
+  RunDriver<3, double> resumed(r.desc, *r.checkpoint, RunSettings{tmp / "part", r.checkpoint_every});
+  ASSERT_EQ(resumed.run().status, RunStatus::Completed);
+  const std::vector<std::string> names = entries(tmp / "full" / "frames");
+  ASSERT_EQ(names, entries(tmp / "part" / "frames"));
+  ASSERT_EQ(names.size(), 9u);
+  for (const auto& n : names)
+    EXPECT_TRUE(slurp(tmp / "full" / "frames" / n) == slurp(tmp / "part" / "frames" / n)) << n << " differs";
+}
+
+}  // namespace
+}  // namespace sph

@@ -33,7 +33,7 @@ STATS_COLUMNS = ("step,time,particles,kinetic_energy,max_speed,mean_neighbors,li
                  "boundary_pairs_stored,boundary_missed_pairs,"
                  "entries_rebuilt,list_insertions,list_removals,list_overflows,skin,dt,solver_iterations,density_error,"
                  "divergence_iterations,divergence_error,t_solve")
-PHASES = ("grid", "lists", "density", "forces", "integrate", "output")
+PHASES = ("grid", "lists", "density", "forces", "integrate", "solve", "output")
 POINT_FIELDS = {"velocity": 3, "density": 1, "pressure": 1, "id": 1, "initial_position": 3}
 
 
@@ -171,7 +171,7 @@ def check_run(out, *, what, dim, precision, steps, every, dt, expected_particles
         ms = float(r["max_speed"])
         check(math.isfinite(ke) and ke >= 0 and math.isfinite(ms) and ms >= 0,
               f"{what}: stats.csv step {i} kinetic_energy {ke} / max_speed {ms}")
-        for c in ("t_grid", "t_lists", "t_density", "t_forces", "t_integrate", "t_output"):
+        for c in ("t_grid", "t_lists", "t_density", "t_forces", "t_integrate", "t_solve", "t_output"):
             check(float(r[c]) >= 0, f"{what}: stats.csv step {i} {c} = {r[c]} < 0")
     check(int(rows[-1]["particles"]) == summary["particles"],
           f"{what}: last stats row particles {rows[-1]['particles']} != summary {summary['particles']}")

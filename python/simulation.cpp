@@ -409,9 +409,12 @@ after the current step with KeyboardInterrupt; the simulation stays usable.)doc"
       .def_property_readonly(
           "dt",
           [](const PySimulation& s) {
-            return s.visit([](const auto& d) { return d.simulation().params().time_step; });
+            return s.visit([](const auto& d) {
+              const auto& sim = d.simulation();
+              return sim.steps_done() > 0 && sim.last_step().dt > 0 ? sim.last_step().dt : sim.params().time_step;
+            });
           },
-          "The time step, s.")
+          "The time step, s: the last step's (CFL steps vary; Configuration.timeStepSize before the first step).")
       .def_property_readonly(
           "dimension",
           [](const PySimulation& s) {

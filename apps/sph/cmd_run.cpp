@@ -214,14 +214,18 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesyste
   const auto sim_ms = [&] { return static_cast<std::int64_t>(std::llround(sim.time() * 1e3)); };
   const std::int64_t first_ms = sim_ms();
   const std::string length =
-      by_time ? fmt::format("to t = {:.6g} s in CFL steps of {:.4g} to {:.4g} s", desc.end_time,
-                            sim.params().cfl.min_dt, sim.params().cfl.max_dt)
-              : fmt::format(
-                    "{} {}steps of {:.4g} s", desc.steps, sim.params().time_stepping == TimeStepping::Cfl ? "CFL " : "",
-                    sim.params().time_stepping == TimeStepping::Cfl ? sim.params().cfl.max_dt : sim.params().time_step);
-  fmt::print(stderr, "sph: {} ({}D, {}, {} neighbors, {} thread{}): {} particles{}, {}{} -> {}\n", desc.name, D,
-             std::is_same_v<R, float> ? "float" : "double", info.mode, info.threads, info.threads == 1 ? "" : "s",
-             sim.particles().size(), sim.params().emitters.empty() ? "" : " (emitters add more)", length,
+      by_time
+          ? fmt::format("to t = {:.6g} s in CFL steps of {:.4g} to {:.4g} s", desc.end_time, sim.params().cfl.min_dt,
+                        sim.params().cfl.max_dt)
+          : fmt::format(
+                "{} {}steps of {}{:.4g} s", desc.steps, sim.params().time_stepping == TimeStepping::Cfl ? "CFL " : "",
+                sim.params().time_stepping == TimeStepping::Cfl ? "at most " : "",
+                sim.params().time_stepping == TimeStepping::Cfl ? sim.params().cfl.max_dt : sim.params().time_step);
+  fmt::print(stderr, "sph: {} ({}D, {}, {}{} neighbors, {} thread{}): {} particles{}, {}{} -> {}\n", desc.name, D,
+             std::is_same_v<R, float> ? "float" : "double",
+             sim.params().method == SimulationMethod::Dfsph ? "DFSPH, " : "", info.mode, info.threads,
+             info.threads == 1 ? "" : "s", sim.particles().size(),
+             sim.params().emitters.empty() ? "" : " (emitters add more)", length,
              checkpoint ? fmt::format(", resumed at step {}", first) : std::string(), dir.string());
   const Progress::Mode mode =
       opt.no_progress ? Progress::Mode::Off : (::isatty(STDERR_FILENO) ? Progress::Mode::Bar : Progress::Mode::Lines);

@@ -111,9 +111,7 @@ void read_solver(ObjectReader& c, SimulationParams<D>& sim) {
                            c.choice("simulationMethod", names_of(detail::kSimulationMethodNames), "wcsph"));
   if (sim.method == SimulationMethod::Dfsph && sim.boundary.handling != BoundaryHandling::Particles)
     c.ctx().fail(c.child("simulationMethod"),
-                 "DFSPH needs boundary particles: penalty springs push with forces the pressure solve does not see, "
-                 "and at DFSPH's large time steps they are unstable; set Configuration.boundaryHandling to "
-                 "\"particles\" (or use simulationMethod \"wcsph\")");
+                 fmt::format("{} (or use simulationMethod \"wcsph\")", kDfsphNeedsBoundaryParticles));
   DfsphParams& p = sim.dfsph;
   p.min_iterations = static_cast<int>(
       c.integer("minIterations", "DFSPH's least constant-density iterations, 0 to 10000", 0, 10000, p.min_iterations));

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <string_view>
 
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
@@ -27,15 +26,10 @@ constexpr double kWarmStart = 0.5;
 /// 3D and 7 of 12 in 2D, with h = 2 spacings).
 constexpr double kFullNeighbourhood = 0.75;
 
-/// The index of the added real field `name` of `ps`, added (zero) if absent.
+/// Adds the real field `name` (its units in 2D and 3D) to `ps` if absent.
 template <int D, std::floating_point R>
-std::size_t warm_field(ParticleSet<D, R>& ps, const char* name, const char* what) {
-  const std::ptrdiff_t k = ps.added_field_index(name);
-  if (k >= 0) return static_cast<std::size_t>(k);
-  // s (density solve) and s dt (divergence solve): m^(D+2) / (kg s^2) and m^(D+2) / (kg s).
-  const bool density = std::string_view(name) == DfsphSolver<D, R>::kDensityField;
-  return ps.add_field(
-      {name, FieldKind::Real, density ? "m^4/(kg s^2)" : "m^4/(kg s)", density ? "m^5/(kg s^2)" : "m^5/(kg s)", what});
+void warm_field(ParticleSet<D, R>& ps, const char* name, const char* unit_2d, const char* unit_3d, const char* what) {
+  if (ps.added_field_index(name) < 0) ps.add_field({name, FieldKind::Real, unit_2d, unit_3d, what});
 }
 
 /// Calls fluid(j, grad W_ij) for every listed neighbour j of i within h and solid(b, grad W_ib)
@@ -63,8 +57,9 @@ void for_neighbours(const ParticleSet<D, R>& ps, std::size_t i, const NeighborLi
 template <int D, std::floating_point R>
 DfsphSolver<D, R>::DfsphSolver(const DfsphParams& params, ParticleSet<D, R>& ps, R spacing)
     : params_(params), spacing_(spacing) {
-  warm_field(ps, kDensityField, "DFSPH: the constant-density solve's s = p / rho^2 of the last step");
-  warm_field(ps, kDivergenceField, "DFSPH: the divergence solve's s dt of the last step");
+  warm_field(ps, kDensityField, "m^4/(kg s^2)", "m^5/(kg s^2)",
+             "DFSPH: the constant-density solve's s = p / rho^2 of the last step");
+  warm_field(ps, kDivergenceField, "m^4/(kg s)", "m^5/(kg s)", "DFSPH: the divergence solve's s dt of the last step");
 }
 
 template <int D, std::floating_point R>
@@ -73,12 +68,12 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
   const std::size_t n = ps.size();
   beta_.resize(n);
   const R h = kernels.radius(), h2 = h * h;
-  // The floor of beta: kBetaFloor times a full lattice's (where sum grad W = 0).
-  R floor = 0;
-  int lattice = 0;  // a lattice site's neighbours within h
-  if (n > 0 && spacing_ > R(0)) {
+  // Once (the first call with particles: an emitter scene may start empty): the floor of beta,
+  // kBetaFloor times a full lattice site's (where sum grad W = 0), and a full neighbourhood.
+  if (!lattice_done_ && n > 0 && spacing_ > R(0)) {
     const int reach = static_cast<int>(std::ceil(h / spacing_));
     double squares = 0;
+    int lattice = 0;  // a lattice site's neighbours within h
     Vec<D, R> x{};
     const auto visit = [&](auto&& self, int d) -> void {
       if (d == D) {
@@ -92,7 +87,9 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
       }
     };
     visit(visit, 0);
-    floor = static_cast<R>(kBetaFloor * squares) * ps.mass[0] * ps.mass[0];
+    beta_floor_ = static_cast<R>(kBetaFloor * squares) * ps.mass[0] * ps.mass[0];
+    full_count_ = static_cast<int>(std::ceil(kFullNeighbourhood * lattice));
+    lattice_done_ = true;
   }
   full_.resize(n);
   solid_.resize(n);
@@ -109,7 +106,6 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
   for (std::size_t i = 0; i < n; ++i) begin_[i + 1] += begin_[i];
   pair_j_.resize(begin_[n]);
   pair_g_.resize(begin_[n]);
-  const int full = static_cast<int>(std::ceil(kFullNeighbourhood * lattice));
   parallel_for(n, [&](std::size_t i) {
     Vec<D, R> sum{}, solid{};
     R squares = 0;
@@ -130,19 +126,18 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
         });
     sum += solid;
     solid_[i] = solid;
-    beta_[i] = std::max(norm2(sum) + ps.mass[i] * squares, floor);
-    full_[i] = count >= full;
+    beta_[i] = std::max(norm2(sum) + ps.mass[i] * squares, beta_floor_);
+    full_[i] = count >= full_count_;
   });
 }
 
 template <int D, std::floating_point R>
 template <class F>
-double DfsphSolver<D, R>::active_sum(std::size_t n, F&& f) {
+double DfsphSolver<D, R>::chunked_sum(std::size_t n, F&& f) {
   partial_.assign(chunk_count(n), 0.0);
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     double sum = 0;
-    for (std::size_t i = b; i < e; ++i)
-      if (active_[i]) sum += f(i);
+    for (std::size_t i = b; i < e; ++i) sum += f(i);
     partial_[c] = sum;
   });
   double total = 0;
@@ -216,15 +211,11 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
 
   // The error of the current s: the average compression (as the papers measure it).
   const auto error_sum = [&] {
-    partial_.assign(chunk_count(n), 0.0);
-    parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
-      double sum = 0;
-      for (std::size_t i = b; i < e; ++i) sum += static_cast<double>(std::max(scale * (b_[i] - as_[i]), R(0)));
-      partial_[c] = sum;
-    });
-    double total = 0;
-    for (const double p : partial_) total += p;
-    return total;
+    return chunked_sum(n, [&](std::size_t i) { return static_cast<double>(std::max(scale * (b_[i] - as_[i]), R(0))); });
+  };
+  // Sums over the active set.
+  const auto active_sum = [&](auto&& f) {
+    return chunked_sum(n, [&](std::size_t i) { return active_[i] ? f(i) : 0.0; });
   };
   apply(s_, acc_s_, as_);
   double error = error_sum();
@@ -245,14 +236,14 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
         r_[i] = active_[i] ? b_[i] - as_[i] : R(0);
         p_[i] = z_[i] = active_[i] ? r_[i] / beta_[i] : R(0);
       });
-      rz = active_sum(n, [&](std::size_t i) { return static_cast<double>(r_[i]) * static_cast<double>(z_[i]); });
+      rz = active_sum([&](std::size_t i) { return static_cast<double>(r_[i]) * static_cast<double>(z_[i]); });
     };
     restart();
     while (!finished()) {
       apply(p_, acc_p_, ap_);
       ++iterations;
       const double pap =
-          active_sum(n, [&](std::size_t i) { return static_cast<double>(p_[i]) * static_cast<double>(ap_[i]); });
+          active_sum([&](std::size_t i) { return static_cast<double>(p_[i]) * static_cast<double>(ap_[i]); });
       if (!(pap > 0)) break;  // (no direction left: A is only semi-definite)
       const R alpha = static_cast<R>(rz / pap);
       bool negative = false;
@@ -285,10 +276,10 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
       // The active set's own residual: once it is well below the tolerance, what is left is the
       // compression of particles outside it, which the projected iterations below take.
       const double active_error =
-          active_sum(n, [&](std::size_t i) { return std::abs(static_cast<double>(scale * r_[i])); });
+          active_sum([&](std::size_t i) { return std::abs(static_cast<double>(scale * r_[i])); });
       if (active_error <= 0.5 * tolerance) break;
       const double rz_new =
-          active_sum(n, [&](std::size_t i) { return static_cast<double>(r_[i]) * static_cast<double>(z_[i]); });
+          active_sum([&](std::size_t i) { return static_cast<double>(r_[i]) * static_cast<double>(z_[i]); });
       const R ratio = static_cast<R>(rz > 0 ? rz_new / rz : 0.0);
       rz = rz_new;
       parallel_for(n, [&](std::size_t i) { p_[i] = active_[i] ? z_[i] + ratio * p_[i] : R(0); });

@@ -95,12 +95,17 @@ class DfsphSolver {
   /// (J v)_i: the density rate of particle i under the velocities v(j), on the step's pairs.
   template <class V>
   R density_rate(std::size_t i, V&& v) const;
-  /// sum over active particles of f(i), in fixed chunks (the same for any thread count).
+  /// sum over the particles of f(i), in fixed chunks (the same for any thread count).
   template <class F>
-  double active_sum(std::size_t n, F&& f);
+  double chunked_sum(std::size_t n, F&& f);
 
   DfsphParams params_;
   R spacing_;
+  // A full lattice site's values, found on the first compute_factors with particles: the floor
+  // of beta and the neighbours within h that make a full neighbourhood.
+  bool lattice_done_ = false;
+  R beta_floor_ = 0;
+  int full_count_ = 0;
   std::vector<R> beta_;               // per particle: A's diagonal
   std::vector<std::uint8_t> active_;  // per particle: under pressure in this solve
   std::vector<std::uint8_t> full_;    // per particle: a full neighbourhood (compute_factors)

@@ -161,6 +161,11 @@ enum class SimulationMethod {
   Dfsph,
 };
 
+/// Why DFSPH refuses penalty walls (the scene reader and Simulation say it).
+inline constexpr const char* kDfsphNeedsBoundaryParticles =
+    "DFSPH needs boundary particles: penalty springs push with forces the pressure solve does not see, and at "
+    "DFSPH's large time steps they are unstable; set Configuration.boundaryHandling to \"particles\"";
+
 /// DFSPH's two solves (Configuration keys of SPlisHSPlasH's names; docs/scene-format.md).
 struct DfsphParams {
   int min_iterations = 2;         ///< constant-density solve: at least this many iterations

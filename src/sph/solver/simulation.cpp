@@ -124,10 +124,7 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
   }
   if (params_.method == SimulationMethod::Dfsph) {
     if (params_.boundary.handling != BoundaryHandling::Particles)
-      throw Error(
-          "DFSPH needs boundary particles: penalty springs push with forces the pressure solve does not see, and "
-          "at DFSPH's large time steps they are unstable; set Configuration.boundaryHandling to \"particles\"",
-          "Configuration.simulationMethod");
+      throw Error(kDfsphNeedsBoundaryParticles, "Configuration.simulationMethod");
     dfsph_ =
         std::make_unique<DfsphSolver<D, R>>(params_.dfsph, particles_, static_cast<R>(2.0 * params_.particle_radius));
   }
@@ -306,10 +303,9 @@ const StepInfo& Simulation<D, R>::step() {
   Stopwatch watch;
   // (DFSPH: the EOS pressure this pass computes is replaced by the density solve's)
   info.pairs_within_h = compute_density_pressure(particles_, lists, h, params_.fluid, solid);
-  const SmoothingKernels<D, R> kernels(params_.fluid, h);
   const R rho0 = static_cast<R>(params_.fluid.rest_density);
   if (dfsph_) {
-    dfsph_->compute_factors(particles_, lists, kernels, solid);
+    dfsph_->compute_factors(particles_, lists, SmoothingKernels<D, R>(params_.fluid, h), solid);
     info.seconds.density = watch.lap();
     // (its velocity change does not depend on dt: the last step's is as good as any)
     if (params_.dfsph.divergence_solver)

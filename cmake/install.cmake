@@ -24,7 +24,7 @@ install(TARGETS ${sph_layer_targets} EXPORT sphTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(TARGETS sph EXPORT sphTargets RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-install(DIRECTORY scenes/paper scenes/validation scenes/dfsph DESTINATION ${CMAKE_INSTALL_DATADIR}/sph/scenes)
+install(DIRECTORY scenes/paper scenes/validation scenes/dfsph scenes/examples DESTINATION ${CMAKE_INSTALL_DATADIR}/sph/scenes)
 
 install(EXPORT sphTargets NAMESPACE sph:: DESTINATION ${SPH_INSTALL_CMAKEDIR})
 configure_package_config_file(cmake/sphConfig.cmake.in ${PROJECT_BINARY_DIR}/sphConfig.cmake

@@ -1,5 +1,7 @@
 // Pictures of frames for sph render: panels, time label, legends.
 
+#include <cmath>
+#include <numbers>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -107,6 +109,121 @@ TEST(FrameImage, AFrameWithoutTheFieldIsRefused) {
   f.fields.clear();
   const std::vector<FrameData> frames{f};
   EXPECT_THROW(render_frame(runs, frames, style(100, 100)), Error);
+}
+
+/// run2d with two obstacles: [0.2, 0.4] x [0, 0.3] oscillating along x (amplitude 1.2 m, period
+/// 2 s: at 1.4 .. 1.6 at t = 0.5 s) and [0.9, 1.1] x [0.6, 0.7] turning at pi/2 rad/s about its
+/// middle (upright at t = 0); without `rotate` the second has no entry in `motions`.
+RunDirectory run_with_moving_obstacles(bool rotate = true) {
+  RunDirectory run = run2d("moving");
+  SceneBody<2> body;
+  body.sim.obstacles = {Box<2>{{{0.2, 0}}, {{0.4, 0.3}}}, Box<2>{{{0.9, 0.6}}, {{1.1, 0.7}}}};
+  ObstacleMotion<2> paddle;
+  paddle.type = MotionType::Oscillation;
+  paddle.direction = {{1, 0}};
+  paddle.amplitude = 1.2;
+  paddle.period = 2;
+  body.sim.motions = {paddle};
+  if (rotate) {
+    ObstacleMotion<2> stirrer;
+    stirrer.type = MotionType::Rotation;
+    stirrer.center = {{1.0, 0.65}};
+    stirrer.angular_velocity = std::numbers::pi / 2;
+    body.sim.motions.push_back(stirrer);
+  }
+  run.scene.set_body(body);
+  return run;
+}
+
+TEST(FrameImage, RunObstaclesArePlacedAtTheFramesTime) {
+  const RunDirectory run = run_with_moving_obstacles();
+  for (const double t : {0.0, 0.5, 1.0, 1.5}) {
+    const std::vector<SolidBox> s = run_obstacles(run, t);
+    ASSERT_EQ(s.size(), 2u);
+    // Always the boxes at rest, each with its placement.
+    EXPECT_EQ(s[0].lo, (std::array<double, 3>{0.2, 0, 0}));
+    EXPECT_EQ(s[0].hi, (std::array<double, 3>{0.4, 0.3, 0}));
+    EXPECT_EQ(s[1].lo, (std::array<double, 3>{0.9, 0.6, 0}));
+    EXPECT_EQ(s[1].hi, (std::array<double, 3>{1.1, 0.7, 0}));
+    // The paddle: translated by 1.2 sin(pi t) along x, not turned.
+    EXPECT_NEAR(s[0].translation[0], 1.2 * std::sin(std::numbers::pi * t), 1e-12) << t;
+    EXPECT_EQ(s[0].translation[1], 0.0);
+    EXPECT_TRUE(s[0].axis_aligned()) << t;
+    EXPECT_NEAR(s[0].place({0.2, 0, 0}, 2)[0], 0.2 + 1.2 * std::sin(std::numbers::pi * t), 1e-12) << t;
+    // The stirrer: turned by pi t / 2 about (1, 0.65), not translated; its right side's middle goes round.
+    const double angle = std::numbers::pi * t / 2;
+    EXPECT_NEAR(s[1].rotation[0], std::cos(angle), 1e-12) << t;
+    EXPECT_NEAR(s[1].rotation[1], -std::sin(angle), 1e-12) << t;
+    EXPECT_NEAR(s[1].rotation[3], std::sin(angle), 1e-12) << t;
+    EXPECT_EQ(s[1].rotation[8], 1.0);
+    EXPECT_EQ(s[1].center, (std::array<double, 3>{1.0, 0.65, 0}));
+    const auto p = s[1].place({1.1, 0.65, 0}, 2);
+    EXPECT_NEAR(p[0], 1.0 + 0.1 * std::cos(angle), 1e-12) << t;
+    EXPECT_NEAR(p[1], 0.65 + 0.1 * std::sin(angle), 1e-12) << t;
+    EXPECT_EQ(p[2], 0.0);
+  }
+  // An obstacle without a motion is at rest.
+  const std::vector<SolidBox> at_rest = run_obstacles(run_with_moving_obstacles(false), 1.0);
+  EXPECT_TRUE(at_rest[1].axis_aligned());
+  EXPECT_EQ(at_rest[1].translation, (std::array<double, 3>{0, 0, 0}));
+}
+
+TEST(FrameImage, RunObstaclesOfA3DSceneTurnAboutTheirAxis) {
+  RunDirectory run = run2d("3d");
+  run.dimension = 3;
+  run.box_hi = {2, 1, 1};
+  SceneBody<3> body;
+  body.sim.obstacles = {Box<3>{{{0.5, 0.2, 0.2}}, {{0.7, 0.4, 0.6}}}};
+  ObstacleMotion<3> m;
+  m.type = MotionType::Rotation;
+  m.axis = {{1, 0, 0}};
+  m.center = {{0.6, 0.3, 0.4}};
+  m.angular_velocity = std::numbers::pi;  // half a turn at t = 1 s
+  body.sim.motions = {m};
+  run.scene.set_body(body);
+  const std::vector<SolidBox> s = run_obstacles(run, 1.0);
+  ASSERT_EQ(s.size(), 1u);
+  // Half a turn about x through the middle: the corner (0.5, 0.2, 0.2) goes to (0.5, 0.4, 0.6).
+  const auto p = s[0].place({0.5, 0.2, 0.2}, 3);
+  EXPECT_NEAR(p[0], 0.5, 1e-12);
+  EXPECT_NEAR(p[1], 0.4, 1e-12);
+  EXPECT_NEAR(p[2], 0.6, 1e-12);
+  // A quarter turn at t = 0.5 s: +y goes to +z.
+  const auto q = run_obstacles(run, 0.5)[0].axis(1, 3);
+  EXPECT_NEAR(q[0], 0.0, 1e-12);
+  EXPECT_NEAR(q[1], 0.0, 1e-12);
+  EXPECT_NEAR(q[2], 1.0, 1e-12);
+  // Drawn where it is: a 3D frame renders with it.
+  FrameData f = one_particle(1.5, 0.5, 0.0, 0.5);
+  f.position = {1.5, 0.5, 0.5};
+  FrameStyle st = style(200, 100);
+  st.view = default_particle_view(3, 200, 100);
+  EXPECT_NO_THROW(render_frame(std::vector<RunDirectory>{run}, std::vector<FrameData>{f}, st));
+}
+
+TEST(FrameImage, MovingObstaclesAreDrawnWhereTheyAreAtTheFramesTime) {
+  const std::vector<RunDirectory> runs{run_with_moving_obstacles(false)};
+  FrameStyle s = style(400, 200);
+  s.legend = false;
+  // The particle, still (colormap's low end), away from the obstacles.
+  const auto render_at = [&](double t) {
+    return render_frame(runs, std::vector<FrameData>{one_particle(1.0, 0.9, 0.0, t)}, s);
+  };
+  // The paddle [0.2, 0.4] x [0, 0.3] at rest left of the middle at t = 0 (pixels ~66 .. 100),
+  // right of it (1.4 .. 1.6, pixels ~267 .. 300) at t = 0.5 s; the still obstacle [0.9, 1.1] x
+  // [0.6, 0.7] is in the middle (pixels ~183 .. 217), counted in neither part.
+  const Image at0 = render_at(0.0), at05 = render_at(0.5);
+  ASSERT_EQ(at0.width(), 400);
+  const int h = at0.height();
+  const int left = count_color(at0, kSolidColor, 0, 0, 160, h);
+  EXPECT_GT(left, 200);
+  EXPECT_EQ(count_color(at0, kSolidColor, 240, 0, 400, h), 0);
+  EXPECT_EQ(count_color(at05, kSolidColor, 0, 0, 160, h), 0);
+  const int right = count_color(at05, kSolidColor, 240, 0, 400, h);
+  EXPECT_NEAR(right, left, 0.08 * left);  // shifted, not changed
+  // The still obstacle stays where it is.
+  EXPECT_EQ(count_color(at0, kSolidColor, 160, 0, 240, h), count_color(at05, kSolidColor, 160, 0, 240, h));
+  EXPECT_GT(count_color(at0, kSolidColor, 160, 0, 240, h), 100);
 }
 
 }  // namespace

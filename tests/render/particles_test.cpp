@@ -6,6 +6,8 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -397,6 +399,144 @@ TEST(ParticlesSolids, WithoutObstaclesTheImageIsUnchanged) {
   }
 }
 
+/// A 2D box [lo, hi] turned by `angle` radians about its middle and shifted by `shift`.
+SolidBox placed_2d(const A3& lo, const A3& hi, double angle, const A3& shift = {}) {
+  SolidBox s{lo, hi};
+  const double c = std::cos(angle), n = std::sin(angle);
+  s.rotation = {c, -n, 0, n, c, 0, 0, 0, 1};
+  s.center = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0};
+  s.translation = shift;
+  return s;
+}
+
+bool is_solid(Rgb c) { return c == kSolidColor || c == kSolidEdgeColor; }
+
+TEST(ParticlesSolids, A2DObstacleTurnedByItsPoseIsDrawnTurned) {
+  const A3 lo{0, 0, 0}, hi{1, 1, 0};
+  const ParticleView view = flat_view(400, 400);
+  const ParticleCamera cam(2, lo, hi, 0.02, view);
+  const A3 blo{0.35, 0.35, 0}, bhi{0.65, 0.65, 0};  // a square of side 0.3 about (0.5, 0.5)
+  const std::vector<SolidBox> upright = {{blo, bhi}};
+  const std::vector<SolidBox> turned = {placed_2d(blo, bhi, std::numbers::pi / 4)};
+  const Image a = render_particles({}, 2, {}, 0.02, lo, hi, view, upright);
+  const Image b = render_particles({}, 2, {}, 0.02, lo, hi, view, turned);
+  const auto at = [&](const Image& img, double x, double y) {
+    const auto px = pixel_of(cam, A3{x, y, 0});
+    return img.at(px[0], px[1]);
+  };
+  // Turned by 45 degrees the square is a diamond |x - 0.5| + |y - 0.5| <= 0.15 sqrt(2) = 0.212:
+  // its corners point along the axes, past the upright square's sides, and the upright square's
+  // corners are outside it.
+  for (const auto& [x, y] : {std::pair{0.69, 0.5}, std::pair{0.31, 0.5}, std::pair{0.5, 0.69}, std::pair{0.5, 0.31}}) {
+    EXPECT_TRUE(is_solid(at(b, x, y))) << x << " " << y;
+    EXPECT_EQ(at(a, x, y), kWhite) << x << " " << y;
+  }
+  for (const auto& [x, y] :
+       {std::pair{0.37, 0.37}, std::pair{0.63, 0.37}, std::pair{0.63, 0.63}, std::pair{0.37, 0.63}}) {
+    EXPECT_EQ(at(b, x, y), kWhite) << x << " " << y;
+    EXPECT_TRUE(is_solid(at(a, x, y))) << x << " " << y;
+  }
+  EXPECT_EQ(at(b, 0.5, 0.5), kSolidColor);
+  // The outline runs along the diamond's sides: along the row through y = 0.55, the first pixel
+  // that is not background is the outline's, where the side crosses the row (x = 0.5 - 0.212 + 0.05).
+  const auto row = pixel_of(cam, A3{0.5, 0.55, 0});
+  int first = pixel_of(cam, A3{0.1, 0.55, 0})[0];
+  while (first < row[0] && b.at(first, row[1]) == kWhite) ++first;
+  EXPECT_EQ(b.at(first, row[1]), kSolidEdgeColor);
+  EXPECT_NEAR(first + 0.5, cam.project(A3{0.5 - 0.15 * std::sqrt(2.0) + 0.05, 0.55, 0})[0], 1.5);
+  // Turning keeps the area: the same number of pixels to within the outline's rasterization.
+  const auto count = [](const Image& img) {
+    return static_cast<double>(std::count_if(img.pixels().begin(), img.pixels().end(), is_solid));
+  };
+  EXPECT_NEAR(count(b), count(a), 0.03 * count(a));
+  EXPECT_GT(count(a), 1000);
+}
+
+TEST(ParticlesSolids, A2DObstacleTranslatedByItsPoseIsDrawnShifted) {
+  const A3 lo{0, 0, 0}, hi{1, 1, 0};
+  const ParticleView view = flat_view();
+  const A3 blo{0.1, 0.1, 0}, bhi{0.3, 0.25, 0}, shift{0.5, 0.4, 0};
+  SolidBox moved{blo, bhi};
+  moved.translation = shift;
+  const std::vector<SolidBox> solids = {moved};
+  const Image img = render_particles({}, 2, {}, 0.02, lo, hi, view, solids);
+  // The same picture as the box drawn at its shifted corners, and nothing at its place at rest.
+  const std::vector<SolidBox> there = {
+      {A3{blo[0] + shift[0], blo[1] + shift[1], 0}, A3{bhi[0] + shift[0], bhi[1] + shift[1], 0}}};
+  EXPECT_EQ(img, render_particles({}, 2, {}, 0.02, lo, hi, view, there));
+  const ParticleCamera cam(2, lo, hi, 0.02, view);
+  const auto rest = pixel_of(cam, A3{0.2, 0.175, 0});
+  const auto now = pixel_of(cam, A3{0.7, 0.575, 0});
+  EXPECT_EQ(img.at(rest[0], rest[1]), kWhite);
+  EXPECT_EQ(img.at(now[0], now[1]), kSolidColor);
+  // A turn by a full circle, with a translation, is the same shifted box.
+  const std::vector<SolidBox> full_turn = {placed_2d(blo, bhi, 2 * std::numbers::pi, shift)};
+  const Image turned = render_particles({}, 2, {}, 0.02, lo, hi, view, full_turn);
+  EXPECT_TRUE(is_solid(turned.at(now[0], now[1])));
+  EXPECT_EQ(turned.at(rest[0], rest[1]), kWhite);
+}
+
+TEST(ParticlesSolids, A3DObstacleIsDrawnWithItsRotatedFaces) {
+  const A3 lo{-1, -1, -1}, hi{1, 1, 1};
+  ParticleView view = default_particle_view(3, 400, 300);  // from +x, +y, +z
+  view.shaded = false;
+  const ParticleCamera cam(3, lo, hi, 0.05, view);
+  // A box 0.2 x 0.4 x 0.6 turned by +90 degrees about y (x -> -z, z -> x) is the box 0.6 x 0.4 x
+  // 0.2: the same picture, which needs the faces turned to the camera chosen by their rotated
+  // normals (the box's own +x, +y, +z faces are not the ones seen once it is turned).
+  SolidBox turned{A3{-0.1, -0.2, -0.3}, A3{0.1, 0.2, 0.3}};
+  turned.rotation = {0, 0, 1, 0, 1, 0, -1, 0, 0};
+  const std::vector<SolidBox> a = {turned};
+  const std::vector<SolidBox> b = {{A3{-0.3, -0.2, -0.1}, A3{0.3, 0.2, 0.1}}};
+  const std::vector<SolidBox> unturned = {{turned.lo, turned.hi}};
+  const Image img = render_particles({}, 3, {}, 0.05, lo, hi, view, a);
+  const Image same = render_particles({}, 3, {}, 0.05, lo, hi, view, b);
+  const Image other = render_particles({}, 3, {}, 0.05, lo, hi, view, unturned);
+  const auto differing = [](const Image& x, const Image& y) {
+    int n = 0;
+    for (int yy = 0; yy < x.height(); ++yy)
+      for (int xx = 0; xx < x.width(); ++xx) n += x.at(xx, yy) != y.at(xx, yy);
+    return n;
+  };
+  EXPECT_LE(differing(img, same), 10);  // ties between faces along their shared edges at most
+  EXPECT_GT(differing(img, other), 500);
+  // Turned by 30 degrees about an oblique axis and shifted: drawn over its placed center, its
+  // three faces turned to the camera (by their rotated normals) in three grays, and nothing at its
+  // place at rest.
+  SolidBox oblique{A3{-0.3, -0.2, -0.1}, A3{0.3, 0.2, 0.1}};
+  const double s = std::sqrt(1.0 / 3.0), c = std::cos(std::numbers::pi / 6), n = std::sin(std::numbers::pi / 6),
+               k = 1 - c;  // Rodrigues' formula about (1, 1, 1) / sqrt(3)
+  oblique.rotation = {c + s * s * k,     s * s * k - s * n, s * s * k + s * n, s * s * k + s * n, c + s * s * k,
+                      s * s * k - s * n, s * s * k - s * n, s * s * k + s * n, c + s * s * k};
+  oblique.translation = {0.6, 0.5, 0};
+  const std::vector<SolidBox> o = {oblique};
+  const Image oi = render_particles({}, 3, {}, 0.05, lo, hi, view, o);
+  const auto center = pixel_of(cam, A3{0.6, 0.5, 0});
+  const Rgb mid = oi.at(center[0], center[1]);
+  EXPECT_TRUE(is_gray(mid));
+  EXPECT_LE(mid.r, kSolidColor.r);
+  EXPECT_GT(mid.r, kSolidEdgeColor.r);
+  const auto rest = pixel_of(cam, A3{0, 0, 0});
+  EXPECT_EQ(oi.at(rest[0], rest[1]), kWhite);
+  std::vector<Rgb> faces;
+  for (int a = 0; a < 3; ++a) {
+    const A3 axis{oblique.rotation[a], oblique.rotation[3 + a], oblique.rotation[6 + a]};
+    const double toward = axis[0] * cam.axes()[2][0] + axis[1] * cam.axes()[2][1] + axis[2] * cam.axes()[2][2];
+    ASSERT_GT(std::abs(toward), 0.05);
+    const double half = toward > 0 ? oblique.hi[a] : oblique.lo[a];  // the face turned to the camera
+    const A3 at{0.6 + half * axis[0], 0.5 + half * axis[1], half * axis[2]};
+    const auto px = pixel_of(cam, at);
+    const Rgb f = oi.at(px[0], px[1]);
+    EXPECT_TRUE(is_gray(f)) << a;
+    EXPECT_LE(f.r, kSolidColor.r) << a;
+    EXPECT_GT(f.r, kSolidEdgeColor.r) << a;
+    faces.push_back(f);
+  }
+  EXPECT_NE(faces[0], faces[1]);
+  EXPECT_NE(faces[1], faces[2]);
+  EXPECT_NE(faces[0], faces[2]);
+}
+
 TEST(ParticlesSolids, BadObstaclesThrow) {
   const A3 lo{0, 0, 0}, hi{1, 1, 1};
   const std::vector<SolidBox> flipped = {{A3{0.6, 0, 0}, A3{0.4, 1, 1}}};
@@ -406,6 +546,13 @@ TEST(ParticlesSolids, BadObstaclesThrow) {
   // z does not matter in 2D.
   const std::vector<SolidBox> flat = {{A3{0.2, 0.2, 5}, A3{0.4, 0.4, -5}}};
   EXPECT_NO_THROW(render_particles({}, 2, {}, 0.1, lo, hi, flat_view(), flat));
+  // A placement that is not finite.
+  std::vector<SolidBox> placed = {{A3{0.2, 0.2, 0.2}, A3{0.4, 0.4, 0.4}}};
+  placed[0].translation[1] = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(render_particles({}, 3, {}, 0.1, lo, hi, flat_view(), placed), Error);
+  placed[0].translation[1] = 0;
+  placed[0].rotation[4] = std::nan("");
+  EXPECT_THROW(render_particles({}, 2, {}, 0.1, lo, hi, flat_view(), placed), Error);
 }
 
 }  // namespace

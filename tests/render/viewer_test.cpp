@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 #include <random>
 
@@ -161,6 +162,8 @@ TEST(ViewerPage, DataRoundTripsTheFrames) {
   // Initial-position colors: one per particle, shared by the frames (ids 0..n-1 throughout).
   EXPECT_EQ(base64_decode(data["runs"][0]["rgb"].get<std::string>()).size(), 3 * frames[0]["n"].get<std::size_t>());
   EXPECT_FALSE(frames[0].contains("rgb"));
+  // No obstacle moves: the frames carry no poses, exactly as before obstacles could move.
+  for (const auto& f : frames) EXPECT_EQ(f.size(), 4u) << f.dump().substr(0, 80);  // t, n, pos, f
 }
 
 TEST(ViewerPage, TheDataListsTheScenesObstacles) {
@@ -183,6 +186,73 @@ TEST(ViewerPage, TheDataListsTheScenesObstacles) {
   };
   EXPECT_EQ(data["obstacles"],
             nlohmann::json::array({box({0.35, 0, 0}, {0.45, 0.12, 0}), box({0.5, 0.2, 0}, {0.55, 0.25, 0})}));
+  for (const auto& f : data["runs"][0]["frames"]) EXPECT_FALSE(f.contains("poses"));  // they do not move
+}
+
+/// The scene of TheDataListsTheScenesObstacles (with its number of steps, as a run directory's
+/// scene.json has it), `motion` (JSON text) added to each obstacle in order ("" for none).
+std::string obstacle_scene(const std::string& motion0, const std::string& motion1) {
+  const auto with = [](const std::string& m) { return m.empty() ? std::string() : ", \"motion\": " + m; };
+  return R"({
+    "version": 1, "name": "obstacles", "dimension": 2,
+    "Configuration": { "particleRadius": 0.01, "numberOfSteps": 20 },
+    "Container": { "start": [0, 0], "end": [0.6, 0.4] },
+    "Obstacles": [ { "start": [0.35, 0], "end": [0.45, 0.12])" +
+         with(motion0) + R"( }, { "start": [0.5, 0.2], "end": [0.55, 0.25])" + with(motion1) + R"( } ],
+    "FluidBlocks": [ { "start": [0, 0], "end": [0.1, 0.2] } ]
+  })";
+}
+
+TEST(ViewerPage, TheFramesPlaceMovingObstacles) {
+  test::TempDir dir;
+  test::spit(dir.path() / "scene.json", obstacle_scene("", ""));
+  const fs::path out = dir.path() / "run";
+  const auto r = test::run_sph({"run", (dir.path() / "scene.json").string(), "-o", out.string(), "--steps", "20",
+                                "--set", "Configuration.outputEveryNSteps=10", "--no-progress"},
+                               dir.path(), dir.path() / "err.txt");
+  ASSERT_EQ(r.code, 0) << r.err;
+  // The same run as if its obstacles moved: the page places them by the scene it reads, at each
+  // frame's time (a paddle oscillating along x, a stirrer turning about its middle).
+  test::spit(out / "scene.json",
+             obstacle_scene(R"({ "type": "oscillation", "direction": [1, 0], "amplitude": 0.05, "period": 0.037 })",
+                            R"({ "type": "rotation", "angularVelocity": 40 })"));
+  const auto data = nlohmann::json::parse(view_page_data(build_view_page(out, ViewOptions{}).html));
+  // The obstacles at rest, as for a static scene.
+  const auto box = [](std::vector<double> lo, std::vector<double> hi) {
+    return nlohmann::json{{"lo", lo}, {"hi", hi}};
+  };
+  EXPECT_EQ(data["obstacles"],
+            nlohmann::json::array({box({0.35, 0, 0}, {0.45, 0.12, 0}), box({0.5, 0.2, 0}, {0.55, 0.25, 0})}));
+  const auto& frames = data["runs"][0]["frames"];
+  ASSERT_EQ(frames.size(), 3u);
+  double moved = 0, turned = 0;
+  for (const auto& f : frames) {
+    const double t = f["t"];
+    ASSERT_TRUE(f.contains("poses")) << t;
+    const auto& poses = f["poses"];
+    ASSERT_EQ(poses.size(), 2u);
+    for (const auto& p : poses) ASSERT_EQ(p.size(), 15u);  // R (9), center (3), translation (3)
+    // The paddle: translated along x, upright.
+    const double x = 0.05 * std::sin(2 * std::numbers::pi * t / 0.037);
+    EXPECT_NEAR(poses[0][12].get<double>(), x, 1e-12) << t;
+    EXPECT_EQ(poses[0][13].get<double>(), 0.0);
+    for (int k = 0; k < 9; ++k) EXPECT_EQ(poses[0][k].get<double>(), k % 4 == 0 ? 1.0 : 0.0) << k;
+    moved = std::max(moved, std::abs(x));
+    // The stirrer: turned by 40 t about its middle (the motion's default center), not translated.
+    const double a = 40 * t;
+    EXPECT_NEAR(poses[1][0].get<double>(), std::cos(a), 1e-12) << t;
+    EXPECT_NEAR(poses[1][1].get<double>(), -std::sin(a), 1e-12) << t;
+    EXPECT_NEAR(poses[1][3].get<double>(), std::sin(a), 1e-12) << t;
+    EXPECT_NEAR(poses[1][4].get<double>(), std::cos(a), 1e-12) << t;
+    EXPECT_EQ(poses[1][8].get<double>(), 1.0);
+    EXPECT_NEAR(poses[1][9].get<double>(), 0.525, 1e-12);
+    EXPECT_NEAR(poses[1][10].get<double>(), 0.225, 1e-12);
+    EXPECT_EQ(poses[1][11].get<double>(), 0.0);
+    for (int k = 12; k < 15; ++k) EXPECT_EQ(poses[1][k].get<double>(), 0.0) << k;
+    turned = std::max(turned, std::abs(std::sin(a)));
+  }
+  EXPECT_GT(moved, 1e-4);  // the frames are not all at rest, or the test would prove little
+  EXPECT_GT(turned, 1e-3);
 }
 
 TEST(ViewerPage, ChosenQuantitiesOnlyAndInOrder) {

@@ -50,7 +50,9 @@ json every_key_3d() {
     "Container": { "start": [-0.1, 0.05, 0], "end": [0.9, 1.1, 0.7], "wallStiffness": 3.3e5, "wallDamping": 12.5 },
     "FluidBlocks": [ { "start": [0, 0.1, 0.05], "end": [0.2, 0.3, 0.25], "velocity": [0.5, -0.25, 0.125] },
                      { "start": [0.5, 0.6, 0.1], "end": [0.6, 0.7, 0.2] } ],
-    "Obstacles": [ { "start": [0.3, 0.05, 0.3], "end": [0.4, 0.2, 0.4] } ],
+    "Obstacles": [ { "start": [0.3, 0.05, 0.3], "end": [0.4, 0.2, 0.4],
+                     "motion": { "type": "rotation", "axis": [0, 0.6, 0.8], "center": [0.35, 0.1, 0.35],
+                                 "angularVelocity": -1.5, "rampTime": 0.25 } } ],
     "Emitters": [ { "translation": [0.05, 0.8, 0.35], "direction": [1, -0.3, 0.1], "velocity": 4.5, "width": 3,
                     "height": 2, "emitEveryNSteps": 40, "maxParticles": 120, "emitStartTime": 0.001,
                     "emitEndTime": 0.5 } ]
@@ -65,7 +67,7 @@ json every_key_2d() {
     "Configuration": {
       "precision": "double", "timeStepSize": 1e-4, "numberOfSteps": 50, "particleRadius": 0.01,
       "kernelRadius": 0.033, "gravitation": [0, -9.81], "neighbors": "adaptive", "fullRebuildPeriod": 13,
-      "verletSkin": 0.004, "reorderPeriod": 0, "outputEveryNSteps": 3, "outputFps": 0,
+      "verletSkin": 0.004, "reorderPeriod": 0, "outputEveryNSteps": 3, "outputFps": 0, "flagNearMovingBodies": false,
       "outputFormats": ["vtu", "ply", "vtk"], "outputFields": [], "boundaryHandling": "particles",
       "simulationMethod": "dfsph", "minIterations": 3, "maxIterations": 77, "maxError": 0.05,
       "enableDivergenceSolver": false, "maxIterationsV": 33, "maxErrorV": 2.5
@@ -74,7 +76,13 @@ json every_key_2d() {
                "pressureForce": "symmetric", "gradientCorrection": "none", "particleMass": 0.1 },
     "Container": { "start": [0, 0], "end": [1, 1], "wallStiffness": 1e5, "wallDamping": 0.5 },
     "FluidBlocks": [ { "start": [0, 0], "end": [0.2, 0.2], "velocity": [-0.3, 0.7] } ],
-    "Obstacles": [ { "start": [0.5, 0], "end": [0.6, 0.1] }, { "start": [0.7, 0], "end": [0.8, 0.3] } ],
+    "Obstacles": [ { "start": [0.5, 0], "end": [0.6, 0.1],
+                     "motion": { "type": "oscillation", "direction": [3, 4], "amplitude": 0.02, "period": 0.7,
+                                 "phase": 0.5, "rampTime": 0.1 } },
+                   { "start": [0.7, 0], "end": [0.8, 0.3],
+                     "motion": { "type": "keyframes", "center": [0.75, 0.1],
+                                 "keys": [ { "time": 0.001, "translation": [0, 0], "rotation": 0 },
+                                           { "time": 0.004, "translation": [0.05, 0.1], "rotation": 0.2 } ] } } ],
     "Emitters": [ { "translation": [0.05, 0.5], "direction": [3, 7], "velocity": 20.0, "width": 4,
                     "emitEveryNSteps": 12, "maxParticles": 100, "emitStartTime": 0.25, "emitEndTime": 1e300 } ]
   })");
@@ -160,6 +168,14 @@ TEST(SceneWriter, WritesEveryDeclaredKeyOfEveryObject) {
     EXPECT_EQ(keys_of(w["Container"]), set_of(sph::detail::kContainerKeys));
     EXPECT_EQ(keys_of(w["FluidBlocks"][0]), set_of(sph::detail::kFluidBlockKeys));
     EXPECT_EQ(keys_of(w["Obstacles"][0]), set_of(sph::detail::kObstacleKeys));
+    for (const json& o : w["Obstacles"]) {  // each motion with every key of its type
+      const sph::MotionType type =
+          sph::detail::value_named(sph::detail::kMotionTypeNames, o["motion"]["type"].get<std::string>());
+      EXPECT_EQ(keys_of(o["motion"]), set_of(sph::detail::motion_keys(type, d.dimension)));
+      if (type == sph::MotionType::Keyframes) {
+        EXPECT_EQ(keys_of(o["motion"]["keys"][0]), set_of(sph::detail::kMotionKeyKeys));
+      }
+    }
     EXPECT_EQ(keys_of(w["Emitters"][0]), set_of(sph::detail::emitter_keys(d.dimension)));
   }
 }

@@ -11,6 +11,7 @@
 #include <sph/core/parallel.h>
 #include <sph/io/atomic_file.h>
 #include <sph/io/frames.h>
+#include <sph/render/frame_image.h>
 #include <sph/run/driver.h>
 #include <sph/scene/dispatch.h>
 
@@ -178,16 +179,17 @@ CompareResult run_all(const SceneDesc& desc, const CompareOptions& opt, const Co
   res.particle_mass = p.particle_mass;
   res.perturbation = opt.perturbation;
   for (int d = 0; d < D; ++d) res.box_lo[d] = p.container.lo[d], res.box_hi[d] = p.container.hi[d];
-  for (const Box<D>& b : p.obstacles) {
-    SolidBox s;
-    for (int d = 0; d < D; ++d) s.lo[d] = b.lo[d], s.hi[d] = b.hi[d];
-    res.obstacles.push_back(s);
-  }
   res.has_emitters = !p.emitters.empty();
   res.has_boundary_particles = p.boundary.handling == BoundaryHandling::Particles;
   res.audited = opt.audit;
   res.steps = opt.steps > 0 ? opt.steps : desc.steps;
   res.image_steps = image_steps(res.steps, std::max(1, opt.frames));
+  // Each picture's obstacles, where they are at its step's time (the steps are fixed).
+  for (const std::int64_t step : res.image_steps) {
+    std::vector<SolidBox>& at = res.image_obstacles.emplace_back();
+    for (std::size_t k = 0; k < p.obstacles.size(); ++k)
+      at.push_back(obstacle_solid(p, k, static_cast<double>(step) * p.time_step));
+  }
 
   std::vector<NeighborMode> modes = opt.modes;
   modes.erase(std::remove(modes.begin(), modes.end(), NeighborMode::Standard), modes.end());

@@ -94,7 +94,9 @@ struct CompareResult {
   int threads = 1;
   double h = 0, dt = 0, particle_radius = 0, particle_mass = 0, perturbation = 0;
   std::array<double, 3> box_lo{}, box_hi{};
-  std::vector<SolidBox> obstacles;  ///< the scene's obstacles, drawn in the report's pictures
+  /// The scene's obstacles as the report's pictures draw them: image_obstacles[k] holds them where
+  /// they are at image_steps[k] (moving obstacles move; the steps are fixed, step * dt).
+  std::vector<std::vector<SolidBox>> image_obstacles;
   bool has_emitters = false;
   bool has_boundary_particles = false;  ///< Configuration.boundaryHandling: "particles"
   bool audited = false;                 ///< missed-pair figures exist (CompareOptions::audit)

@@ -137,6 +137,12 @@ Image frame_image(const CompareResult& res, std::int64_t step, double mass) {
       if (!std::isnan(v[0])) ke_max = std::max(ke_max, 0.5 * mass * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
   }
   if (ke_max <= 0) ke_max = 1;
+  // The obstacles where they are at this step.
+  const auto at = std::find(res.image_steps.begin(), res.image_steps.end(), step);
+  std::span<const SolidBox> solids;
+  if (at != res.image_steps.end() &&
+      static_cast<std::size_t>(at - res.image_steps.begin()) < res.image_obstacles.size())
+    solids = res.image_obstacles[static_cast<std::size_t>(at - res.image_steps.begin())];
   for (const RunRecord& r : res.runs) {
     if (r.perturbed) continue;
     const Snapshot* snap = image_snapshot(r, step);
@@ -160,7 +166,7 @@ Image frame_image(const CompareResult& res, std::int64_t step, double mass) {
       }
     }
     Image panel =
-        render_particles(xyz, res.dimension, colors, res.particle_radius, res.box_lo, res.box_hi, view, res.obstacles);
+        render_particles(xyz, res.dimension, colors, res.particle_radius, res.box_lo, res.box_hi, view, solids);
     panels.push_back(std::move(panel));
     captions.push_back(r.failure.empty() ? fmt::format("{} (step {})", r.label, step)
                                          : fmt::format("{} (blew up before step {})", r.label, step));

@@ -1,5 +1,7 @@
 #include <sph/neighbors/boundary_lists.h>
 
+#include <algorithm>
+
 #include <sph/core/error.h>
 #include <sph/core/state_stream.h>
 
@@ -15,14 +17,25 @@ void BoundaryLists<D, R>::set_samples(std::span<const Vec<D, R>> samples, R radi
 }
 
 template <int D, std::floating_point R>
+void BoundaryLists<D, R>::move_samples(std::span<const Vec<D, R>> samples) {
+  SPH_CHECK(samples.size() == samples_.size(), "moved boundary samples: as many as were set");
+  if (samples_.empty()) return;
+  std::copy(samples.begin(), samples.end(), samples_.begin());
+  grid_.build(samples_, radius_);
+  moved_ = true;
+}
+
+template <int D, std::floating_point R>
 void BoundaryLists<D, R>::build(std::span<const Vec<D, R>> fluid) {
   if (samples_.empty()) return;
   builder_.build_queries(grid_, fluid, radius_, lists_);
+  moved_ = false;
 }
 
 template <int D, std::floating_point R>
 void BoundaryLists<D, R>::rebuild_some(std::span<const Vec<D, R>> fluid, std::span<const std::uint8_t> rebuild) {
   if (samples_.empty()) return;
+  if (moved_) return build(fluid);
   builder_.rebuild_some_queries(grid_, fluid, radius_, rebuild, lists_);
 }
 

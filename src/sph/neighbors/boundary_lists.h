@@ -14,17 +14,22 @@ namespace sph {
 class StateWriter;
 class StateReader;
 
-/// The boundary samples never move: they are indexed once, in their own grid, when set; each
-/// build then queries that grid at every fluid particle's position (ListBuilder::build_queries),
-/// so a step costs one lookup per fluid particle and no grid build. Lists hold sample indices;
-/// with no samples there are no lists (particle_count() 0), and the solver skips the boundary
-/// terms. Deterministic for any thread count, as the fluid lists are.
+/// The samples are indexed in their own grid when set (and again when moving obstacles move
+/// them); each build then queries that grid at every fluid particle's position
+/// (ListBuilder::build_queries), so a step costs one lookup per fluid particle and no grid build. Lists hold sample
+/// indices; with no samples there are no lists (particle_count() 0), and the solver skips the boundary terms.
+/// Deterministic for any thread count, as the fluid lists are.
 template <int D, std::floating_point R>
 class BoundaryLists {
  public:
   /// Takes the samples and indexes them for lists of pairs closer than `radius` (the
   /// strategy's list radius: h, or h + skin for verlet).
   void set_samples(std::span<const Vec<D, R>> samples, R radius);
+  /// The samples moved (moving obstacles): takes their new positions (as many as before) and
+  /// indexes them again; the next build or rebuild_some() then rebuilds every list.
+  void move_samples(std::span<const Vec<D, R>> samples);
+  /// Whether the samples moved since the lists were last built.
+  bool moved() const { return moved_; }
   bool empty() const { return samples_.empty(); }
   std::span<const Vec<D, R>> samples() const { return samples_; }
   R radius() const { return radius_; }
@@ -32,7 +37,7 @@ class BoundaryLists {
   /// Rebuilds every fluid particle's list. Nothing (and no lists) without samples.
   void build(std::span<const Vec<D, R>> fluid);
   /// Rebuilds the lists of the particles with rebuild[i] != 0 and of any particle appended since
-  /// the last build; keeps the others.
+  /// the last build; keeps the others (all of them after move_samples()).
   void rebuild_some(std::span<const Vec<D, R>> fluid, std::span<const std::uint8_t> rebuild);
   const NeighborLists& lists() const { return lists_; }
 
@@ -47,6 +52,7 @@ class BoundaryLists {
   UniformGrid<D, R> grid_;
   ListBuilder<D, R> builder_;
   NeighborLists lists_;
+  bool moved_ = false;
 };
 
 extern template class BoundaryLists<2, float>;

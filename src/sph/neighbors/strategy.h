@@ -61,6 +61,16 @@ class NeighborStrategy {
   /// lists the samples within h + skin and rebuilds them with the fluid lists. Called before
   /// the first update; the samples never move.
   void set_boundary(std::span<const Vec<D, R>> samples) { boundary_.set_samples(samples, list_radius()); }
+  /// The samples moved (moving obstacles; as many as were set): the next update() rebuilds
+  /// every boundary list, whatever the strategy's rule, so that no fluid-boundary pair is missed.
+  void move_boundary(std::span<const Vec<D, R>> samples) { boundary_.move_samples(samples); }
+  /// Rebuilds the boundary lists if the samples moved and update() did not rebuild them
+  /// (strategies that rebuild lists only on their own schedule, like verlet). Returns whether it did.
+  bool refresh_moved_boundary(const ParticleSet<D, R>& particles) {
+    if (!boundary_.moved()) return false;
+    boundary_.build(particles.position);
+    return true;
+  }
   /// Each particle's boundary samples (indices into the samples); no lists without samples.
   virtual const NeighborLists& boundary_lists() const { return boundary_.lists(); }
   std::span<const Vec<D, R>> boundary_samples() const { return boundary_.samples(); }

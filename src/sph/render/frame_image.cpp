@@ -32,19 +32,43 @@ std::vector<double> xy_of(const FrameData& frame) {
   return xy;
 }
 
+/// Obstacle k of `sim` placed at `time` (obstacle_solid).
+template <int D>
+SolidBox placed_obstacle(const SimulationParams<D>& sim, std::size_t k, double time) {
+  SPH_CHECK(k < sim.obstacles.size(), "no such obstacle");
+  const Box<D>& box = sim.obstacles[k];
+  SolidBox s;
+  for (int a = 0; a < D; ++a) {
+    s.lo[a] = box.lo[a];
+    s.hi[a] = box.hi[a];
+  }
+  const ObstacleMotion<D>& motion = obstacle_motion(sim, k);
+  if (!motion.moves()) return s;
+  const RigidPose<D> pose = pose_at(motion, time);
+  // A 2D pose turns about z: its upper-left 2 x 2 is all that matters, and z stays.
+  for (std::size_t r = 0; r < D; ++r)
+    for (std::size_t c = 0; c < D; ++c) s.rotation[3 * r + c] = pose.rotation[3 * r + c];
+  for (int a = 0; a < D; ++a) {
+    s.center[a] = pose.center[a];
+    s.translation[a] = pose.translation[a];
+  }
+  return s;
+}
+
 }  // namespace
 
-std::vector<SolidBox> run_obstacles(const RunDirectory& run) {
-  return run.scene.visit_body([](const auto& body) {
+SolidBox obstacle_solid(const SimulationParams<2>& sim, std::size_t k, double time) {
+  return placed_obstacle(sim, k, time);
+}
+
+SolidBox obstacle_solid(const SimulationParams<3>& sim, std::size_t k, double time) {
+  return placed_obstacle(sim, k, time);
+}
+
+std::vector<SolidBox> run_obstacles(const RunDirectory& run, double time) {
+  return run.scene.visit_body([&](const auto& body) {
     std::vector<SolidBox> out;
-    for (const auto& box : body.sim.obstacles) {
-      SolidBox s;
-      for (std::size_t a = 0; a < box.lo.c.size(); ++a) {
-        s.lo[a] = box.lo.c[a];
-        s.hi[a] = box.hi.c[a];
-      }
-      out.push_back(s);
-    }
+    for (std::size_t k = 0; k < body.sim.obstacles.size(); ++k) out.push_back(obstacle_solid(body.sim, k, time));
     return out;
   });
 }
@@ -75,7 +99,7 @@ Image render_frame(std::span<const RunDirectory> runs, std::span<const FrameData
     const RunDirectory& run = runs[k];
     const FrameData& frame = frames[k];
     SPH_CHECK(frame.position.size() == 3 * frame.size, "3 coordinates per particle");
-    const std::vector<SolidBox> obstacles = run_obstacles(run);
+    const std::vector<SolidBox> obstacles = run_obstacles(run, frame.time);  // where they are now
     SurfaceMesh mesh;
     if (style.surface) {
       SurfaceSettings settings = style.surface_settings;

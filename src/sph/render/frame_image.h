@@ -26,9 +26,15 @@ struct FrameStyle {
   SurfaceSettings surface_settings;  ///< for `surface`; its spacing is set per run
 };
 
-/// The scene's obstacles (its Obstacles, static solid boxes) as render_particles draws them, in
-/// the scene's order; z is 0 in 2D.
-std::vector<SolidBox> run_obstacles(const RunDirectory& run);
+/// Obstacle k of `sim` (its box at rest) placed where its motion (obstacle_motion) puts it at
+/// `time` (s), as render_particles draws it; z is 0 in 2D. Precondition: k < sim.obstacles.size().
+SolidBox obstacle_solid(const SimulationParams<2>& sim, std::size_t k, double time);
+SolidBox obstacle_solid(const SimulationParams<3>& sim, std::size_t k, double time);
+
+/// The scene's obstacles (its Obstacles) as render_particles draws them at `time` (s, a frame's
+/// simulated time), in the scene's order: each moving one where its motion puts it then, the
+/// others at rest (obstacle_solid).
+std::vector<SolidBox> run_obstacles(const RunDirectory& run, double time);
 
 /// The color range for `by` over whole runs (color_range of every run's values together), from
 /// at most `max_frames` evenly spaced frames of each run (first and last included) and at most

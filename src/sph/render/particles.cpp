@@ -166,8 +166,9 @@ void fill_face(Image& img, const Face& f, double edge, std::vector<float>* depth
 /// The outline width of solids, in pixels: about 1.5 at 800 x 600, wider in larger images.
 double solid_edge_width(const Image& img) { return 0.75 + std::min(img.width(), img.height()) / 800.0; }
 
-/// The faces of a solid box turned to the camera, flat-shaded by facing: one rectangle in 2D, up
-/// to three faces in 3D.
+/// The faces of a solid box turned to the camera, flat-shaded by facing: one quadrilateral in 2D
+/// (the placed rectangle), up to three faces in 3D. Corners are placed by the box's pose, and a
+/// face is turned to the camera by its rotated normal R e_a.
 std::vector<Face> solid_faces(const SolidBox& box, int dim, const ParticleCamera& cam) {
   std::vector<Face> faces;
   if (dim == 2) {
@@ -175,7 +176,7 @@ std::vector<Face> solid_faces(const SolidBox& box, int dim, const ParticleCamera
     const Vec3 corners[4] = {
         {box.lo[0], box.lo[1], 0}, {box.hi[0], box.lo[1], 0}, {box.hi[0], box.hi[1], 0}, {box.lo[0], box.hi[1], 0}};
     for (int k = 0; k < 4; ++k) {
-      const Vec3 s = cam.project(corners[k]);
+      const Vec3 s = cam.project(box.place(corners[k], 2));
       f.q[k] = {s[0], s[1]};
     }
     f.color = kSolidColor;
@@ -183,10 +184,12 @@ std::vector<Face> solid_faces(const SolidBox& box, int dim, const ParticleCamera
     return faces;
   }
   const auto& axes = cam.axes();
-  for (int a = 0; a < 3; ++a)
+  for (int a = 0; a < 3; ++a) {
+    const Vec3 normal = box.axis(a, 3);  // of the face on the hi side; the lo side's is its opposite
+    const Vec3 n_cam{dot(normal, axes[0]), dot(normal, axes[1]), dot(normal, axes[2])};
     for (int side = 0; side < 2; ++side) {
       const double sign = side ? 1.0 : -1.0;
-      if (!(sign * axes[2][a] > 1e-9)) continue;  // turned away from the camera, or edge-on
+      if (!(sign * n_cam[2] > 1e-9)) continue;  // turned away from the camera, or edge-on
       const int b = (a + 1) % 3, c = (a + 2) % 3;
       Face f;
       std::array<double, 4> w{};
@@ -195,7 +198,7 @@ std::vector<Face> solid_faces(const SolidBox& box, int dim, const ParticleCamera
         p[a] = side ? box.hi[a] : box.lo[a];
         p[b] = k == 1 || k == 2 ? box.hi[b] : box.lo[b];
         p[c] = k >= 2 ? box.hi[c] : box.lo[c];
-        const Vec3 s = cam.project(p);
+        const Vec3 s = cam.project(box.place(p, 3));
         f.q[k] = {s[0], s[1]};
         w[k] = s[2];
       }
@@ -207,20 +210,28 @@ std::vector<Face> solid_faces(const SolidBox& box, int dim, const ParticleCamera
       f.w0 = w[0];
       f.gx = ((w[1] - w[0]) * by - (w[3] - w[0]) * ay) / det;
       f.gy = ((w[3] - w[0]) * ax - (w[1] - w[0]) * bx) / det;
-      const Vec3 n_cam{sign * axes[0][a], sign * axes[1][a], sign * axes[2][a]};
-      f.color = scaled(kSolidColor, kFaceAmbient + kFaceDiffuse * std::max(0.0, dot(n_cam, kFaceLight)));
+      const Vec3 face_n{sign * n_cam[0], sign * n_cam[1], sign * n_cam[2]};
+      f.color = scaled(kSolidColor, kFaceAmbient + kFaceDiffuse * std::max(0.0, dot(face_n, kFaceLight)));
       faces.push_back(f);
     }
+  }
   return faces;
 }
 
-/// Throws sph::Error for a solid with non-finite corners or lo > hi.
+/// Throws sph::Error for a solid with non-finite corners or placement, or lo > hi.
 void check_solids(std::span<const SolidBox> solids, int dim) {
-  for (std::size_t k = 0; k < solids.size(); ++k)
+  for (std::size_t k = 0; k < solids.size(); ++k) {
+    const SolidBox& s = solids[k];
     for (int a = 0; a < dim; ++a)
-      if (!std::isfinite(solids[k].lo[a]) || !std::isfinite(solids[k].hi[a]) || solids[k].lo[a] > solids[k].hi[a])
+      if (!std::isfinite(s.lo[a]) || !std::isfinite(s.hi[a]) || s.lo[a] > s.hi[a])
         throw Error(fmt::format("obstacle {} must have finite corners with lo <= hi (axis {}: {} .. {})", k + 1,
-                                "xyz"[a], solids[k].lo[a], solids[k].hi[a]));
+                                "xyz"[a], s.lo[a], s.hi[a]));
+    const auto finite = [](double v) { return std::isfinite(v); };
+    if (!std::all_of(s.rotation.begin(), s.rotation.end(), finite) ||
+        !std::all_of(s.center.begin(), s.center.end(), finite) ||
+        !std::all_of(s.translation.begin(), s.translation.end(), finite))
+      throw Error(fmt::format("obstacle {} must have a finite placement (rotation, center and translation)", k + 1));
+  }
 }
 
 /// A projected edge of the container box; `front` if it bounds a face turned to the camera (always in 2D).
@@ -259,6 +270,33 @@ std::vector<BoxEdge> box_edges(const ParticleCamera& cam, int dim, const Vec3& b
 }
 
 }  // namespace
+
+bool SolidBox::axis_aligned() const {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      if (rotation[static_cast<std::size_t>(3 * r + c)] != (r == c ? 1.0 : 0.0)) return false;
+  return true;
+}
+
+Vec3 SolidBox::place(const Vec3& p, int dim) const {
+  Vec3 x = p;
+  if (axis_aligned()) {  // p + t exactly: an obstacle at rest is drawn as it was before poses existed
+    for (int a = 0; a < dim; ++a) x[a] = p[a] + translation[a];
+    return x;
+  }
+  for (int a = 0; a < dim; ++a) {
+    double r = 0;
+    for (int b = 0; b < dim; ++b) r += rotation[static_cast<std::size_t>(3 * a + b)] * (p[b] - center[b]);
+    x[a] = center[a] + translation[a] + r;
+  }
+  return x;
+}
+
+Vec3 SolidBox::axis(int a, int dim) const {
+  Vec3 v{};
+  for (int r = 0; r < dim; ++r) v[r] = rotation[static_cast<std::size_t>(3 * r + a)];
+  return v;
+}
 
 ParticleView default_particle_view(int dim, int width, int height) {
   ParticleView v;

@@ -22,10 +22,23 @@ struct ParticleView {
   bool shaded = true;  ///< sphere shading (Lambert, light from the upper left, plus ambient)
 };
 
-/// A solid axis-aligned box to draw (an obstacle of the scene): corners in world units, z
-/// ignored in 2D.
+/// A solid box to draw (an obstacle of the scene): the box [lo, hi] at rest, in world units, and
+/// the rigid placement that puts its point p at center + translation + R (p - center), R =
+/// `rotation` (row-major 3 x 3), so that a moving obstacle is drawn where it is. The default
+/// placement is the identity: `SolidBox{lo, hi}` is the axis-aligned box itself. In 2D, z is
+/// ignored and only the upper-left 2 x 2 of R is used.
 struct SolidBox {
   std::array<double, 3> lo{}, hi{};
+  std::array<double, 9> rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};  ///< R, a rotation
+  std::array<double, 3> center{}, translation{};              ///< c and t, world units
+
+  /// Whether R is the identity (the box is axis-aligned, only translated if at all).
+  bool axis_aligned() const;
+  /// Where the point p of the box at rest is drawn: c + t + R (p - c) (2D: x, y only, z kept).
+  /// Exactly p + t when R is the identity.
+  std::array<double, 3> place(const std::array<double, 3>& p, int dim) const;
+  /// The world direction of the box's axis a (0, 1, 2): R e_a, its face normals' direction.
+  std::array<double, 3> axis(int a, int dim) const;
 };
 
 /// The fill of a solid box in 2D, and the base color of its faces in 3D (each face scaled by
@@ -72,14 +85,16 @@ class ParticleCamera {
 /// algorithm; equal depths in index order), in 2D in index order. Particles with a non-finite
 /// coordinate are skipped.
 ///
-/// Each of `solids` is drawn as a solid box with a kSolidEdgeColor outline: in 2D a rectangle
-/// filled with kSolidColor, drawn over the particles and the container outline; in 3D its faces
-/// turned to the camera, flat-shaded by facing, hidden per pixel behind nearer faces and by
-/// particles nearer than the face (depth of the particle's center), and hiding the particles
-/// behind them. Either way a particle inside a solid (a leak) is not seen: the solid always reads
-/// as the solid the fluid meets. Without solids the image is the same as before they existed.
+/// Each of `solids` is drawn, where its placement puts it, as a solid box with a kSolidEdgeColor
+/// outline: in 2D a rectangle (turned, if it is) filled with kSolidColor, drawn over the
+/// particles and the container outline; in 3D its faces turned to the camera (by their rotated
+/// normals), flat-shaded by facing, hidden per pixel behind nearer faces and by particles nearer
+/// than the face (depth of the particle's center), and hiding the particles behind them. Either way a particle inside a
+/// solid (a leak) is not seen: the solid always reads as the solid the fluid meets. Without solids the image is the
+/// same as before they existed.
 ///
-/// Throws sph::Error as ParticleCamera does, and for a solid with non-finite corners or lo > hi.
+/// Throws sph::Error as ParticleCamera does, and for a solid with non-finite corners or
+/// placement, or lo > hi.
 /// Preconditions: dim is 2 or 3, xyz.size() is a multiple of dim, colors.size() is 0, 1 or the
 /// particle count.
 Image render_particles(std::span<const double> xyz, int dim, std::span<const Rgb> colors, double radius,

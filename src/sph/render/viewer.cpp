@@ -58,6 +58,7 @@ struct EncodedFrame {
   std::vector<std::uint16_t> position;     ///< dim per particle
   std::vector<std::vector<float>> values;  ///< per offered scalar quantity
   std::vector<std::uint8_t> rgb;           ///< initial-position colors, when per frame
+  std::vector<SolidBox> obstacles;         ///< where the obstacles are, when some obstacle moves
 };
 
 struct EncodedRun {
@@ -194,12 +195,12 @@ PageQuantities page_quantities(const std::vector<ColorBy>& asked, const std::vec
 /// Refuses, before the frames are read, a page whose estimated size is above options.max_bytes.
 void check_page_estimate(const fs::path& dir, const ViewOptions& options,
                          const std::vector<std::vector<std::size_t>>& picks, const PageQuantities& q, int dim,
-                         std::size_t max_particles) {
+                         std::size_t max_particles, std::size_t pose_bytes) {
   const std::size_t runs = picks.size();
   std::size_t frames = 0;
   for (const auto& p : picks) frames += p.size();
   const std::size_t per_particle = 2 * static_cast<std::size_t>(dim) + q.scalars.size();
-  const std::size_t estimate = base64_size(per_particle * max_particles) * frames + 100 * frames +
+  const std::size_t estimate = base64_size(per_particle * max_particles) * frames + (100 + pose_bytes) * frames +
                                (q.rgb ? base64_size(3 * max_particles) * runs : 0) + detail::viewer_html().size() +
                                detail::viewer_css().size() + detail::viewer_js().size();
   if (estimate <= options.max_bytes) return;
@@ -260,6 +261,33 @@ EncodedFrame encode_frame(const FrameData& frame, const RunDirectory& run, const
   return ef;
 }
 
+/// Whether an obstacle of the run's scene moves (its frames then carry the obstacles' poses).
+bool obstacles_move(const RunDirectory& run) {
+  return run.scene.visit_body([](const auto& body) { return any_obstacle_moves(body.sim); });
+}
+
+/// The obstacles' placements in a frame: [[r00, r01, r02, r10, r11, r12, r20, r21, r22, cx, cy,
+/// cz, tx, ty, tz], ...], one per obstacle in the scene's order (SolidBox: a point p of the box at
+/// rest is at c + t + R (p - c); 2D: the upper-left 2 x 2 of R, z = 0).
+std::string poses_json(const std::vector<SolidBox>& obstacles) {
+  std::string out = "[";
+  for (const SolidBox& b : obstacles) {
+    out += out.size() > 1 ? ",[" : "[";
+    bool first = true;
+    const auto add = [&](double v) {
+      out += first ? "" : ",";
+      out += json_number(v);
+      first = false;
+    };
+    for (double v : b.rotation) add(v);
+    for (double v : b.center) add(v);
+    for (double v : b.translation) add(v);
+    out += ']';
+  }
+  out += ']';
+  return out;
+}
+
 /// The kept frames `picks` of one run, `first` being the first of them, already read; raises
 /// `max_particles` to the largest frame.
 EncodedRun encode_run(const RunDirectory& run, const std::vector<std::size_t>& picks, FrameData first,
@@ -267,6 +295,7 @@ EncodedRun encode_run(const RunDirectory& run, const std::vector<std::size_t>& p
                       std::size_t& max_particles) {
   EncodedRun er;
   er.label = run.label;
+  const bool moving = obstacles_move(run);
   bool ids_dense = true;
   std::vector<std::uint8_t> rgb_by_id;
   for (std::size_t k = 0; k < picks.size(); ++k) {
@@ -276,6 +305,7 @@ EncodedRun encode_run(const RunDirectory& run, const std::vector<std::size_t>& p
     else
       frame = read_frame(run.frames[picks[k]]);
     EncodedFrame ef = encode_frame(frame, run, qb, q, stride, samples, ids_dense);
+    if (moving) ef.obstacles = run_obstacles(run, frame.time);
     if (ef.rgb.size() > rgb_by_id.size()) rgb_by_id = ef.rgb;
     max_particles = std::max(max_particles, frame.size);
     er.frames.push_back(std::move(ef));
@@ -346,6 +376,7 @@ std::string runs_json(std::vector<EncodedRun>& encoded, std::vector<OfferedScala
         append_base64(out, f.rgb);
         out += '"';
       }
+      if (!f.obstacles.empty()) out += ",\"poses\":" + poses_json(f.obstacles);
       out += '}';
       f = EncodedFrame{};  // free as we go
     }
@@ -394,10 +425,11 @@ std::string json_vec3(const std::array<double, 3>& v) {
   return fmt::format("[{},{},{}]", json_number(v[0]), json_number(v[1]), json_number(v[2]));
 }
 
-/// The scene's obstacles as [{"lo": [x, y, z], "hi": [x, y, z]}, ...] (z = 0 in 2D).
+/// The scene's obstacles at rest as [{"lo": [x, y, z], "hi": [x, y, z]}, ...] (z = 0 in 2D); a
+/// moving one's frames place them ("poses", poses_json).
 std::string obstacles_json(const RunDirectory& run) {
   std::string out = "[";
-  for (const SolidBox& b : run_obstacles(run))
+  for (const SolidBox& b : run_obstacles(run, 0.0))
     out += fmt::format("{}{{\"lo\":{},\"hi\":{}}}", out.size() > 1 ? "," : "", json_vec3(b.lo), json_vec3(b.hi));
   out += ']';
   return out;
@@ -442,7 +474,11 @@ ViewPage build_view_page(const fs::path& dir, const ViewOptions& options) {
     if (picks[r].size() > 1) max_particles = std::max(max_particles, read_frame(runs[r].frames[picks[r].back()]).size);
   }
   const PageQuantities q = page_quantities(options.color_by, runs, first_frames);
-  check_page_estimate(dir, options, picks, q, run0.dimension, max_particles);
+  // A scene with moving obstacles places each obstacle in every frame: 15 numbers, at most ~25
+  // characters each.
+  const std::size_t pose_bytes =
+      obstacles_move(run0) ? 400 * run0.scene.visit_body([](const auto& b) { return b.sim.obstacles.size(); }) : 0;
+  check_page_estimate(dir, options, picks, q, run0.dimension, max_particles, pose_bytes);
 
   // Read every kept frame once: positions quantized now, scalars kept until their run-wide
   // range is known. The range comes from a sample of at most ~4 million values per quantity

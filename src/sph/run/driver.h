@@ -51,7 +51,7 @@ struct RunSettings {
   /// Also the free surface of every frame written (`sph run --surface`): DIR/surface/
   /// surface_NNNNNN.ply, .obj, .vdb (sph/surface/mesh_files.h). Its spacing is taken from the
   /// scene (2 Configuration.particleRadius). Needs `dir`.
-  std::optional<SurfaceOutput> surface;
+  std::optional<SurfaceOutput> surface{};
 };
 
 /// What the caller hears during the run. Each is called between steps; any may be empty.

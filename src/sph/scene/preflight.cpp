@@ -95,6 +95,42 @@ void check_obstacles_inside(const ReadContext& ctx, const SimulationParams<D>& s
   }
 }
 
+/// A moving obstacle must stay inside the container: its corners are checked at 4,096 times
+/// evenly over the run (and at each key of keyframes), and one that goes farther than the kernel
+/// radius past a wall is refused (a unit mistake, or an amplitude too large for the tank). Less
+/// is allowed: a paddle standing on the floor that tilts a little pokes into the floor, which
+/// holds the fluid there anyway.
+template <int D>
+void check_motions_stay_inside(const ReadContext& ctx, const SceneDesc& desc, const SimulationParams<D>& sim) {
+  const Box<D>& c = sim.container;
+  const double run = desc.end_time > 0 ? desc.end_time : static_cast<double>(desc.steps) * sim.time_step;
+  for (std::size_t k = 0; k < sim.obstacles.size(); ++k) {
+    const ObstacleMotion<D>& m = obstacle_motion(sim, k);
+    if (!m.moves()) continue;
+    std::vector<double> times;
+    constexpr int kSamples = 4096;
+    for (int j = 0; j <= kSamples; ++j) times.push_back(run * j / kSamples);
+    for (const MotionKey<D>& key : m.keys)
+      if (key.time <= run) times.push_back(key.time);
+    for (const double t : times) {
+      const RigidPose<D> pose = pose_at(m, t);
+      for (int corner = 0; corner < (1 << D); ++corner) {
+        Vec<D, double> X;
+        for (int d = 0; d < D; ++d) X[d] = corner >> d & 1 ? sim.obstacles[k].hi[d] : sim.obstacles[k].lo[d];
+        const Vec<D, double> x = pose.place(X);
+        double out = 0;
+        for (int d = 0; d < D; ++d) out = std::max({out, c.lo[d] - x[d], x[d] - c.hi[d]});
+        if (out > sim.kernel_radius)
+          ctx.fail(fmt::format("Obstacles[{}].motion", k),
+                   fmt::format("the motion takes the obstacle out of the container {}: at t = {:.6g} s its corner {} "
+                               "is at {}, {:.3g} m past the wall (at most the kernel radius, {:.3g} m, is allowed); "
+                               "make the motion smaller, or the obstacle, so that it stays inside",
+                               box_text<D>(c), t, point_text<D>(X), point_text<D>(x), out, sim.kernel_radius));
+      }
+    }
+  }
+}
+
 /// Obstacles covering the whole container are refused (the fluid has no room at all).
 template <int D>
 void check_obstacles_leave_room(const ReadContext& ctx, const SimulationParams<D>& sim) {
@@ -255,6 +291,7 @@ void preflight(SceneDesc& desc, const detail::ReadContext& ctx) {
   SceneBody<D>& body = desc.body<D>();
   const SimulationParams<D>& sim = body.sim;
   check_obstacles_inside<D>(ctx, sim);
+  check_motions_stay_inside<D>(ctx, desc, sim);
   check_obstacles_leave_room<D>(ctx, sim);
   check_coordinates<D>(ctx, desc, sim);
   check_blocks_apart<D>(ctx, body);

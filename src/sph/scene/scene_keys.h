@@ -24,45 +24,51 @@ namespace sph::detail {
 inline const std::vector<std::string> kRootKeys{"version",     "name",          "description", "units",
                                                 "dimension",   "Configuration", "Fluid",       "Container",
                                                 "FluidBlocks", "Obstacles",     "Emitters"};
-inline const std::vector<std::string> kConfigurationKeys{"precision",
-                                                         "timeStepSize",
-                                                         "numberOfSteps",
-                                                         "stopAt",
-                                                         "particleRadius",
-                                                         "kernelRadius",
-                                                         "gravitation",
-                                                         "neighbors",
-                                                         "fullRebuildPeriod",
-                                                         "verletSkin",
-                                                         "trackedSkin",
-                                                         "reorderPeriod",
-                                                         "boundaryHandling",
-                                                         "boundaryVolume",
-                                                         "boundaryPressure",
-                                                         "boundaryFriction",
-                                                         "kernel",
-                                                         "outputEveryNSteps",
-                                                         "outputFps",
-                                                         "outputFormats",
-                                                         "outputFields",
-                                                         "outputBoundary",
-                                                         "cflMethod",
-                                                         "cflFactor",
-                                                         "cflMinTimeStepSize",
-                                                         "cflMaxTimeStepSize",
-                                                         "simulationMethod",
-                                                         "minIterations",
-                                                         "maxIterations",
-                                                         "maxError",
-                                                         "enableDivergenceSolver",
-                                                         "maxIterationsV",
-                                                         "maxErrorV"};
+inline const std::vector<std::string> kConfigurationKeys{"precision",          "timeStepSize",
+                                                         "numberOfSteps",      "stopAt",
+                                                         "particleRadius",     "kernelRadius",
+                                                         "gravitation",        "neighbors",
+                                                         "fullRebuildPeriod",  "flagNearMovingBodies",
+                                                         "verletSkin",         "trackedSkin",
+                                                         "reorderPeriod",      "boundaryHandling",
+                                                         "boundaryVolume",     "boundaryPressure",
+                                                         "boundaryFriction",   "kernel",
+                                                         "outputEveryNSteps",  "outputFps",
+                                                         "outputFormats",      "outputFields",
+                                                         "outputBoundary",     "cflMethod",
+                                                         "cflFactor",          "cflMinTimeStepSize",
+                                                         "cflMaxTimeStepSize", "simulationMethod",
+                                                         "minIterations",      "maxIterations",
+                                                         "maxError",           "enableDivergenceSolver",
+                                                         "maxIterationsV",     "maxErrorV"};
 inline const std::vector<std::string> kFluidKeys{
     "density0",         "stiffness",     "viscosity",          "viscosityModel", "artificialViscosityAlpha",
     "negativePressure", "pressureForce", "gradientCorrection", "particleMass"};
 inline const std::vector<std::string> kContainerKeys{"start", "end", "wallStiffness", "wallDamping"};
 inline const std::vector<std::string> kFluidBlockKeys{"start", "end", "velocity"};
-inline const std::vector<std::string> kObstacleKeys{"start", "end"};
+inline const std::vector<std::string> kObstacleKeys{"start", "end", "motion"};
+/// The keys of an obstacle's motion of each type (Obstacles[].motion; "type" first), in D
+/// dimensions: a 2D rotation turns about the z axis, so it has no "axis".
+inline std::vector<std::string> motion_keys(MotionType type, int dimension) {
+  switch (type) {
+    case MotionType::None:
+      return {"type"};
+    case MotionType::Oscillation:
+      return {"type", "direction", "amplitude", "period", "phase", "rampTime"};
+    case MotionType::Rotation:
+      if (dimension == 2) return {"type", "center", "angularVelocity", "rampTime"};
+      return {"type", "axis", "center", "angularVelocity", "rampTime"};
+    case MotionType::Keyframes:
+      if (dimension == 2) return {"type", "center", "keys"};
+      return {"type", "axis", "center", "keys"};
+  }
+  return {"type"};
+}
+/// Every key a motion of any type may have (the reader checks each against the type's own).
+inline const std::vector<std::string> kAnyMotionKeys{"type", "direction", "amplitude",       "period", "phase",
+                                                     "axis", "center",    "angularVelocity", "keys",   "rampTime"};
+/// The keys of one of a keyframes motion's keys.
+inline const std::vector<std::string> kMotionKeyKeys{"time", "translation", "rotation"};
 /// The keys the writer never writes because the reader resolves them into another key's value.
 inline const std::vector<std::string> kWriterResolvedKeys{"stopAt"};
 /// An emitter's keys in D dimensions: a 2D nozzle is a line of `width` particles (no height).
@@ -99,6 +105,10 @@ inline constexpr Named<KernelKind> kKernelNames[] = {
 inline constexpr Named<SimulationMethod> kSimulationMethodNames[] = {{SimulationMethod::Wcsph, "wcsph"},
                                                                      {SimulationMethod::Dfsph, "dfsph"}};
 inline constexpr Named<TimeStepping> kCflMethodNames[] = {{TimeStepping::Fixed, "none"}, {TimeStepping::Cfl, "cfl"}};
+inline constexpr Named<MotionType> kMotionTypeNames[] = {{MotionType::None, "none"},
+                                                         {MotionType::Oscillation, "oscillation"},
+                                                         {MotionType::Rotation, "rotation"},
+                                                         {MotionType::Keyframes, "keyframes"}};
 inline constexpr Named<ViscosityModel> kViscosityModelNames[] = {{ViscosityModel::Paper, "paper"},
                                                                  {ViscosityModel::Artificial, "artificial"}};
 

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include <sph/core/error.h>
@@ -71,6 +72,81 @@ Box<D> read_box(ObjectReader& r, const char* what) {
                                                "double in some coordinate",
                                                what, point_text<D>(b.lo), point_text<D>(b.hi)));
   return b;
+}
+
+/// A unit vector from `key` (any non-zero length), m.
+template <int D>
+Vec<D, double> read_unit(ObjectReader& r, const std::string& key, const std::string& what,
+                         std::optional<Vec<D, double>> def = {}) {
+  const Vec<D, double> v = r.vec<D>(key, what, def);
+  const double n = std::sqrt(norm2(v));
+  if (!(n > 0) || !std::isfinite(n))
+    r.ctx().fail(r.child(key), fmt::format("expected {}, got {} (it has no direction)", what, point_text<D>(v)));
+  return v * (1.0 / n);
+}
+
+/// Obstacles[].motion of the obstacle `box` (docs/scene-format.md, "Obstacles").
+template <int D>
+ObstacleMotion<D> read_motion(ObjectReader& o, const Box<D>& box) {
+  using detail::names_of, detail::value_named;
+  ObstacleMotion<D> m;
+  o.object("motion", detail::kAnyMotionKeys, [&](ObjectReader& r) {
+    if (!o.find("motion")) return;
+    const std::vector<std::string> types = names_of(detail::kMotionTypeNames);
+    r.require("type", fmt::format("the kind of motion, one of \"{}\"", fmt::join(types, "\", \"")));
+    m.type = value_named(detail::kMotionTypeNames, r.choice("type", types, "none"));
+    // A key of another type's motion is refused, naming the keys this type takes.
+    const std::vector<std::string> own = detail::motion_keys(m.type, D);
+    for (const std::string& k : detail::kAnyMotionKeys)
+      if (r.find(k) && std::find(own.begin(), own.end(), k) == own.end())
+        r.ctx().fail(r.child(k), fmt::format("not a key of the motion type \"{}\"{}; it takes {}", r.string("type", ""),
+                                             k == "axis" && D == 2 ? " in 2D (2D rotations turn about z)" : "",
+                                             fmt::join(own, ", ")));
+    Vec<D, double> middle = (box.lo + box.hi) * 0.5;
+    switch (m.type) {
+      case MotionType::None:
+        break;
+      case MotionType::Oscillation:
+        m.direction = read_unit<D>(r, "direction", "the direction of the oscillation, a non-zero vector");
+        m.amplitude = r.positive("amplitude", "the amplitude of the oscillation, m (> 0)");
+        m.period = r.positive("period", "the period of the oscillation, s (> 0)");
+        m.phase = r.find("phase") ? r.number(*r.find("phase"), "phase", "the phase at t = 0 in rad, a number") : 0.0;
+        break;
+      case MotionType::Rotation:
+      case MotionType::Keyframes:
+        if constexpr (D == 3)
+          m.axis = read_unit<3>(r, "axis", "the rotation axis, a non-zero vector", Vec<3, double>{{0, 0, 1}});
+        m.center = r.vec<D>("center", "the point the obstacle turns about, m", middle);
+        break;
+    }
+    if (m.type == MotionType::Rotation)
+      m.angular_velocity =
+          r.number(r.require("angularVelocity", "the angular velocity in rad/s (counter-clockwise about the axis)"),
+                   "angularVelocity", "the angular velocity in rad/s, a number");
+    if (m.type == MotionType::Oscillation || m.type == MotionType::Rotation)
+      m.ramp_time = r.positive("rampTime", "a time over which the motion starts up, s (>= 0)", 0.0, true);
+    if (m.type == MotionType::Keyframes) {
+      r.require("keys", "the keyframes, an array of {\"time\", \"translation\", \"rotation\"}");
+      r.array_of_objects("keys", detail::kMotionKeyKeys, [&](ObjectReader& k, std::size_t i) {
+        MotionKey<D> key;
+        key.time = k.positive("time", "the key's time, s (>= 0)", std::nullopt, true);
+        key.translation = k.vec<D>("translation", "the translation at the key's time, m", Vec<D, double>{});
+        key.rotation = k.find("rotation") ? k.number(*k.find("rotation"), "rotation",
+                                                     "the rotation at the key's time in rad, a number")
+                                          : 0.0;
+        if (i == 0 && (norm2(key.translation) != 0 || key.rotation != 0))
+          k.ctx().fail(k.child(key.rotation != 0 ? "rotation" : "translation"),
+                       "the first key must have no translation and no rotation: the obstacle is where \"start\" "
+                       "and \"end\" put it until then; move the box there instead");
+        if (i > 0 && !(key.time > m.keys.back().time))
+          k.ctx().fail(k.child("time"),
+                       fmt::format("the keys' times must increase: {} s follows {} s", key.time, m.keys.back().time));
+        m.keys.push_back(key);
+      });
+      if (m.keys.empty()) r.ctx().fail(r.child("keys"), "expected at least one key {\"time\": ...}, got none");
+    }
+  });
+  return m;
 }
 
 /// Configuration.outputEveryNSteps, outputFps, outputFormats, outputFields.
@@ -185,6 +261,8 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
   sim.neighbors = parse_neighbor_mode(c.choice("neighbors", neighbor_mode_names(), "standard"), c.child("neighbors"));
   sim.full_rebuild_period = static_cast<int>(
       c.integer("fullRebuildPeriod", "a full-rebuild period of at least 1 step", 1, 1'000'000'000, 200));
+  sim.flag_near_moving = c.boolean(
+      "flagNearMovingBodies", "whether the adaptive mode rebuilds the lists of particles near moving obstacles", true);
   sim.reorder_period = static_cast<int>(
       c.integer("reorderPeriod", "a whole number of steps, 0 or more (0: never reorder particles in memory)", 0,
                 1'000'000'000, sim.full_rebuild_period));
@@ -476,8 +554,11 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
   root.object("Fluid", detail::kFluidKeys, [&](ObjectReader& f) { read_fluid<D>(f, sim, derived); });
   read_container<D>(root, sim, derived);
   double total = read_blocks<D>(root, body);
-  root.array_of_objects("Obstacles", detail::kObstacleKeys,
-                        [&](ObjectReader& o, std::size_t) { sim.obstacles.push_back(read_box<D>(o, "obstacle")); });
+  root.array_of_objects("Obstacles", detail::kObstacleKeys, [&](ObjectReader& o, std::size_t) {
+    sim.obstacles.push_back(read_box<D>(o, "obstacle"));
+    sim.motions.push_back(read_motion<D>(o, sim.obstacles.back()));
+  });
+  if (!any_obstacle_moves(sim)) sim.motions.clear();  // (all at rest: as a scene without motions)
   root.array_of_objects("Emitters", detail::emitter_keys(D), [&](ObjectReader& e, std::size_t) {
     sim.emitters.push_back(read_emitter<D>(e, sim));
     total += static_cast<double>(sim.emitters.back().max_particles);

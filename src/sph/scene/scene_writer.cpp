@@ -57,6 +57,7 @@ OrderedJson configuration_json(const SceneDesc& desc, const SimulationParams<D>&
       .put("gravitation", vec_json<D>(sim.gravity))
       .put("neighbors", std::string(to_string(sim.neighbors)))
       .put("fullRebuildPeriod", sim.full_rebuild_period)
+      .put("flagNearMovingBodies", sim.flag_near_moving)
       .put("verletSkin", sim.verlet_skin)
       .put("trackedSkin", sim.tracked_skin)
       .put("reorderPeriod", sim.reorder_period)
@@ -115,6 +116,42 @@ OrderedJson emitter_json(const EmitterParams<D>& e) {
 }
 
 template <int D>
+OrderedJson motion_json(const ObstacleMotion<D>& m) {
+  const std::vector<std::string> keys = detail::motion_keys(m.type, D);  // (the writer keeps a reference)
+  ObjectWriter w(keys);
+  w.put("type", detail::name_of(detail::kMotionTypeNames, m.type));
+  switch (m.type) {
+    case MotionType::None:
+      break;
+    case MotionType::Oscillation:
+      w.put("direction", vec_json<D>(m.direction))
+          .put("amplitude", m.amplitude)
+          .put("period", m.period)
+          .put("phase", m.phase)
+          .put("rampTime", m.ramp_time);
+      break;
+    case MotionType::Rotation:
+    case MotionType::Keyframes:
+      if constexpr (D == 3) w.put("axis", vec_json<3>(m.axis));
+      w.put("center", vec_json<D>(m.center));
+      if (m.type == MotionType::Rotation) {
+        w.put("angularVelocity", m.angular_velocity).put("rampTime", m.ramp_time);
+      } else {
+        OrderedJson keys = OrderedJson::array();
+        for (const MotionKey<D>& k : m.keys)
+          keys.push_back(ObjectWriter(detail::kMotionKeyKeys)
+                             .put("time", k.time)
+                             .put("translation", vec_json<D>(k.translation))
+                             .put("rotation", k.rotation)
+                             .take());
+        w.put("keys", std::move(keys));
+      }
+      break;
+  }
+  return w.take();
+}
+
+template <int D>
 void write_body(const SceneDesc& desc, const SceneBody<D>& body, ObjectWriter& root) {
   const SimulationParams<D>& sim = body.sim;
   OrderedJson blocks = OrderedJson::array(), obstacles = OrderedJson::array(), emitters = OrderedJson::array();
@@ -124,9 +161,12 @@ void write_body(const SceneDesc& desc, const SceneBody<D>& body, ObjectWriter& r
                          .put("end", vec_json<D>(b.box.hi))
                          .put("velocity", vec_json<D>(b.velocity))
                          .take());
-  for (const Box<D>& o : sim.obstacles)
-    obstacles.push_back(
-        ObjectWriter(detail::kObstacleKeys).put("start", vec_json<D>(o.lo)).put("end", vec_json<D>(o.hi)).take());
+  for (std::size_t k = 0; k < sim.obstacles.size(); ++k)
+    obstacles.push_back(ObjectWriter(detail::kObstacleKeys)
+                            .put("start", vec_json<D>(sim.obstacles[k].lo))
+                            .put("end", vec_json<D>(sim.obstacles[k].hi))
+                            .put("motion", motion_json<D>(obstacle_motion(sim, k)))
+                            .take());
   for (const EmitterParams<D>& e : sim.emitters) emitters.push_back(emitter_json<D>(e));
   root.put("Configuration", configuration_json<D>(desc, sim))
       .put("Fluid", fluid_json<D>(sim))

@@ -53,7 +53,7 @@ int boundary_layers(double spacing, double h) {
 
 template <int D>
 std::vector<Vec<D, double>> sample_boundary(const Box<D>& container, const std::vector<Box<D>>& obstacles,
-                                            double spacing, double h) {
+                                            double spacing, double h, std::vector<std::size_t>* obstacle_begin) {
   const int layers = boundary_layers(spacing, h);
   std::vector<Vec<D, double>> out;
   // The container's shell: sites outside the box on at least one axis.
@@ -70,6 +70,7 @@ std::vector<Vec<D, double>> sample_boundary(const Box<D>& container, const std::
     if (outside) out.push_back(x);
   });
   // Each obstacle: its sites within `layers` of a face, inside the container.
+  if (obstacle_begin) obstacle_begin->assign(1, out.size());
   for (const Box<D>& b : obstacles) {
     for (int d = 0; d < D; ++d) axes[d] = axis_sites(b.lo[d], b.hi[d], spacing, layers, false);
     for_each_site<D>(axes, [&](const std::array<int, D>& idx) {
@@ -83,6 +84,7 @@ std::vector<Vec<D, double>> sample_boundary(const Box<D>& container, const std::
       }
       if (near_face && in_container) out.push_back(x);
     });
+    if (obstacle_begin) obstacle_begin->push_back(out.size());
   }
   return out;
 }
@@ -156,9 +158,9 @@ template <int D, std::floating_point R>
 BoundarySet<D, R> make_boundary(const SimulationParams<D>& params) {
   BoundarySet<D, R> set;
   if (params.boundary.handling != BoundaryHandling::Particles) return set;
-  for (const auto& x :
-       sample_boundary<D>(params.container, params.obstacles, 2.0 * params.particle_radius, params.kernel_radius))
-    set.position.push_back(vec_cast<R>(x));
+  const std::vector<Vec<D, double>> samples = sample_boundary<D>(
+      params.container, params.obstacles, 2.0 * params.particle_radius, params.kernel_radius, &set.obstacle_begin);
+  for (const auto& x : samples) set.position.push_back(vec_cast<R>(x));
   SPH_CHECK(set.position.size() < (std::size_t{1} << 31) / D, "too many boundary samples for 32-bit gather offsets");
   std::vector<Vec<D, R>> rest;
   if (params.boundary.volume == BoundaryVolume::RestFluid)
@@ -166,17 +168,41 @@ BoundarySet<D, R> make_boundary(const SimulationParams<D>& params) {
          rest_fluid_sites<D>(params.container, params.obstacles, 2.0 * params.particle_radius, params.kernel_radius))
       rest.push_back(vec_cast<R>(x));
   set.psi = boundary_psi<D, R>(set.position, params.fluid, static_cast<R>(params.kernel_radius), rest);
+  if (any_obstacle_moves(params)) {
+    set.rest_position = samples;
+    set.velocity.assign(set.size(), Vec<D, R>{});
+    place_boundary(set, params, 0.0);
+  }
   return set;
 }
 
-template std::vector<Vec<2, double>> sample_boundary<2>(const Box<2>&, const std::vector<Box<2>>&, double, double);
-template std::vector<Vec<3, double>> sample_boundary<3>(const Box<3>&, const std::vector<Box<3>>&, double, double);
+template <int D, std::floating_point R>
+void place_boundary(BoundarySet<D, R>& set, const SimulationParams<D>& params, double t) {
+  if (!set.moving()) return;
+  for (std::size_t k = 0; k < params.obstacles.size(); ++k) {
+    const ObstacleMotion<D>& motion = obstacle_motion(params, k);
+    if (!motion.moves()) continue;
+    const RigidPose<D> pose = pose_at(motion, t);
+    const std::size_t b = set.obstacle_begin[k], e = set.obstacle_begin[k + 1];
+    parallel_for(e - b, [&](std::size_t s) {
+      const Vec<D, double> x = pose.place(set.rest_position[b + s]);
+      set.position[b + s] = vec_cast<R>(x);
+      set.velocity[b + s] = vec_cast<R>(pose.velocity_at(x));
+    });
+  }
+}
+
+template std::vector<Vec<2, double>> sample_boundary<2>(const Box<2>&, const std::vector<Box<2>>&, double, double,
+                                                        std::vector<std::size_t>*);
+template std::vector<Vec<3, double>> sample_boundary<3>(const Box<3>&, const std::vector<Box<3>>&, double, double,
+                                                        std::vector<std::size_t>*);
 template std::vector<Vec<2, double>> rest_fluid_sites<2>(const Box<2>&, const std::vector<Box<2>>&, double, double);
 template std::vector<Vec<3, double>> rest_fluid_sites<3>(const Box<3>&, const std::vector<Box<3>>&, double, double);
 #define SPH_INSTANTIATE(D, R)                                                                   \
   template std::vector<R> boundary_psi<D, R>(std::span<const Vec<D, R>>, const FluidParams&, R, \
                                              std::span<const Vec<D, R>>);                       \
-  template BoundarySet<D, R> make_boundary<D, R>(const SimulationParams<D>&);
+  template BoundarySet<D, R> make_boundary<D, R>(const SimulationParams<D>&);                   \
+  template void place_boundary<D, R>(BoundarySet<D, R>&, const SimulationParams<D>&, double);
 SPH_INSTANTIATE(2, float)
 SPH_INSTANTIATE(2, double)
 SPH_INSTANTIATE(3, float)

@@ -29,18 +29,35 @@ namespace sph {
 int boundary_layers(double spacing, double h);
 
 /// The sample positions of the container's shell and the obstacles (in that order, each in a
-/// fixed lattice order), m.
+/// fixed lattice order), m. With `obstacle_begin`, obstacle k's samples are
+/// [(*obstacle_begin)[k], (*obstacle_begin)[k + 1]) (obstacles.size() + 1 entries).
 template <int D>
 std::vector<Vec<D, double>> sample_boundary(const Box<D>& container, const std::vector<Box<D>>& obstacles,
-                                            double spacing, double h);
+                                            double spacing, double h,
+                                            std::vector<std::size_t>* obstacle_begin = nullptr);
 
-/// The static boundary of a run: sample positions and each sample's psi, kg (kg/m in 2D).
+/// The boundary of a run: sample positions and each sample's psi, kg (kg/m in 2D). The samples of
+/// moving obstacles (motion.h) are placed at each step's time by place_boundary(); their psi is
+/// the one they have at rest (a rigid motion keeps an obstacle's own samples' spacing).
 template <int D, std::floating_point R>
 struct BoundarySet {
-  std::vector<Vec<D, R>> position;
+  std::vector<Vec<D, R>> position;  ///< where the samples are now, m
   std::vector<R> psi;
+  /// Obstacle k's samples are [obstacle_begin[k], obstacle_begin[k + 1]); the container's come
+  /// first, [0, obstacle_begin[0]).
+  std::vector<std::size_t> obstacle_begin;
+  /// When an obstacle moves: every sample's position at rest, and its velocity now (zero for
+  /// the container's and the resting obstacles'). Empty when nothing moves.
+  std::vector<Vec<D, double>> rest_position;
+  std::vector<Vec<D, R>> velocity;
   std::size_t size() const { return position.size(); }
+  bool moving() const { return !velocity.empty(); }
 };
+
+/// Places the moving obstacles' samples of `set` (make_boundary's for `params`) where their
+/// motions put them at time t, with their velocities. Nothing if no obstacle moves.
+template <int D, std::floating_point R>
+void place_boundary(BoundarySet<D, R>& set, const SimulationParams<D>& params, double t);
 
 /// The lattice sites of fluid at rest next to the solids (BoundaryVolume::RestFluid): the
 /// container's interior sites within the layers' depth of a face, and each obstacle's sites

@@ -93,6 +93,7 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
   }
   full_.resize(n);
   solid_.resize(n);
+  solid_rate_.assign(boundary.velocity.empty() ? 0 : n, R(0));
   // The step's pairs within h, once: each solve iteration then reads m_j grad W_ij instead of
   // evaluating the kernel again (about half the entries of a list are within h).
   begin_.resize(n + 1);
@@ -122,6 +123,7 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
         },
         [&](std::uint32_t b, const Vec<D, R>& g) {
           solid += g * boundary.psi[b];
+          if (!boundary.velocity.empty()) solid_rate_[i] += boundary.psi[b] * dot(boundary.velocity[b], g);
           ++count;
         });
     sum += solid;
@@ -195,11 +197,13 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
   // expand a little in any step: they keep their pressure, and the solve balances it exactly).
   parallel_for(n, [&](std::size_t i) {
     R err;
+    // (moving obstacles: the samples' own velocities count, sum_b psi_b (v_i - v_b) . grad W_ib)
+    const R moving = solid_rate_.empty() ? R(0) : solid_rate_[i];
     if constexpr (kDensity)
       err = ps.density[i] - rho0 +
-            dt * density_rate(i, [&](std::size_t j) { return ps.velocity[j] + ps.acceleration[j] * dt; });
+            dt * (density_rate(i, [&](std::size_t j) { return ps.velocity[j] + ps.acceleration[j] * dt; }) - moving);
     else
-      err = density_rate(i, [&](std::size_t j) { return ps.velocity[j]; });
+      err = density_rate(i, [&](std::size_t j) { return ps.velocity[j]; }) - moving;
     // (the divergence solve leaves out the particles without a full neighbourhood: at a free
     // surface or in a splash, their velocity divergence is the kernel's truncation, not a flow
     // to correct; SPlisHSPlasH does the same)

@@ -115,6 +115,9 @@ class DfsphSolver {
   std::vector<std::uint32_t> pair_j_;
   std::vector<Vec<D, R>> pair_g_;
   std::vector<Vec<D, R>> solid_;
+  // Moving obstacles: sum_b psi_b v_b . grad W_ib, the samples' share of the density rate (empty
+  // when every sample is at rest).
+  std::vector<R> solid_rate_;
   std::vector<R> b_, s_, r_, z_, p_, as_, ap_;
   std::vector<Vec<D, R>> acc_s_, acc_p_;
   std::vector<double> partial_;  // per-chunk sums

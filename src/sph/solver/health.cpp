@@ -71,7 +71,7 @@ HealthScene health_scene(const SimulationParams<D>& p) {
     for (int d = 0; d < D; ++d) head += std::abs(p.gravity[d]) * (p.container.hi[d] - p.container.lo[d]);
     s.head = head / s.gravity;
   }
-  s.closed = p.emitters.empty();
+  s.closed = p.emitters.empty() && !any_obstacle_moves(p);  // (a moving obstacle does work on the fluid)
   s.tension = p.fluid.negative_pressure == NegativePressure::Allow;
   s.incompressible = p.method == SimulationMethod::Dfsph;
   s.boundary_particles = p.boundary.handling == BoundaryHandling::Particles;

@@ -2,6 +2,7 @@
 /// \file SimulationParams: everything the solver needs, as plain values in SI units.
 /// Scene files are turned into these by the scene layer; the solver never reads files.
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -9,6 +10,7 @@
 #include <sph/core/kernels.h>
 #include <sph/core/vec.h>
 #include <sph/neighbors/strategy.h>
+#include <sph/solver/motion.h>
 
 namespace sph {
 
@@ -214,10 +216,17 @@ struct SimulationParams {
   WallParams walls;  ///< BoundaryHandling::Penalty's springs
   BoundaryParams boundary;
   Box<D> container;               ///< closed box holding the fluid
-  std::vector<Box<D>> obstacles;  ///< static solid boxes
+  std::vector<Box<D>> obstacles;  ///< solid boxes, as they are at rest (motion.h)
+  /// Each obstacle's prescribed motion (Obstacles[].motion), in the obstacles' order; shorter
+  /// than `obstacles` (empty: none moves) means the others are at rest. See obstacle_motion().
+  std::vector<ObstacleMotion<D>> motions;
   std::vector<EmitterParams<D>> emitters;
   NeighborMode neighbors = NeighborMode::Standard;
   int full_rebuild_period = 200;  ///< adaptive mode
+  /// Adaptive mode: every step, the fluid particles within reach of a moving obstacle (h plus the
+  /// obstacle's travel in the step) are flagged for a rebuild of their lists, whatever Eq. 7
+  /// says (the paper's Section 6 suggestion; Configuration.flagNearMovingBodies).
+  bool flag_near_moving = true;
   /// Every this many steps (from step 0), particles are reordered in memory along a Morton
   /// curve and every list is rebuilt; 0 never reorders. Defaults to full_rebuild_period so
   /// that adaptive runs rebuild nothing extra.
@@ -233,5 +242,18 @@ struct SimulationParams {
 
   friend bool operator==(const SimulationParams&, const SimulationParams&) = default;
 };
+
+/// Obstacle k's motion (MotionType::None when it is at rest).
+template <int D>
+const ObstacleMotion<D>& obstacle_motion(const SimulationParams<D>& p, std::size_t k) {
+  static const ObstacleMotion<D> kAtRest;
+  return k < p.motions.size() ? p.motions[k] : kAtRest;
+}
+
+/// Whether any obstacle of `p` moves.
+template <int D>
+bool any_obstacle_moves(const SimulationParams<D>& p) {
+  return std::any_of(p.motions.begin(), p.motions.end(), [](const ObstacleMotion<D>& m) { return m.moves(); });
+}
 
 }  // namespace sph

@@ -41,8 +41,11 @@ double chunked_sum(std::size_t n, std::vector<double>& partial, F&& term) {
 template <int D, std::floating_point R>
 class HealthProbe {
  public:
-  HealthProbe(const SimulationParams<D>& p, R w0)
+  HealthProbe(const SimulationParams<D>& p, R w0, std::span<const RigidPose<D>> poses,
+              std::span<const std::uint8_t> moving)
       : p_(p),
+        poses_(poses),
+        moving_(moving),
         tol_(kOutsideTolerance * 2.0 * p.particle_radius),
         r_(p.particle_radius),
         w0_(w0),
@@ -53,7 +56,7 @@ class HealthProbe {
 
   template <bool kInternal>
   void add(detail::HealthChunk& c, std::size_t i, const Vec<D, R>& xr, const Vec<D, R>& vr, R m, R rho) const {
-    const Vec<D, double> x = vec_cast<double>(xr);
+    const Vec<D, double> x = vec_cast<double>(xr), x_world = x;
     const double v2 = static_cast<double>(norm2(vr)), md = static_cast<double>(m);
     if (v2 > c.v2) c.v2 = v2, c.v_i = i;
     double out = -kNoLimit, springs = 0;  // signed distance past the container's planes
@@ -65,7 +68,10 @@ class HealthProbe {
     }
     if (out > tol_) ++c.outside;
     if (out > 0 && out > c.outside_depth) c.outside_depth = out, c.outside_i = i;
-    for (const Box<D>& b : p_.obstacles) {
+    for (std::size_t k = 0; k < p_.obstacles.size(); ++k) {
+      const Box<D>& b = p_.obstacles[k];
+      // (a moving obstacle: measured in its own frame, where its pose puts the particle)
+      const Vec<D, double> x = k < moving_.size() && moving_[k] ? poses_[k].to_rest(x_world) : x_world;
       double in = kNoLimit, grown = kNoLimit;  // depth inside the box, and inside the box grown by r
       for (int d = 0; d < D; ++d) {
         in = std::min({in, x[d] - b.lo[d], b.hi[d] - x[d]});
@@ -91,6 +97,8 @@ class HealthProbe {
   static double squared_positive(double a) { return a > 0 ? a * a : 0.0; }
 
   const SimulationParams<D>& p_;
+  std::span<const RigidPose<D>> poses_;
+  std::span<const std::uint8_t> moving_;
   double tol_, r_, low_ = 0;
   R w0_;
   bool tension_;
@@ -104,6 +112,7 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
     : params_(std::move(params)),
       particles_(std::move(particles)),
       boundary_(make_boundary<D, R>(params_)),
+      poses_(params_.obstacles.size()),
       emitters_(params_.emitters.size()),
       monitor_(health_scene(params_), params_.health_failures) {
   NeighborOptions opt;
@@ -128,6 +137,12 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
     dfsph_ =
         std::make_unique<DfsphSolver<D, R>>(params_.dfsph, particles_, static_cast<R>(2.0 * params_.particle_radius));
   }
+  if (any_obstacle_moves(params_)) {
+    SPH_CHECK(params_.motions.size() <= params_.obstacles.size(), "one motion per obstacle");
+    for (std::size_t k = 0; k < params_.obstacles.size(); ++k)
+      moving_.push_back(obstacle_motion(params_, k).moves() ? 1 : 0);
+    place_obstacles();
+  }
   neighbors_ = make_neighbor_strategy<D, R>(params_.neighbors, opt);
   neighbors_->set_boundary(boundary_.position);
   if (params_.audit) auditor_ = std::make_unique<ListAuditor<D, R>>();
@@ -151,11 +166,44 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
 }
 
 template <int D, std::floating_point R>
+void Simulation<D, R>::place_obstacles() {
+  if (moving_.empty()) return;
+  const double t = time();
+  for (std::size_t k = 0; k < moving_.size(); ++k)
+    if (moving_[k]) poses_[k] = pose_at(obstacle_motion(params_, k), t);
+  place_boundary(boundary_, params_, t);
+}
+
+template <int D, std::floating_point R>
+void Simulation<D, R>::flag_near_moving_obstacles(double dt) {
+  const std::span<std::uint8_t> flags = neighbors_->pair_exit_flags();
+  if (moving_.empty() || flags.empty()) return;
+  const double h = params_.kernel_radius, t = time();
+  for (std::size_t k = 0; k < moving_.size(); ++k) {
+    if (!moving_[k]) continue;
+    const Box<D>& box = params_.obstacles[k];
+    const RigidPose<D>& pose = poses_[k];
+    const double reach = h + max_surface_speed(obstacle_motion(params_, k), box.lo, box.hi, t) * dt;
+    parallel_for(particles_.size(), [&](std::size_t i) {
+      // The distance from the particle to the box, in the box's frame.
+      const Vec<D, double> X = pose.to_rest(vec_cast<double>(particles_.position[i]));
+      double out2 = 0;
+      for (int d = 0; d < D; ++d) {
+        const double o = std::max({box.lo[d] - X[d], 0.0, X[d] - box.hi[d]});
+        out2 += o * o;
+      }
+      if (out2 < reach * reach) flags[i] = 1;
+    });
+  }
+}
+
+template <int D, std::floating_point R>
 BoundaryView<D, R> Simulation<D, R>::boundary_view(const NeighborLists& lists) const {
   BoundaryView<D, R> v;
   if (boundary_.size() == 0) return v;
   v.position = boundary_.position;
   v.psi = boundary_.psi;
+  v.velocity = boundary_.velocity;
   v.lists = &lists;
   v.friction = static_cast<R>(params_.boundary.friction);
   v.extrapolate = params_.boundary.pressure == BoundaryPressure::Extrapolate;
@@ -224,6 +272,11 @@ double Simulation<D, R>::next_time_step() const {
   });
   double u = 0;
   for (double p : partial_) u = std::max(u, p);
+  // A moving obstacle's surface counts as a particle at its speed (it is about to push the fluid).
+  for (std::size_t k = 0; k < moving_.size(); ++k)
+    if (moving_[k])
+      u = std::max(
+          u, max_surface_speed(obstacle_motion(params_, k), params_.obstacles[k].lo, params_.obstacles[k].hi, time()));
   // Advective CFL: a particle moves at most 0.4 factor diameters (SPlisHSPlasH's rule).
   double dt = u > 0 ? c.factor * 0.4 * (2.0 * params_.particle_radius) / u : kNoLimit;
   // The scene's other limits (time_step.h's warning levels, as "auto" takes them: cfl_limit_),
@@ -287,8 +340,18 @@ const StepInfo& Simulation<D, R>::step() {
   // Emit after reordering, so that this step's new particles are the last ones (callers, like
   // sph compare's perturbation, rely on that).
   info.emitted = emit();
+  // Moving obstacles: where they are at the step's start; their samples' lists are all rebuilt.
+  place_obstacles();
+  if (boundary_.moving()) neighbors_->move_boundary(boundary_.position);
   neighbors_->update(particles_);
   info.neighbors = neighbors_->counters();
+  if (boundary_.moving()) {  // (for strategies that rebuild lists on their own schedule)
+    Stopwatch refresh;
+    if (neighbors_->refresh_moved_boundary(particles_)) {
+      info.neighbors.lists_seconds += refresh.lap();
+      info.neighbors.boundary_pairs_stored = neighbors_->boundary_lists().entry_count();
+    }
+  }
   info.seconds.grid = info.neighbors.grid_seconds + reorder_seconds;
   info.seconds.lists = info.neighbors.lists_seconds;
   const NeighborLists& lists = neighbors_->lists();
@@ -318,8 +381,11 @@ const StepInfo& Simulation<D, R>::step() {
   const StepTime st = choose_time_step();
   const R dt = static_cast<R>(st.dt);
   info.dt = st.dt;
+  // The paper's Section 6: particles near a moving body rebuild their lists next step, whatever
+  // Eq. 7 predicts (the body's push is not in its linear prediction).
+  if (params_.neighbors == NeighborMode::Adaptive && params_.flag_near_moving) flag_near_moving_obstacles(st.dt);
   const WallContact<D, R> walls(params_.container, params_.obstacles, static_cast<R>(params_.particle_radius),
-                                params_.walls, params_.boundary.handling == BoundaryHandling::Penalty);
+                                params_.walls, params_.boundary.handling == BoundaryHandling::Penalty, poses_, moving_);
   compute_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity), walls,
                         neighbors_->pair_exit_flags(), dt, solid, neighbors_->pair_exit_radius(), !dfsph_);
   info.seconds.forces = watch.lap();
@@ -348,7 +414,8 @@ HealthStats Simulation<D, R>::integrate_and_check(R dt) {
   // Symplectic Euler (v += dt a; x += dt v), the blow-up check and the health statistics in one pass.
   const std::size_t n = particles_.size();
   const HealthProbe<D, R> probe(
-      params_, SmoothingKernels<D, R>(params_.fluid.kernel, static_cast<R>(params_.kernel_radius)).w_zero());
+      params_, SmoothingKernels<D, R>(params_.fluid.kernel, static_cast<R>(params_.kernel_radius)).w_zero(), poses_,
+      moving_);
   health_chunks_.assign(chunk_count(n), detail::HealthChunk{});
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     detail::HealthChunk& chunk = health_chunks_[c];

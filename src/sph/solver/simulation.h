@@ -157,6 +157,11 @@ class Simulation {
   StepTime choose_time_step() const;
   std::size_t emit();
   void reserve_for_emitters();
+  /// Places the moving obstacles (their poses, and their boundary samples) at the current time.
+  void place_obstacles();
+  /// Adaptive mode (SimulationParams::flag_near_moving): flags for a list rebuild every particle
+  /// within h plus its travel in a step of dt of a moving obstacle.
+  void flag_near_moving_obstacles(double dt);
   /// What the passes see of the boundary particles, with `lists` as their lists.
   BoundaryView<D, R> boundary_view(const NeighborLists& lists) const;
   /// Integrates (symplectic Euler; none with kIntegrate false), checks every value (throws on a
@@ -169,6 +174,8 @@ class Simulation {
   SimulationParams<D> params_;
   ParticleSet<D, R> particles_;
   BoundarySet<D, R> boundary_;
+  std::vector<std::uint8_t> moving_;  // per obstacle: whether it moves (empty: none does)
+  std::vector<RigidPose<D>> poses_;   // per obstacle: its pose at the current step's start
   std::unique_ptr<NeighborStrategy<D, R>> neighbors_;
   std::unique_ptr<ListAuditor<D, R>> auditor_;
   MortonOrder<D, R> morton_;

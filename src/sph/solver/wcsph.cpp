@@ -241,6 +241,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
   const bool solid = boundary.active();
   const R* bpos = solid ? flat(boundary.position) : nullptr;
   const R* psi = boundary.psi.data();
+  const R* bvel = solid && !boundary.velocity.empty() ? flat(boundary.velocity) : nullptr;
   const P dtv = P::set1(dt);
   const PackKernel<K, D, R> kernel_value(h);
   const PackKernel<K, D, R>* kernel = &kernel_value;
@@ -355,8 +356,11 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
         const P r = sqrt(select(near, r2, h2v));
         const P f = gradient_factor < K, kVariational && K == KernelKind::Paper, D > (kernel, r2, r, near, h);
         const P psib = P::template gather<1>(psi, bidx + k0, 0);
+        // The velocity relative to the sample's (moving obstacles), else the particle's own.
+        P vib[D];
+        for (int d = 0; d < D; ++d) vib[d] = bvel ? vi[d] - P::template gather<D>(bvel, bidx + k0, d) : vi[d];
         P vr = zero;
-        for (int d = 0; d < D; ++d) vr = vr + vi[d] * rib[d];
+        for (int d = 0; d < D; ++d) vr = vr + vib[d] * rib[d];
         const P pi_ib = minus_one * nu_i * select(vr < zero, vr, zero) / (r2 + eps_h2);
         P pterm = pii_v;
         if (extrapolate) {
@@ -370,7 +374,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
         for (int d = 0; d < D; ++d) {
           acc[d] = acc[d] + rib[d] * fb;
           if constexpr (kExitTest) {
-            const P t = rib[d] + vi[d] * dtv;
+            const P t = rib[d] + vib[d] * dtv;
             q2 = q2 + t * t;
           }
         }

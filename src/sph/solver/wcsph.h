@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include <sph/core/particle_set.h>
@@ -26,6 +27,9 @@ struct BoundaryView {
   bool extrapolate = false;
   bool clamp = true;
   Vec<D, R> extrapolation{};
+  /// Each sample's velocity (moving obstacles; empty: all at rest): the friction and the Eq. 7
+  /// test see the fluid's velocity relative to it.
+  std::span<const Vec<D, R>> velocity{};
   bool active() const { return lists != nullptr && lists->particle_count() > 0 && !position.empty(); }
 };
 
@@ -42,17 +46,21 @@ std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborList
 
 /// The damped penalty acceleration of the container walls and the obstacles on one particle.
 /// A particle interacts with a wall plane when closer than `particle_radius` to it; the contact
-/// pushes along the wall's normal and never pulls.
+/// pushes along the wall's normal and never pulls. A moving obstacle (motion.h) is met where its
+/// pose puts it, and damps the particle's velocity relative to its own surface's.
 template <int D, std::floating_point R>
 class WallContact {
  public:
-  /// `enabled` false (boundary particles): no wall acceleration at all.
+  /// `enabled` false (boundary particles): no wall acceleration at all. `poses`: each obstacle's
+  /// pose now (empty: all at rest); `moving[k]` whether obstacle k moves (empty: none).
   WallContact(const Box<D>& container, const std::vector<Box<D>>& obstacles, R particle_radius, const WallParams& walls,
-              bool enabled = true)
+              bool enabled = true, std::span<const RigidPose<D>> poses = {}, std::span<const std::uint8_t> moving = {})
       : enabled_(enabled),
         lo_(vec_cast<R>(container.lo)),
         hi_(vec_cast<R>(container.hi)),
         obstacles_(&obstacles),
+        poses_(poses),
+        moving_(moving),
         radius_(particle_radius),
         ks_(static_cast<R>(walls.stiffness)),
         kd_(static_cast<R>(walls.damping)) {}
@@ -68,24 +76,20 @@ class WallContact {
       if (pen_hi > 0) a[d] -= contact(pen_hi, -v[d]);
     }
     // Obstacles: a particle inside the box grown by one radius is pushed out through the
-    // nearest face.
-    for (const Box<D>& b : *obstacles_) {
-      R best = std::numeric_limits<R>::max();
-      int best_d = -1;
-      R best_sign = 0;
-      bool inside = true;
-      for (int d = 0; d < D && inside; ++d) {
-        const R to_lo = x[d] - (static_cast<R>(b.lo[d]) - radius_);
-        const R to_hi = (static_cast<R>(b.hi[d]) + radius_) - x[d];
-        if (to_lo <= 0 || to_hi <= 0) {
-          inside = false;
-          break;
-        }
-        if (to_lo < best) best = to_lo, best_d = d, best_sign = R(-1);
-        if (to_hi < best) best = to_hi, best_d = d, best_sign = R(1);
+    // nearest face (a moving one's, in the obstacle's own frame, with the velocity relative to
+    // its surface there, and the push turned back into the world's frame).
+    for (std::size_t k = 0; k < obstacles_->size(); ++k) {
+      const Box<D>& b = (*obstacles_)[k];
+      if (k < moving_.size() && moving_[k]) {
+        const RigidPose<D>& pose = poses_[k];
+        const Vec<D, double> xw = vec_cast<double>(x);
+        const Vec<D, double> xb = pose.to_rest(xw);
+        const Vec<D, double> vb = pose.unrotate(vec_cast<double>(v) - pose.velocity_at(xw));
+        Vec<D, R> push{};
+        if (push_out(b, vec_cast<R>(xb), vec_cast<R>(vb), push)) a += vec_cast<R>(pose.rotate(vec_cast<double>(push)));
+        continue;
       }
-      if (!inside) continue;
-      a[best_d] += best_sign * contact(best, best_sign * v[best_d]);
+      push_out(b, x, v, a);
     }
     return a;
   }
@@ -95,10 +99,28 @@ class WallContact {
   R contact(R penetration, R normal_velocity) const {
     return std::max(R(0), ks_ * penetration - kd_ * normal_velocity);
   }
+  /// Adds to `a` the push out of box b (grown by one radius) on a particle at x with velocity v,
+  /// in the box's frame; false (nothing added) if x is outside it.
+  bool push_out(const Box<D>& b, const Vec<D, R>& x, const Vec<D, R>& v, Vec<D, R>& a) const {
+    R best = std::numeric_limits<R>::max();
+    int best_d = -1;
+    R best_sign = 0;
+    for (int d = 0; d < D; ++d) {
+      const R to_lo = x[d] - (static_cast<R>(b.lo[d]) - radius_);
+      const R to_hi = (static_cast<R>(b.hi[d]) + radius_) - x[d];
+      if (to_lo <= 0 || to_hi <= 0) return false;
+      if (to_lo < best) best = to_lo, best_d = d, best_sign = R(-1);
+      if (to_hi < best) best = to_hi, best_d = d, best_sign = R(1);
+    }
+    a[best_d] += best_sign * contact(best, best_sign * v[best_d]);
+    return true;
+  }
 
   bool enabled_;
   Vec<D, R> lo_, hi_;
   const std::vector<Box<D>>* obstacles_;
+  std::span<const RigidPose<D>> poses_;
+  std::span<const std::uint8_t> moving_;
   R radius_, ks_, kd_;
 };
 

@@ -3,10 +3,14 @@
 // work offline, from file://, and in browsers without WebGL (headless, remote desktops).
 //
 // Data (the JSON in #sph-data, written by src/sph/render/viewer.cpp):
-//   dimension, box {lo, hi} (the container), obstacles [{lo, hi}] (static solid boxes; z = 0 in
+//   dimension, box {lo, hi} (the container), obstacles [{lo, hi}] (solid boxes at rest; z = 0 in
 //   2D), qbox {lo, hi} (what positions are quantized over),
 //   radius (particle radius, m), colors [{name, label, scalar, lo, hi, lut (base64, 256 RGB)}],
-//   defaultColor, notes [text], runs [{label, rgb?, frames [{t, n, pos, f {name: base64}, rgb?}]}].
+//   defaultColor, notes [text], runs [{label, rgb?, frames [{t, n, pos, f {name: base64}, rgb?,
+//   poses?}]}].
+//   poses (only when an obstacle moves): per obstacle [r00, r01, r02, r10, r11, r12, r20, r21,
+//   r22, cx, cy, cz, tx, ty, tz], its placement at the frame's time: the point p of the box at
+//   rest is at c + t + R (p - c).
 //   pos: n * dimension uint16 (little endian) over qbox; scalar fields: one byte per particle,
 //   0..254 over [lo, hi] and 255 for "no value"; rgb: 3 bytes per particle (per run when the
 //   particles keep their index in every frame, else per frame).
@@ -323,12 +327,38 @@
   })();
   function solidRgb(shade) { return `rgb(${SOLID_RGB.map((c) => Math.round(c * shade)).join(', ')})`; }
 
+  // The obstacles of a frame as drawn: each box at rest with its placement in that frame (the
+  // frame's poses) or at rest. R is null for an upright box (then the point p is at p + t).
+  const AT_REST = OBSTACLES.map((o) => ({ lo: o.lo, hi: o.hi, R: null, c: [0, 0, 0], t: [0, 0, 0] }));
+  function solidsOf(ri, fi) {
+    const fr = frameOf(RUNS[ri], fi);
+    if (!fr.poses) return AT_REST;
+    return cached(`${ri}/${fi}/solids`, () => OBSTACLES.map((o, k) => {
+      const pose = fr.poses[k];
+      if (!pose) return AT_REST[k];
+      const R = pose.slice(0, 9);
+      const upright = R.every((v, j) => v === (j % 4 === 0 ? 1 : 0));
+      return { lo: o.lo, hi: o.hi, R: upright ? null : R, c: pose.slice(9, 12), t: pose.slice(12, 15) };
+    }));
+  }
+  // Where the point p of the box at rest is drawn.
+  function place(o, p) {
+    if (!o.R) return [p[0] + o.t[0], p[1] + o.t[1], p[2] + o.t[2]];
+    const R = o.R, d0 = p[0] - o.c[0], d1 = p[1] - o.c[1], d2 = p[2] - o.c[2];
+    return [0, 1, 2].map((a) => o.c[a] + o.t[a] + R[3 * a] * d0 + R[3 * a + 1] * d1 + R[3 * a + 2] * d2);
+  }
+
   // True if the segment from the world point towards the eye (orthographic: the ray towards the
-  // viewer) meets an obstacle, the point itself included (slab test).
-  function hiddenBySolid(x, y, z, b, persp) {
-    const p = [x, y, z];
-    const d = persp ? [b.eye[0] - x, b.eye[1] - y, b.eye[2] - z] : b.back;
-    for (const o of OBSTACLES) {
+  // viewer) meets an obstacle, the point itself included (slab test, in the box's own frame).
+  function hiddenBySolid(x, y, z, b, persp, solids) {
+    const dw = persp ? [b.eye[0] - x, b.eye[1] - y, b.eye[2] - z] : b.back;
+    for (const o of solids) {
+      let p = [x - o.t[0], y - o.t[1], z - o.t[2]], d = dw;
+      if (o.R) {  // back to the box at rest: c + R^T (x - c - t), and R^T d
+        const R = o.R, q0 = p[0] - o.c[0], q1 = p[1] - o.c[1], q2 = p[2] - o.c[2];
+        p = [0, 1, 2].map((a) => o.c[a] + R[a] * q0 + R[3 + a] * q1 + R[6 + a] * q2);
+        d = [0, 1, 2].map((a) => R[a] * dw[0] + R[3 + a] * dw[1] + R[6 + a] * dw[2]);
+      }
       let t0 = 0, t1 = persp ? 1 : Infinity;
       for (let k = 0; k < 3 && t0 <= t1; k++) {
         if (Math.abs(d[k]) < 1e-12) {
@@ -345,52 +375,77 @@
     return false;
   }
 
-  function drawSolids(ctx, proj, dpr) {
-    if (!OBSTACLES.length) return;
+  function polygon(ctx, pts) {
+    ctx.beginPath();
+    ctx.moveTo(pts[0][0], pts[0][1]);
+    for (let k = 1; k < pts.length; k++) ctx.lineTo(pts[k][0], pts[k][1]);
+    ctx.closePath();
+  }
+
+  function drawSolids(ctx, proj, dpr, solids) {
+    if (!solids.length) return;
     ctx.lineWidth = Math.max(1, 1.25 * dpr);
     ctx.lineJoin = 'round';
     ctx.strokeStyle = SOLID_EDGE;
     if (DIM === 2) {
       ctx.fillStyle = solidRgb(1);
-      for (const o of OBSTACLES) {
-        const a = proj.fn(o.lo[0], o.lo[1], 0), c = proj.fn(o.hi[0], o.hi[1], 0);
-        const x = Math.min(a[0], c[0]), y = Math.min(a[1], c[1]), w = Math.abs(c[0] - a[0]), h = Math.abs(c[1] - a[1]);
-        ctx.fillRect(x, y, w, h);
-        const e = ctx.lineWidth / 2;  // the outline inside the rectangle, as sph render draws it
-        if (w > 2 * e && h > 2 * e) ctx.strokeRect(x + e, y + e, w - 2 * e, h - 2 * e);
+      const e = ctx.lineWidth / 2;  // the outline inside the box, as sph render draws it
+      for (const o of solids) {
+        if (!o.R) {
+          const a = proj.fn(o.lo[0] + o.t[0], o.lo[1] + o.t[1], 0), c = proj.fn(o.hi[0] + o.t[0], o.hi[1] + o.t[1], 0);
+          const x = Math.min(a[0], c[0]), y = Math.min(a[1], c[1]), w = Math.abs(c[0] - a[0]), h = Math.abs(c[1] - a[1]);
+          ctx.fillRect(x, y, w, h);
+          if (w > 2 * e && h > 2 * e) ctx.strokeRect(x + e, y + e, w - 2 * e, h - 2 * e);
+          continue;
+        }
+        // A turned box: the quadrilateral through its placed corners, outlined inside (its box
+        // shrunk by half the line width before it is placed).
+        const corners = (m) => [[o.lo[0] + m, o.lo[1] + m], [o.hi[0] - m, o.lo[1] + m], [o.hi[0] - m, o.hi[1] - m],
+          [o.lo[0] + m, o.hi[1] - m]].map(([x, y]) => { const w = place(o, [x, y, 0]); return proj.fn(w[0], w[1], 0); });
+        polygon(ctx, corners(0));
+        ctx.fill();
+        const m = e / proj.s;
+        if (o.hi[0] - o.lo[0] > 2 * m && o.hi[1] - o.lo[1] > 2 * m) {
+          polygon(ctx, corners(m));
+          ctx.stroke();
+        }
       }
       return;
     }
     const b = basis(state.cam), persp = $('perspective').checked;
-    const boxes = OBSTACLES.map((o) => {
-      const c = [0, 1, 2].map((k) => 0.5 * (o.lo[k] + o.hi[k]));
+    const boxes = solids.map((o) => {
+      const c = place(o, [0, 1, 2].map((k) => 0.5 * (o.lo[k] + o.hi[k])));
       return { o, depth: proj.fn(c[0], c[1], c[2])[2] };
     });
     boxes.sort((u, v) => v.depth - u.depth);  // far to near
     for (const { o } of boxes)
-      for (let a = 0; a < 3; a++)
+      for (let a = 0; a < 3; a++) {
+        const axis = o.R ? [o.R[a], o.R[3 + a], o.R[6 + a]] : [0, 1, 2].map((k) => (k === a ? 1 : 0));
         for (const side of [0, 1]) {
-          const sign = side ? 1 : -1, at = side ? o.hi[a] : o.lo[a];
+          const sign = side ? 1 : -1, n = axis.map((v) => sign * v);
+          const mid = [0, 1, 2].map((k) => 0.5 * (o.lo[k] + o.hi[k]));
+          mid[a] = side ? o.hi[a] : o.lo[a];
+          const at = place(o, mid);  // the face's center
           // Turned to the camera: towards the eye (perspective) or the viewer (orthographic).
-          const facing = persp ? sign * (b.eye[a] - at) : sign * b.back[a];
+          const facing = persp ? n[0] * (b.eye[0] - at[0]) + n[1] * (b.eye[1] - at[1]) + n[2] * (b.eye[2] - at[2])
+                               : n[0] * b.back[0] + n[1] * b.back[1] + n[2] * b.back[2];
           if (!(facing > 1e-9)) continue;
           const u = (a + 1) % 3, v = (a + 2) % 3, pts = [];
           for (const [ku, kv] of [[0, 0], [1, 0], [1, 1], [0, 1]]) {
             const w = [0, 0, 0];
-            w[a] = at; w[u] = ku ? o.hi[u] : o.lo[u]; w[v] = kv ? o.hi[v] : o.lo[v];
-            pts.push(proj.fn(w[0], w[1], w[2]));
+            w[a] = mid[a]; w[u] = ku ? o.hi[u] : o.lo[u]; w[v] = kv ? o.hi[v] : o.lo[v];
+            const q = place(o, w);
+            pts.push(proj.fn(q[0], q[1], q[2]));
           }
           if (persp && pts.some((q) => q[2] <= 0)) continue;  // reaches behind the eye
-          const n = [sign * b.right[a], sign * b.up[a], sign * b.back[a]];
-          const shade = 0.55 + 0.45 * Math.max(0, n[0] * FACE_LIGHT[0] + n[1] * FACE_LIGHT[1] + n[2] * FACE_LIGHT[2]);
+          const nc = [b.right, b.up, b.back].map((e) => n[0] * e[0] + n[1] * e[1] + n[2] * e[2]);  // camera space
+          const shade = 0.55 + 0.45 * Math.max(0, nc[0] * FACE_LIGHT[0] + nc[1] * FACE_LIGHT[1] + nc[2] * FACE_LIGHT[2]);
           ctx.fillStyle = solidRgb(shade);
-          ctx.beginPath();
-          ctx.moveTo(pts[0][0], pts[0][1]);
-          for (let k = 1; k < 4; k++) ctx.lineTo(pts[k][0], pts[k][1]);
-          ctx.closePath();
+          polygon(ctx, pts);
           ctx.fill();
           ctx.stroke();
         }
+      }
   }
 
   function drawAxes(ctx, p, dpr) {
@@ -426,6 +481,7 @@
     ensure(n);
     const persp = DIM === 3 && $('perspective').checked;
     const occluding = DIM === 3 && OBSTACLES.length > 0, b3 = occluding ? basis(state.cam) : null;
+    const solids = solidsOf(p.index, fi);  // where the obstacles are in this frame
     let zmin = Infinity, zmax = -Infinity, rmax = 0, count = 0;
     for (let i = 0; i < n; i++) {
       const x = lo[0] + pos[DIM * i] * dq[0], y = lo[1] + pos[DIM * i + 1] * dq[1];
@@ -435,7 +491,7 @@
       const r = Math.max(0.6, DATA.radius * q[3]);
       if (q[0] < -r || q[1] < -r || q[0] > p.w + r || q[1] > p.h + r) continue;
       sx[count] = q[0]; sy[count] = q[1]; sz[count] = q[2]; sr[count] = r; order[count] = i;
-      hid[count] = occluding && hiddenBySolid(x, y, z, b3, persp) ? 1 : 0;
+      hid[count] = occluding && hiddenBySolid(x, y, z, b3, persp, solids) ? 1 : 0;
       count++;
       if (q[2] < zmin) zmin = q[2];
       if (q[2] > zmax) zmax = q[2];
@@ -461,7 +517,7 @@
     // 3D with obstacles: the particles behind them, the obstacles, the particles in front.
     // 2D: every particle, then the obstacles over them.
     for (const pass of occluding ? [1, 0] : [-1]) {
-      if (pass === 0) drawSolids(ctx, proj, dpr);
+      if (pass === 0) drawSolids(ctx, proj, dpr, solids);
       for (let m = 0; m < count; m++) {
         const j = idx[m];
         if (pass >= 0 && hid[j] !== pass) continue;
@@ -469,7 +525,7 @@
         ctx.drawImage(img, (b % cols) * S, ((b / cols) | 0) * S, S, S, sx[j] - r, sy[j] - r, 2 * r, 2 * r);
       }
     }
-    if (DIM === 2) drawSolids(ctx, proj, dpr);
+    if (DIM === 2) drawSolids(ctx, proj, dpr, solids);
     drawEdges(ctx, proj, 'front', dpr);
     drawAxes(ctx, p, dpr);
   }

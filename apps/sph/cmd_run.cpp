@@ -147,13 +147,17 @@ class StopSignals {
 };
 
 /// The lines of the closing message that say where the frames are (none if none were written).
-std::string frames_hint(const OutputDesc& output, const std::filesystem::path& dir, std::size_t frames) {
+std::string frames_hint(const OutputDesc& output, const std::filesystem::path& dir, std::size_t frames,
+                        bool obstacles) {
   std::string s;
   if (frames == 0) return s;
   for (FrameFormat f : output.formats) {
     const FrameFormatDesc& d = frame_format_desc(f);
     s += fmt::format("  {}/{} {}\n", dir.string(), d.look_at, d.hint);
   }
+  if (obstacles)
+    s +=
+        fmt::format("  {}/solids.pvd   the obstacles at each frame's time (ParaView, with the frames)\n", dir.string());
   return s;
 }
 
@@ -172,7 +176,8 @@ void print_done(const RunDriver<D, R>& run, const RunResult& result, bool audit)
              ran, run.simulation().particles().size(), result.wall_seconds,
              1e3 * result.wall_seconds / static_cast<double>(std::max<std::int64_t>(ran, 1)),
              result.first_step > 0 ? "The run now has" : "Wrote", out.frames_written(),
-             frames_hint(run.scene().output, dir, out.frames_written()), dir.string(), dir.string(),
+             frames_hint(run.scene().output, dir, out.frames_written(), !run.simulation().params().obstacles.empty()),
+             dir.string(), dir.string(),
              out.frames_written() > 0
                  ? fmt::format("  look at it: sph render {0} --mp4 (PNG frames, a movie); sph view {0} (a web page)\n",
                                shell_word(dir.string()))

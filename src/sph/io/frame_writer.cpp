@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include <sph/io/ply.h>
+#include <sph/io/solids.h>
 #include <sph/io/vtk.h>
 
 namespace sph {
@@ -21,6 +22,8 @@ constexpr double kTickTolerance = 1e-9;
 std::string frame_name(std::size_t index, FrameFormat f) {
   return fmt::format("frames/frame_{:06d}.{}", index, frame_format_name(f));
 }
+
+std::string solids_name(std::size_t index) { return fmt::format("frames/solids_{:06d}.vtp", index); }
 
 }  // namespace
 
@@ -73,6 +76,12 @@ void FrameWriter<D, R>::write(const Simulation<D, R>& sim) {
   const std::size_t index = times_.size();
   for (FrameFormat f : output_.formats)
     write_frame(f, dir_ / frame_name(index, f), sim.particles(), sim.time(), fields_);
+  if (!sim.params().obstacles.empty()) {
+    write_solids_vtp(dir_ / solids_name(index), sim.params(), sim.time());
+    if (std::find(output_.formats.begin(), output_.formats.end(), FrameFormat::Ply) != output_.formats.end())
+      write_solids_ply(dir_ / fmt::format("frames/solids_{:06d}.ply", index), sim.params(), sim.time());
+    solids_ = true;
+  }
   times_.push_back(sim.time());
   schedule_.written(sim.time());
   last_off_schedule_ = false;
@@ -81,6 +90,11 @@ void FrameWriter<D, R>::write(const Simulation<D, R>& sim) {
 
 template <int D, std::floating_point R>
 void FrameWriter<D, R>::write_index() const {
+  if (solids_) {
+    std::vector<PvdEntry> solids;
+    for (std::size_t i = 0; i < times_.size(); ++i) solids.push_back({times_[i], solids_name(i)});
+    write_pvd(dir_ / "solids.pvd", solids);
+  }
   if (std::find(output_.formats.begin(), output_.formats.end(), FrameFormat::Vtu) == output_.formats.end()) return;
   std::vector<PvdEntry> entries;
   entries.reserve(times_.size());
@@ -117,7 +131,12 @@ void FrameWriter<D, R>::load_state(StateReader& in) {
     if (std::sscanf(f.c_str(), "frame_%u.%3s", &index, ext) == 2 && parse_frame_format(ext) &&
         f == fmt::format("frame_{:06d}.{}", index, ext) && index >= times_.size())
       fs::remove(entry.path(), ec);
+    if (std::sscanf(f.c_str(), "solids_%u.%3s", &index, ext) == 2 &&
+        (f == fmt::format("solids_{:06d}.vtp", index) || f == fmt::format("solids_{:06d}.ply", index)) &&
+        index >= times_.size())
+      fs::remove(entry.path(), ec);
   }
+  solids_ = fs::exists(dir_ / "solids.pvd", ec);
   if (!times_.empty()) write_index();  // (a run without frames has no frames.pvd)
 }
 

@@ -11,6 +11,9 @@
 /// number in every format) and, when vtu is among the formats, DIR/frames.pvd (ParaView's time
 /// series of the .vtu files, rewritten after every frame). Without vtu no index is written:
 /// every frame file carries its simulated time (read_frame in frames.h reads it back).
+/// A scene with obstacles also gets DIR/frames/solids_NNNNNN.vtp with each frame (the obstacles
+/// where they are at its time, io/solids.h; with the ply format also solids_NNNNNN.ply) and
+/// DIR/solids.pvd, their time series.
 
 #include <cstdint>
 #include <filesystem>
@@ -91,6 +94,7 @@ class FrameWriter {
   FrameSchedule schedule_;
   std::vector<double> times_;
   bool last_off_schedule_ = false;  // the latest frame was written only because its step was the last
+  bool solids_ = false;             // the scene has obstacles: each frame has its solids_NNNNNN.vtp
 };
 
 extern template class FrameWriter<2, float>;

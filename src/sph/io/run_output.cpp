@@ -104,14 +104,15 @@ void prepare_output_directory(const fs::path& dir) {
   remove_stale_temporaries(dir);
   remove_stale_temporaries(dir / "frames");
   // Remove what a previous run left, so that frames of two runs are never mixed.
-  for (const char* name :
-       {"frames.pvd", "stats.csv", "summary.json", "scene.json", "checkpoint.sphc", "run.json", "boundary.vtu"})
+  for (const char* name : {"frames.pvd", "solids.pvd", "stats.csv", "summary.json", "scene.json", "checkpoint.sphc",
+                           "run.json", "boundary.vtu"})
     fs::remove(dir / name, ec);
   remove_pictures(dir);
   for (const auto& entry : fs::directory_iterator(dir / "frames", ec)) {
     const std::string f = entry.path().filename().string();
     const std::string ext = entry.path().extension().string();
     if (f.rfind("frame_", 0) == 0 && (ext == ".vtu" || ext == ".vtk" || ext == ".ply")) fs::remove(entry.path(), ec);
+    if (f.rfind("solids_", 0) == 0 && (ext == ".vtp" || ext == ".ply")) fs::remove(entry.path(), ec);
   }
 }
 

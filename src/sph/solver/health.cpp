@@ -29,7 +29,8 @@ std::string wall_advice(const HealthScene& s, double v) {
         "cflMaxTimeStepSize){}",
         s.kernel_radius, v, s.time_step, v * s.time_step / s.kernel_radius,
         s.misses_pairs ? ", or a neighbor mode that never misses a pair (standard, verlet, tracked, adaptive_exact): "
-                         "the adaptive mode's lists miss the boundary samples a particle comes to"
+                         "the adaptive mode's lists miss the pairs a particle comes to (fluid pairs, and the boundary "
+                         "samples of solids at rest)"
                        : "");
   const double r = s.particle_radius;
   const double ks_speed = (v / r) * (v / r);

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Checks that two sph binaries write bitwise-identical frames: every paper and validation scene
 # for a short run (120 steps, a frame every 40) in the standard and adaptive modes, in every
-# frame format (vtu, vtk, ply), then compares the sha256 of every frame file.
+# frame format (vtu, vtk, ply), then compares the sha256 of every frame file (frames/frame_*: the
+# obstacles' surfaces beside them, frames/solids_*, are not compared).
 #   bash scripts/frames_identical.sh OLD_SPH NEW_SPH [OUT_DIR]
 # Exits 0 if every frame matches, 1 (listing the differing files) otherwise. Used for changes
 # that must not change results (e.g. a refactoring: build the starting commit's sph, then yours).
@@ -22,7 +23,7 @@ run_all() {  # binary, directory
         { echo "frames_identical: $1 failed on $scene ($mode); see $2/$name.$mode.err" >&2; exit 1; }
     done
   done
-  (cd "$2" && find . -path '*/frames/*' -type f | sort | xargs sha256sum) >"$2.sums"
+  (cd "$2" && find . -path '*/frames/frame_*' -type f | sort | xargs sha256sum) >"$2.sums"
 }
 run_all "$old" "$out/old"
 run_all "$new" "$out/new"

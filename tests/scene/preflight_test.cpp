@@ -467,3 +467,44 @@ TEST(Preflight, TheCorpusRefusedScenesAreRefusedWithTheirMessages) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Moving obstacles
+
+namespace {
+
+/// The base scene with a paddle left of the block that oscillates along x.
+json paddle_scene(double amplitude, double period) {
+  json j = base_scene();
+  j["FluidBlocks"][0] = json::parse(R"({ "start": [0.3, 0], "end": [0.8, 0.2] })");
+  j["Obstacles"] = json::array();
+  j["Obstacles"].push_back(json::parse(R"({ "start": [0.1, 0], "end": [0.2, 0.4] })"));
+  j["Obstacles"][0]["motion"] = {
+      {"type", "oscillation"}, {"direction", {1, 0}}, {"amplitude", amplitude}, {"period", period}};
+  return j;
+}
+
+}  // namespace
+
+TEST(Preflight, AMovingObstacleTooFastForTheFixedStepIsWarnedAbout) {
+  // 5 cm at 1 s is at most 0.31 m/s: well under 0.4 diameters a step.
+  EXPECT_EQ(warnings_of(paddle_scene(0.05, 1.0)).find("cannot follow"), std::string::npos);
+  // 5 cm at 20 ms: 15.7 m/s, 0.79 diameters in a step of 1 ms.
+  json j = paddle_scene(0.05, 0.02);
+  j["Configuration"]["timeStepSize"] = 1e-3;
+  const std::string fast = warnings_of(j);
+  EXPECT_NE(fast.find("Obstacles[0].motion: the obstacle's surface moves up to 15.7 m/s"), std::string::npos) << fast;
+  EXPECT_NE(fast.find("take steps of at most"), std::string::npos) << fast;
+  // A period of a few steps.
+  const std::string coarse = warnings_of(paddle_scene(1e-4, 1e-3));
+  EXPECT_NE(coarse.find("sampled too coarsely"), std::string::npos) << coarse;
+}
+
+TEST(Preflight, AMotionThatOverflowsIsRefused) {
+  json j = paddle_scene(0.05, 1.0);
+  j["Obstacles"][0]["motion"] = json::parse(
+      R"({ "type": "keyframes", "keys": [ { "time": 0 }, { "time": 0.001, "rotation": 1e308 }, { "time": 0.002, "rotation": -1e308 } ] })");
+  const std::string e = error_of(j);
+  EXPECT_NE(e.find("Obstacles[0].motion: the motion's pose at t = "), std::string::npos) << e;
+  EXPECT_NE(e.find("is not finite"), std::string::npos) << e;
+}

@@ -107,6 +107,8 @@ TEST(Motion, KeyframesInterpolateLinearlyAndHoldTheirEnds) {
   m.keys = {{0.5, {}, 0.0}, {1.5, {{0.2, 0.1}}, kPi / 2}, {2.0, {{0.2, -0.1}}, kPi / 2}};
   expect_near<2>(pose_at(m, 0.2).translation, {}, 0);  // before the first key: at rest
   EXPECT_EQ(norm2(pose_at(m, 0.2).velocity), 0.0);
+  // The first key's own time starts the first segment (a step that starts there sees the speed).
+  expect_near<2>(pose_at(m, 0.5).velocity, {{0.2, 0.1}}, 1e-15);
   const RigidPose<2> p = pose_at(m, 1.0);  // halfway between the first two keys
   expect_near<2>(p.translation, {{0.1, 0.05}}, 1e-15);
   expect_near<2>(p.velocity, {{0.2, 0.1}}, 1e-15);

@@ -97,37 +97,65 @@ void check_obstacles_inside(const ReadContext& ctx, const SimulationParams<D>& s
 
 /// A moving obstacle must stay inside the container: its corners are checked at 4,096 times
 /// evenly over the run (and at each key of keyframes), and one that goes farther than the kernel
-/// radius past a wall is refused (a unit mistake, or an amplitude too large for the tank). Less
-/// is allowed: a paddle standing on the floor that tilts a little pokes into the floor, which
-/// holds the fluid there anyway.
+/// radius past a wall is refused (a unit mistake, or an amplitude too large for the tank), as is a
+/// motion whose pose overflows (not finite). Less is allowed: a paddle standing on the floor that
+/// tilts a little pokes into the floor, which holds the fluid there anyway. With fixed steps, a
+/// surface that moves more than 0.4 particle diameters in a step, or an oscillation shorter than
+/// 20 steps, draws a warning (CFL steps take the obstacles' speed into their length).
 template <int D>
-void check_motions_stay_inside(const ReadContext& ctx, const SceneDesc& desc, const SimulationParams<D>& sim) {
+void check_motions(const ReadContext& ctx, SceneDesc& desc, const SimulationParams<D>& sim) {
   const Box<D>& c = sim.container;
-  const double run = desc.end_time > 0 ? desc.end_time : static_cast<double>(desc.steps) * sim.time_step;
+  const bool cfl = sim.time_stepping == TimeStepping::Cfl;
+  // The run's end: its end time, or its steps at their longest.
+  const double run = desc.end_time > 0 ? desc.end_time
+                                       : static_cast<double>(desc.steps) *
+                                             (cfl ? std::max(sim.time_step, sim.cfl.max_dt) : sim.time_step);
   for (std::size_t k = 0; k < sim.obstacles.size(); ++k) {
     const ObstacleMotion<D>& m = obstacle_motion(sim, k);
     if (!m.moves()) continue;
+    const std::string where = fmt::format("Obstacles[{}].motion", k);
     std::vector<double> times;
     constexpr int kSamples = 4096;
     for (int j = 0; j <= kSamples; ++j) times.push_back(run * j / kSamples);
     for (const MotionKey<D>& key : m.keys)
       if (key.time <= run) times.push_back(key.time);
+    double fastest = 0;
     for (const double t : times) {
       const RigidPose<D> pose = pose_at(m, t);
       for (int corner = 0; corner < (1 << D); ++corner) {
         Vec<D, double> X;
         for (int d = 0; d < D; ++d) X[d] = corner >> d & 1 ? sim.obstacles[k].hi[d] : sim.obstacles[k].lo[d];
         const Vec<D, double> x = pose.place(X);
+        const double speed = std::sqrt(norm2(pose.velocity_at(x)));
+        if (!all_finite(x) || !std::isfinite(speed))
+          ctx.fail(where, fmt::format("the motion's pose at t = {:.6g} s is not finite (a value too large: an "
+                                      "angle, a rate or a period that overflows); expected a motion of a size the "
+                                      "container holds",
+                                      t));
+        fastest = std::max(fastest, speed);
         double out = 0;
         for (int d = 0; d < D; ++d) out = std::max({out, c.lo[d] - x[d], x[d] - c.hi[d]});
         if (out > sim.kernel_radius)
-          ctx.fail(fmt::format("Obstacles[{}].motion", k),
-                   fmt::format("the motion takes the obstacle out of the container {}: at t = {:.6g} s its corner {} "
-                               "is at {}, {:.3g} m past the wall (at most the kernel radius, {:.3g} m, is allowed); "
-                               "make the motion smaller, or the obstacle, so that it stays inside",
+          ctx.fail(where,
+                   fmt::format("the motion takes the obstacle out of the container {}: at t = {:.6g} s its "
+                               "corner {} is at {}, {:.3g} m past the wall (at most the kernel radius, {:.3g} "
+                               "m, is allowed); make the motion smaller, or the obstacle, so that it stays inside",
                                box_text<D>(c), t, point_text<D>(X), point_text<D>(x), out, sim.kernel_radius));
       }
     }
+    if (cfl) continue;
+    const double dx = 2 * sim.particle_radius;
+    if (fastest * sim.time_step > 0.4 * dx)
+      desc.warnings.push_back(fmt::format(
+          "{}: the obstacle's surface moves up to {:.3g} m/s, {:.2g} particle diameters in a step of {:.3g} s (more "
+          "than 0.4): the fluid next to it cannot follow; take steps of at most {:.3g} s, or cflMethod \"cfl\" "
+          "(its steps count the obstacles' speed)",
+          where, fastest, fastest * sim.time_step / dx, sim.time_step, 0.4 * dx / fastest));
+    if (m.type == MotionType::Oscillation && m.period < 20 * sim.time_step)
+      desc.warnings.push_back(
+          fmt::format("{}: a period of {:.3g} s is only {:.3g} steps of {:.3g} s: the motion is "
+                      "sampled too coarsely; take steps of at most {:.3g} s (period / 20)",
+                      where, m.period, m.period / sim.time_step, sim.time_step, m.period / 20));
   }
 }
 
@@ -291,7 +319,7 @@ void preflight(SceneDesc& desc, const detail::ReadContext& ctx) {
   SceneBody<D>& body = desc.body<D>();
   const SimulationParams<D>& sim = body.sim;
   check_obstacles_inside<D>(ctx, sim);
-  check_motions_stay_inside<D>(ctx, desc, sim);
+  check_motions<D>(ctx, desc, sim);
   check_obstacles_leave_room<D>(ctx, sim);
   check_coordinates<D>(ctx, desc, sim);
   check_blocks_apart<D>(ctx, body);

@@ -162,17 +162,46 @@ BoundarySet<D, R> make_boundary(const SimulationParams<D>& params) {
       params.container, params.obstacles, 2.0 * params.particle_radius, params.kernel_radius, &set.obstacle_begin);
   for (const auto& x : samples) set.position.push_back(vec_cast<R>(x));
   SPH_CHECK(set.position.size() < (std::size_t{1} << 31) / D, "too many boundary samples for 32-bit gather offsets");
-  std::vector<Vec<D, R>> rest;
-  if (params.boundary.volume == BoundaryVolume::RestFluid)
-    for (const auto& x :
-         rest_fluid_sites<D>(params.container, params.obstacles, 2.0 * params.particle_radius, params.kernel_radius))
-      rest.push_back(vec_cast<R>(x));
-  set.psi = boundary_psi<D, R>(set.position, params.fluid, static_cast<R>(params.kernel_radius), rest);
-  if (any_obstacle_moves(params)) {
-    set.rest_position = samples;
-    set.velocity.assign(set.size(), Vec<D, R>{});
-    place_boundary(set, params, 0.0);
+  const R h = static_cast<R>(params.kernel_radius);
+  const double dx = 2.0 * params.particle_radius;
+  const bool rest_fluid = params.boundary.volume == BoundaryVolume::RestFluid;
+  const auto rest_sites = [&](const std::vector<Box<D>>& obstacles) {
+    std::vector<Vec<D, R>> rest;
+    if (rest_fluid)
+      for (const auto& x : rest_fluid_sites<D>(params.container, obstacles, dx, params.kernel_radius))
+        rest.push_back(vec_cast<R>(x));
+    return rest;
+  };
+  if (!any_obstacle_moves(params)) {
+    set.psi = boundary_psi<D, R>(set.position, params.fluid, h, rest_sites(params.obstacles));
+    return set;
   }
+  // Moving obstacles: psi counts only what moves with the sample. The container's and the resting
+  // obstacles' samples are weighed among themselves; each moving obstacle's among its own (and the
+  // rest fluid around it), so that neither keeps the crowding of the other's samples at t = 0
+  // once they part (a gate standing on the floor, then lifted).
+  set.psi.assign(set.size(), R(0));
+  std::vector<Vec<D, R>> still;
+  std::vector<std::size_t> still_index;
+  std::vector<Box<D>> still_boxes;
+  for (std::size_t b = 0; b < set.obstacle_begin[0]; ++b) still.push_back(set.position[b]), still_index.push_back(b);
+  for (std::size_t k = 0; k < params.obstacles.size(); ++k) {
+    const std::size_t b0 = set.obstacle_begin[k], b1 = set.obstacle_begin[k + 1];
+    if (obstacle_motion(params, k).moves()) {
+      const std::vector<Vec<D, R>> own(set.position.begin() + static_cast<std::ptrdiff_t>(b0),
+                                       set.position.begin() + static_cast<std::ptrdiff_t>(b1));
+      const std::vector<R> psi = boundary_psi<D, R>(own, params.fluid, h, rest_sites({params.obstacles[k]}));
+      std::copy(psi.begin(), psi.end(), set.psi.begin() + static_cast<std::ptrdiff_t>(b0));
+      continue;
+    }
+    still_boxes.push_back(params.obstacles[k]);
+    for (std::size_t b = b0; b < b1; ++b) still.push_back(set.position[b]), still_index.push_back(b);
+  }
+  const std::vector<R> psi = boundary_psi<D, R>(still, params.fluid, h, rest_sites(still_boxes));
+  for (std::size_t i = 0; i < still.size(); ++i) set.psi[still_index[i]] = psi[i];
+  set.rest_position = samples;
+  set.velocity.assign(set.size(), Vec<D, R>{});
+  place_boundary(set, params, 0.0);
   return set;
 }
 

@@ -61,7 +61,7 @@ RigidPose<D> pose_at(const ObstacleMotion<D>& m, double t) {
     case MotionType::Keyframes: {
       SPH_CHECK(!m.keys.empty(), "keyframes need at least one key");
       const auto& k = m.keys;
-      if (t <= k.front().time || k.size() == 1) {
+      if (t < k.front().time || k.size() == 1) {  // (the first key's own time starts its segment)
         p.translation = k.front().translation;
         p.rotation = rotation_matrix<D>(m.axis, k.front().rotation);
         break;

@@ -113,6 +113,7 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
       particles_(std::move(particles)),
       boundary_(make_boundary<D, R>(params_)),
       poses_(params_.obstacles.size()),
+      health_poses_(params_.obstacles.size()),
       emitters_(params_.emitters.size()),
       monitor_(health_scene(params_), params_.health_failures) {
   NeighborOptions opt;
@@ -312,6 +313,14 @@ typename Simulation<D, R>::StepTime Simulation<D, R>::choose_time_step() const {
     const double next = emitters_[k].next_time < 0 ? e.start_time : emitters_[k].next_time;
     if (next > time_) end = std::min(end, next);
   }
+  // Keyframes: a step ends on the next key, where the obstacle's velocity jumps (the step's
+  // length took the speed at its start).
+  for (std::size_t k = 0; k < moving_.size(); ++k)
+    for (const MotionKey<D>& key : obstacle_motion(params_, k).keys)
+      if (key.time > time_) {
+        end = std::min(end, key.time);
+        break;
+      }
   const double left = end - time_;
   if (!(left > 0) || !std::isfinite(left)) return st;
   if (left <= st.dt * (1 + 1e-9)) {
@@ -413,9 +422,12 @@ template <bool kIntegrate>
 HealthStats Simulation<D, R>::integrate_and_check(R dt) {
   // Symplectic Euler (v += dt a; x += dt v), the blow-up check and the health statistics in one pass.
   const std::size_t n = particles_.size();
+  // (the particles are measured after their motion: the obstacles where they are then)
+  for (std::size_t k = 0; k < moving_.size(); ++k)
+    if (moving_[k]) health_poses_[k] = pose_at(obstacle_motion(params_, k), time());
   const HealthProbe<D, R> probe(
-      params_, SmoothingKernels<D, R>(params_.fluid.kernel, static_cast<R>(params_.kernel_radius)).w_zero(), poses_,
-      moving_);
+      params_, SmoothingKernels<D, R>(params_.fluid.kernel, static_cast<R>(params_.kernel_radius)).w_zero(),
+      health_poses_, moving_);
   health_chunks_.assign(chunk_count(n), detail::HealthChunk{});
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     detail::HealthChunk& chunk = health_chunks_[c];

@@ -174,8 +174,9 @@ class Simulation {
   SimulationParams<D> params_;
   ParticleSet<D, R> particles_;
   BoundarySet<D, R> boundary_;
-  std::vector<std::uint8_t> moving_;  // per obstacle: whether it moves (empty: none does)
-  std::vector<RigidPose<D>> poses_;   // per obstacle: its pose at the current step's start
+  std::vector<std::uint8_t> moving_;        // per obstacle: whether it moves (empty: none does)
+  std::vector<RigidPose<D>> poses_;         // per obstacle: its pose at the current step's start
+  std::vector<RigidPose<D>> health_poses_;  // per obstacle: its pose at the step's end (the health checks)
   std::unique_ptr<NeighborStrategy<D, R>> neighbors_;
   std::unique_ptr<ListAuditor<D, R>> auditor_;
   MortonOrder<D, R> morton_;

@@ -112,6 +112,7 @@ class WallContact {
       if (to_lo < best) best = to_lo, best_d = d, best_sign = R(-1);
       if (to_hi < best) best = to_hi, best_d = d, best_sign = R(1);
     }
+    if (best_d < 0) return false;  // (a non-finite position: the blow-up check reports it)
     a[best_d] += best_sign * contact(best, best_sign * v[best_d]);
     return true;
   }

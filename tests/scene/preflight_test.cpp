@@ -508,3 +508,14 @@ TEST(Preflight, AMotionThatOverflowsIsRefused) {
   EXPECT_NE(e.find("Obstacles[0].motion: the motion's pose at t = "), std::string::npos) << e;
   EXPECT_NE(e.find("is not finite"), std::string::npos) << e;
 }
+
+TEST(Preflight, AnObstacleMovingOverANozzleIsWarnedAbout) {
+  json j = emitter_scene();  // a nozzle at x = 0.05 around y = 0.5, emitting along +x for the run's 1 ms
+  j["Obstacles"] = json::parse(R"([ { "start": [0.2, 0.4], "end": [0.3, 0.6],
+      "motion": { "type": "keyframes", "keys": [ { "time": 0 }, { "time": 0.0008, "translation": [-0.2, 0] } ] } } ])");
+  const std::string w = warnings_of(j);
+  EXPECT_NE(w.find("Emitters[0]: Obstacles[0] moves over the nozzle while it emits"), std::string::npos) << w;
+  // The same box moving away from the nozzle: no such warning.
+  j["Obstacles"][0]["motion"]["keys"][1]["translation"] = {0.2, 0};
+  EXPECT_EQ(warnings_of(j).find("moves over the nozzle"), std::string::npos);
+}

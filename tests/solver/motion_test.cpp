@@ -121,6 +121,22 @@ TEST(Motion, KeyframesInterpolateLinearlyAndHoldTheirEnds) {
   EXPECT_EQ(pose_at(m, 3.0).angular_velocity[2], 0.0);
 }
 
+TEST(Motion, OnlyAMotionThatLeavesTheRestPoseMoves) {
+  ObstacleMotion<3> m;
+  EXPECT_FALSE(m.moves());
+  m.type = MotionType::Rotation;
+  EXPECT_FALSE(m.moves());  // no angular velocity
+  m.angular_velocity = 1e-3;
+  EXPECT_TRUE(m.moves());
+  m.type = MotionType::Keyframes;
+  m.keys = {{0.5, {}, 0.0}};
+  EXPECT_FALSE(m.moves());  // one key: the rest pose throughout
+  m.keys.push_back({1.0, {{0, 0, 0.1}}, 0.0});
+  EXPECT_TRUE(m.moves());
+  m.type = MotionType::Oscillation;
+  EXPECT_TRUE(m.moves());
+}
+
 TEST(Motion, PenaltyWallsOfAMovingBoxPushWhereItIsAndDampRelativeToIt) {
   const Box<2> container{{{0, 0}}, {{1, 1}}};
   const std::vector<Box<2>> obstacles{{{{0.4, 0.4}}, {{0.6, 0.6}}}};

@@ -57,7 +57,12 @@ struct ObstacleMotion {
   /// at full amplitude.
   double ramp_time = 0;
 
-  bool moves() const { return type != MotionType::None; }
+  /// Whether the obstacle ever leaves its place at rest: not for MotionType::None, a rotation at
+  /// no speed, or keyframes with one key (which the reader requires to be the rest pose).
+  bool moves() const {
+    return type == MotionType::Oscillation || (type == MotionType::Rotation && angular_velocity != 0) ||
+           (type == MotionType::Keyframes && keys.size() > 1);
+  }
   friend bool operator==(const ObstacleMotion&, const ObstacleMotion&) = default;
 };
 

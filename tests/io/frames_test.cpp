@@ -10,12 +10,14 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <gtest/gtest.h>
 
 #include <sph/core/error.h>
 #include <sph/io/frame_writer.h>
 #include <sph/io/frames.h>
 #include <sph/io/ply.h>
+#include <sph/io/run_directory.h>
 #include <sph/io/run_output.h>
 #include <sph/io/vtk.h>
 #include <sph/scene/builders.h>
@@ -506,6 +508,39 @@ TEST(RunDirectories, ARunOrTheRunsOfACompareDirectoryInOrder) {
     EXPECT_EQ(e.where(), cmp.string());
     EXPECT_NE(e.message().find("neither a run directory"), std::string::npos) << e.what();
   }
+}
+
+}  // namespace
+}  // namespace sph
+
+namespace sph {
+namespace {
+
+TEST(BodiesTable, ReadsWhatTheWriterWritesAndRefusesAnythingElse) {
+  test::TempDir tmp;
+  const std::string header = fmt::format("{}\n", fmt::join(kBodyColumns, ","));
+  const std::string row = "3,0.25,1,0.5,0.75,0,1,0,0,0,0.1,0,0,0,0,0.2,1,2,0,0,0,3\n";
+  test::spit(tmp / "good.csv", header + row);
+  const std::vector<BodyPoseRow> rows = read_body_rows(tmp / "good.csv");
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].time, 0.25);
+  EXPECT_EQ(rows[0].obstacle, 1u);
+  EXPECT_EQ(rows[0].position, (std::array<double, 3>{0.5, 0.75, 0}));
+  EXPECT_EQ(rows[0].orientation, (std::array<double, 4>{1, 0, 0, 0}));
+  // A wrong header, a short row, a word, a negative or fractional obstacle: one error naming the file.
+  for (const std::string& bad : {std::string("frame,time\n") + row, header + "3,0.25,1\n",
+                                 header + "3,0.25,one,0.5,0.75,0,1,0,0,0,0.1,0,0,0,0,0.2,1,2,0,0,0,3\n",
+                                 header + "3,0.25,-1,0.5,0.75,0,1,0,0,0,0.1,0,0,0,0,0.2,1,2,0,0,0,3\n",
+                                 header + "3,0.25,1.5,0.5,0.75,0,1,0,0,0,0.1,0,0,0,0,0.2,1,2,0,0,0,3\n"}) {
+    test::spit(tmp / "bad.csv", bad);
+    try {
+      read_body_rows(tmp / "bad.csv");
+      ADD_FAILURE() << "accepted: " << bad;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.csv"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW(read_body_rows(tmp / "missing.csv"), Error);
 }
 
 }  // namespace

@@ -168,6 +168,34 @@ TEST(FrameImage, RunObstaclesArePlacedAtTheFramesTime) {
   EXPECT_EQ(at_rest[1].translation, (std::array<double, 3>{0, 0, 0}));
 }
 
+TEST(FrameImage, FloatingBodiesAreDrawnWhereTheRunsTableHasThem) {
+  // A floating box [0.2, 0.4] x [0, 0.2] (centre 0.3, 0.1) whose bodies.csv rows put it at
+  // (1, 0.5) turned by 90 degrees at t = 1 s, and back at rest at t = 0.
+  RunDirectory run = run2d("floating");
+  SceneBody<2> body;
+  body.sim.obstacles = {Box<2>{{{0.2, 0}}, {{0.4, 0.2}}}};
+  BodyParams<2> b;
+  b.dynamic = true;
+  b.density = 500;
+  body.sim.bodies = {b};
+  run.scene.set_body(body);
+  const double h = std::sqrt(0.5);
+  run.bodies = {BodyPoseRow{0.0, 0, {0.3, 0.1, 0}, {1, 0, 0, 0}}, BodyPoseRow{1.0, 0, {1.0, 0.5, 0}, {h, 0, 0, h}}};
+  // The frame nearest each time: 0.4 s takes t = 0's row, 0.9 s t = 1's.
+  EXPECT_TRUE(run_obstacles(run, 0.4)[0].axis_aligned());
+  EXPECT_NEAR(run_obstacles(run, 0.4)[0].translation[0], 0.0, 1e-12);
+  const SolidBox s = run_obstacles(run, 0.9)[0];
+  const auto centre = s.place({0.3, 0.1, 0}, 2);
+  EXPECT_NEAR(centre[0], 1.0, 1e-12);
+  EXPECT_NEAR(centre[1], 0.5, 1e-12);
+  const auto corner = s.place({0.4, 0.0, 0}, 2);  // (0.1, -0.1) from the centre, turned a quarter
+  EXPECT_NEAR(corner[0], 1.1, 1e-12);
+  EXPECT_NEAR(corner[1], 0.6, 1e-12);
+  // Without a table, where it started.
+  run.bodies.clear();
+  EXPECT_EQ(run_obstacles(run, 0.9)[0].translation, (std::array<double, 3>{0, 0, 0}));
+}
+
 TEST(FrameImage, RunObstaclesOfA3DSceneTurnAboutTheirAxis) {
   RunDirectory run = run2d("3d");
   run.dimension = 3;

@@ -52,7 +52,9 @@ json every_key_3d() {
                      { "start": [0.5, 0.6, 0.1], "end": [0.6, 0.7, 0.2] } ],
     "Obstacles": [ { "start": [0.3, 0.05, 0.3], "end": [0.4, 0.2, 0.4],
                      "motion": { "type": "rotation", "axis": [0, 0.6, 0.8], "center": [0.35, 0.1, 0.35],
-                                 "angularVelocity": -1.5, "rampTime": 0.25 } } ],
+                                 "angularVelocity": -1.5, "rampTime": 0.25 } },
+                   { "start": [0.6, 0.3, 0.3], "end": [0.7, 0.35, 0.4], "dynamic": true, "density": 650,
+                     "velocity": [0.1, -0.2, 0.3], "angularVelocity": [0.5, -0.25, 2] } ],
     "Emitters": [ { "translation": [0.05, 0.8, 0.35], "direction": [1, -0.3, 0.1], "velocity": 4.5, "width": 3,
                     "height": 2, "emitEveryNSteps": 40, "maxParticles": 120, "emitStartTime": 0.001,
                     "emitEndTime": 0.5 } ]
@@ -82,7 +84,9 @@ json every_key_2d() {
                    { "start": [0.7, 0], "end": [0.8, 0.3],
                      "motion": { "type": "keyframes", "center": [0.75, 0.1],
                                  "keys": [ { "time": 0.001, "translation": [0, 0], "rotation": 0 },
-                                           { "time": 0.004, "translation": [0.05, 0.1], "rotation": 0.2 } ] } } ],
+                                           { "time": 0.004, "translation": [0.05, 0.1], "rotation": 0.2 } ] } },
+                   { "start": [0.85, 0.5], "end": [0.95, 0.55], "dynamic": true, "density": 700,
+                     "velocity": [-0.5, 0.25], "angularVelocity": 1.5 } ],
     "Emitters": [ { "translation": [0.05, 0.5], "direction": [3, 7], "velocity": 20.0, "width": 4,
                     "emitEveryNSteps": 12, "maxParticles": 100, "emitStartTime": 0.25, "emitEndTime": 1e300 } ]
   })");
@@ -167,7 +171,14 @@ TEST(SceneWriter, WritesEveryDeclaredKeyOfEveryObject) {
     EXPECT_EQ(keys_of(w["Fluid"]), set_of(sph::detail::kFluidKeys));
     EXPECT_EQ(keys_of(w["Container"]), set_of(sph::detail::kContainerKeys));
     EXPECT_EQ(keys_of(w["FluidBlocks"][0]), set_of(sph::detail::kFluidBlockKeys));
-    EXPECT_EQ(keys_of(w["Obstacles"][0]), set_of(sph::detail::kObstacleKeys));
+    // Every obstacle key among the obstacles: a floating body's own keys only on the floating one.
+    std::set<std::string> obstacle_keys;
+    for (const json& o : w["Obstacles"]) {
+      const std::set<std::string> keys = keys_of(o);
+      obstacle_keys.insert(keys.begin(), keys.end());
+      EXPECT_EQ(keys.count("density"), o["dynamic"].get<bool>() ? 1u : 0u);
+    }
+    EXPECT_EQ(obstacle_keys, set_of(sph::detail::kObstacleKeys));
     for (const json& o : w["Obstacles"]) {  // each motion with every key of its type
       const sph::MotionType type =
           sph::detail::value_named(sph::detail::kMotionTypeNames, o["motion"]["type"].get<std::string>());

@@ -24,8 +24,9 @@
 
 namespace sph {
 
-/// The format version this build writes and reads. Version 9 stores DFSPH's last constant-density
-/// solve (iterations, error, converged: the next CFL step depends on it) after the last CFL step.
+/// The format version this build writes and reads. Version 10 stores the floating bodies' states
+/// (RigidBodyState, after the emitters') and the frames' body rows (bodies.csv). Version 9 stores DFSPH's last
+/// constant-density solve (iterations, error, converged: the next CFL step depends on it) after the last CFL step.
 /// Version 8 stores the simulated time and the
 /// last CFL step after the step count, and each emitter's next batch time (TimeStepping::Cfl).
 /// Version 7 changes no byte but the meaning of
@@ -38,7 +39,7 @@ namespace sph {
 /// name and kind, in kParticleFields order, then the fields a run added (ParticleSet::save);
 /// version 2 kept the frames' times and the schedule's next tick instead of version 1's .vtu
 /// file list.
-inline constexpr std::uint32_t kCheckpointVersion = 9;
+inline constexpr std::uint32_t kCheckpointVersion = 10;
 /// The checkpoint's file name in a run's output directory.
 inline constexpr const char* kCheckpointFile = "checkpoint.sphc";
 

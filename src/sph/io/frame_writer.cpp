@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include <sph/io/atomic_file.h>
 #include <sph/io/ply.h>
 #include <sph/io/solids.h>
 #include <sph/io/vtk.h>
@@ -77,15 +78,47 @@ void FrameWriter<D, R>::write(const Simulation<D, R>& sim) {
   for (FrameFormat f : output_.formats)
     write_frame(f, dir_ / frame_name(index, f), sim.particles(), sim.time(), fields_);
   if (!sim.params().obstacles.empty()) {
-    write_solids_vtp(dir_ / solids_name(index), sim.params(), sim.time());
+    const std::vector<RigidPose<D>> poses = sim.obstacle_poses();
+    write_solids_vtp<D>(dir_ / solids_name(index), sim.params().obstacles, poses, sim.time());
     if (std::find(output_.formats.begin(), output_.formats.end(), FrameFormat::Ply) != output_.formats.end())
-      write_solids_ply(dir_ / fmt::format("frames/solids_{:06d}.ply", index), sim.params(), sim.time());
+      write_solids_ply<D>(dir_ / fmt::format("frames/solids_{:06d}.ply", index), sim.params().obstacles, poses,
+                          sim.time());
     solids_ = true;
   }
+  // The floating bodies: a row each in bodies.csv (kBodyColumns).
+  for (std::size_t s = 0; s < sim.bodies().size(); ++s) {
+    const RigidBodyState<D>& b = sim.bodies()[s];
+    const BodyLoad<D>& f = sim.body_fluid_forces()[s];
+    std::vector<double> row{static_cast<double>(index), sim.time(), static_cast<double>(sim.body_obstacles()[s])};
+    const auto add = [&row](const auto& v, int n) {
+      for (int c = 0; c < 3; ++c) row.push_back(c < n ? v[c] : 0.0);
+    };
+    add(b.position, D);
+    row.insert(row.end(), b.orientation.begin(), b.orientation.end());
+    add(b.velocity, D);
+    add(b.angular_velocity, 3);
+    add(f.impulse, D);
+    add(f.angular_impulse, 3);
+    body_rows_.insert(body_rows_.end(), row.begin(), row.end());
+  }
+  if (!sim.bodies().empty()) write_bodies();
   times_.push_back(sim.time());
   schedule_.written(sim.time());
   last_off_schedule_ = false;
   write_index();
+}
+
+template <int D, std::floating_point R>
+void FrameWriter<D, R>::write_bodies() const {
+  std::string text = fmt::format("{}\n", fmt::join(kBodyColumns, ","));
+  const std::size_t columns = std::size(kBodyColumns);
+  for (std::size_t r = 0; r + columns <= body_rows_.size(); r += columns) {
+    const double* v = &body_rows_[r];
+    text += fmt::format("{:.0f},{:.17g},{:.0f}", v[0], v[1], v[2]);
+    for (std::size_t c = 3; c < columns; ++c) text += fmt::format(",{:.17g}", v[c]);
+    text += '\n';
+  }
+  write_file_atomic(dir_ / "bodies.csv", text);
 }
 
 template <int D, std::floating_point R>
@@ -107,6 +140,7 @@ void FrameWriter<D, R>::save_state(StateWriter& out) const {
   out.put(times_);
   out.put(schedule_.next_tick());
   out.put(static_cast<std::uint8_t>(last_off_schedule_));
+  out.put(body_rows_);
 }
 
 template <int D, std::floating_point R>
@@ -122,6 +156,13 @@ void FrameWriter<D, R>::load_state(StateReader& in) {
   // step does not have it (an uninterrupted run of more steps writes no frame there), so it goes.
   if (off) times_.pop_back();
   last_off_schedule_ = false;
+  in.get(body_rows_);
+  const std::size_t columns = std::size(kBodyColumns);
+  in.expect(body_rows_.size() % columns == 0, "a bad floating body table");
+  std::size_t keep = 0;  // (the rows of the frames kept)
+  while (keep < body_rows_.size() && body_rows_[keep] < static_cast<double>(times_.size())) keep += columns;
+  body_rows_.resize(keep);
+  if (!body_rows_.empty()) write_bodies();
   // Frames the interrupted run wrote after the checkpoint, in any format.
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dir_ / "frames", ec)) {

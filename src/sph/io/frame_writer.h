@@ -13,7 +13,8 @@
 /// every frame file carries its simulated time (read_frame in frames.h reads it back).
 /// A scene with obstacles also gets DIR/frames/solids_NNNNNN.vtp with each frame (the obstacles
 /// where they are at its time, io/solids.h; with the ply format also solids_NNNNNN.ply) and
-/// DIR/solids.pvd, their time series.
+/// DIR/solids.pvd, their time series. A scene with floating bodies also gets DIR/bodies.csv,
+/// a row per body per frame (kBodyColumns), rewritten after every frame.
 
 #include <cstdint>
 #include <filesystem>
@@ -22,6 +23,7 @@
 
 #include <sph/core/state_stream.h>
 #include <sph/io/frame_format.h>
+#include <sph/io/run_directory.h>
 #include <sph/scene/scene_desc.h>
 #include <sph/solver/simulation.h>
 
@@ -87,6 +89,7 @@ class FrameWriter {
 
  private:
   void write_index() const;
+  void write_bodies() const;
 
   std::filesystem::path dir_;
   OutputDesc output_;
@@ -95,6 +98,7 @@ class FrameWriter {
   std::vector<double> times_;
   bool last_off_schedule_ = false;  // the latest frame was written only because its step was the last
   bool solids_ = false;             // the scene has obstacles: each frame has its solids_NNNNNN.vtp
+  std::vector<double> body_rows_;   // bodies.csv's rows, kBodyColumns values each
 };
 
 extern template class FrameWriter<2, float>;

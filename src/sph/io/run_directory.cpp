@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <ctime>
 #include <fstream>
 #include <map>
@@ -11,6 +13,7 @@
 #include <unistd.h>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include <sph/core/error.h>
@@ -75,6 +78,40 @@ std::vector<fs::path> list_frames(const fs::path& dir, FrameFormat format) {
   return frames;
 }
 
+std::vector<BodyPoseRow> read_body_rows(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) throw Error("cannot be read", file.string());
+  std::string line;
+  const std::string header = fmt::format("{}", fmt::join(kBodyColumns, ","));
+  if (!std::getline(in, line) || line != header)
+    throw Error(fmt::format("line 1 is not the header of a bodies table; expected \"{}\"", header), file.string());
+  std::vector<BodyPoseRow> rows;
+  for (int number = 2; std::getline(in, line); ++number) {
+    std::vector<double> v;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) {
+      char* end = nullptr;
+      const double x = std::strtod(cell.c_str(), &end);
+      if (cell.empty() || *end != '\0' || !std::isfinite(x)) {
+        v.clear();
+        break;
+      }
+      v.push_back(x);
+    }
+    if (v.size() != std::size(kBodyColumns) || v[2] < 0 || v[2] != std::floor(v[2]))
+      throw Error(fmt::format("line {} is not a row of {} finite numbers (frame, time, obstacle, ...)", number,
+                              std::size(kBodyColumns)),
+                  file.string());
+    BodyPoseRow r;
+    r.time = v[1];
+    r.obstacle = static_cast<std::size_t>(v[2]);
+    r.position = {v[3], v[4], v[5]};
+    r.orientation = {v[6], v[7], v[8], v[9]};
+    rows.push_back(r);
+  }
+  return rows;
+}
+
 RunDirectory open_run_directory(const fs::path& dir, std::optional<FrameFormat> format) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec))
@@ -87,6 +124,7 @@ RunDirectory open_run_directory(const fs::path& dir, std::optional<FrameFormat> 
   run.dir = dir;
   run.scene = read_scene_file(scene_file.string());
   run.dimension = run.scene.dimension;
+  if (fs::is_regular_file(dir / "bodies.csv", ec)) run.bodies = read_body_rows(dir / "bodies.csv");
   run.scene.visit_body([&]<int D>(const SceneBody<D>& body) {
     const SimulationParams<D>& sim = body.sim;
     run.particle_radius = sim.particle_radius;

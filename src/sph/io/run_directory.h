@@ -15,6 +15,22 @@
 
 namespace sph {
 
+/// The columns of bodies.csv: the frame, its time (s), the body's index in Obstacles[], its centre
+/// of mass (m), orientation (unit quaternion w, x, y, z), velocity (m/s), angular velocity
+/// (rad/s), and the fluid's mean force (N) and moment about the centre of mass (N m) over the
+/// frame's last step (2D: z = 0, the moment about z, per metre of depth).
+inline constexpr const char* kBodyColumns[] = {"frame", "time", "obstacle", "x",  "y",  "z",  "qw", "qx",
+                                               "qy",    "qz",   "vx",       "vy", "vz", "wx", "wy", "wz",
+                                               "fx",    "fy",   "fz",       "mx", "my", "mz"};
+
+/// One row of DIR/bodies.csv: a floating body where it was at a frame.
+struct BodyPoseRow {
+  double time = 0;  ///< the frame's time, s
+  std::size_t obstacle = 0;
+  std::array<double, 3> position{};               ///< centre of mass, m (z = 0 in 2D)
+  std::array<double, 4> orientation{1, 0, 0, 0};  ///< unit quaternion w, x, y, z
+};
+
 /// A run directory as `sph run -o DIR` leaves it.
 struct RunDirectory {
   std::filesystem::path dir;
@@ -31,7 +47,13 @@ struct RunDirectory {
   /// open_run_directory.
   std::vector<std::filesystem::path> frames;
   FrameFormat format = FrameFormat::Vtu;
+  /// DIR/bodies.csv's rows (a scene with floating bodies), in the file's order; empty without one.
+  std::vector<BodyPoseRow> bodies;
 };
+
+/// Reads a bodies.csv (kBodyColumns). Throws sph::Error naming the file and the line if its header
+/// or a row is not what FrameWriter writes.
+std::vector<BodyPoseRow> read_body_rows(const std::filesystem::path& file);
 
 /// Opens a run directory: reads DIR/scene.json and lists the frames of `format`, or of the first
 /// format present in the order vtu, vtk, ply. Throws sph::Error naming the path if DIR is

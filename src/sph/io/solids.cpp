@@ -12,7 +12,7 @@ namespace sph {
 
 namespace {
 
-/// The obstacles of `params` at time t as points (each box's corners: corner c has bit d set for
+/// The obstacles placed by their poses as points (each box's corners: corner c has bit d set for
 /// the upper end along axis d) and quads (3D: 6 per box, outward and counter-clockwise seen from
 /// outside; 2D: one per box, counter-clockwise), with each quad's obstacle index.
 template <int D>
@@ -21,7 +21,7 @@ struct SolidSurfaces {
   std::vector<std::array<std::size_t, 4>> quads;
   std::vector<std::size_t> owner;
 
-  SolidSurfaces(const SimulationParams<D>& params, double t) {
+  SolidSurfaces(const std::vector<Box<D>>& obstacles, std::span<const RigidPose<D>> poses) {
     static constexpr std::array<std::array<int, 4>, 6> kFaces3{{{0, 4, 6, 2},    // -x
                                                                 {1, 3, 7, 5},    // +x
                                                                 {0, 1, 5, 4},    // -y
@@ -29,14 +29,12 @@ struct SolidSurfaces {
                                                                 {0, 2, 3, 1},    // -z
                                                                 {4, 5, 7, 6}}};  // +z
     static constexpr std::array<std::array<int, 4>, 1> kFaces2{{{0, 1, 3, 2}}};
-    for (std::size_t k = 0; k < params.obstacles.size(); ++k) {
-      const Box<D>& box = params.obstacles[k];
-      const RigidPose<D> pose = pose_at(obstacle_motion(params, k), t);
+    for (std::size_t k = 0; k < obstacles.size(); ++k) {
+      const Box<D>& box = obstacles[k];
+      const RigidPose<D> pose = k < poses.size() ? poses[k] : RigidPose<D>{};
       const std::size_t base = points.size();
       for (int c = 0; c < (1 << D); ++c) {
-        Vec<D, double> X;
-        for (int d = 0; d < D; ++d) X[d] = c >> d & 1 ? box.hi[d] : box.lo[d];
-        const Vec<D, double> x = pose.place(X);
+        const Vec<D, double> x = pose.place(box_corner<D>(box.lo, box.hi, c));
         points.push_back({x[0], x[1], D == 3 ? x[D - 1] : 0.0});
       }
       const auto add = [&](const auto& faces) {
@@ -57,8 +55,9 @@ struct SolidSurfaces {
 }  // namespace
 
 template <int D>
-void write_solids_vtp(const std::filesystem::path& path, const SimulationParams<D>& params, double t) {
-  const SolidSurfaces<D> s(params, t);
+void write_solids_vtp(const std::filesystem::path& path, const std::vector<Box<D>>& obstacles,
+                      std::span<const RigidPose<D>> poses, double t) {
+  const SolidSurfaces<D> s(obstacles, poses);
   std::string points, connectivity, offsets, ids;
   for (const auto& p : s.points) points += fmt::format("{:.17g} {:.17g} {:.17g}\n", p[0], p[1], p[2]);
   for (std::size_t f = 0; f < s.quads.size(); ++f) {
@@ -86,8 +85,9 @@ void write_solids_vtp(const std::filesystem::path& path, const SimulationParams<
 }
 
 template <int D>
-void write_solids_ply(const std::filesystem::path& path, const SimulationParams<D>& params, double t) {
-  const SolidSurfaces<D> s(params, t);
+void write_solids_ply(const std::filesystem::path& path, const std::vector<Box<D>>& obstacles,
+                      std::span<const RigidPose<D>> poses, double t) {
+  const SolidSurfaces<D> s(obstacles, poses);
   std::string text = fmt::format(
       "ply\nformat ascii 1.0\ncomment sph obstacles\ncomment time {:.17g}\nelement vertex {}\nproperty double "
       "x\nproperty double y\nproperty double z\nelement face {}\nproperty list uchar int vertex_indices\n"
@@ -98,9 +98,13 @@ void write_solids_ply(const std::filesystem::path& path, const SimulationParams<
   write_file_atomic(path, text);
 }
 
-template void write_solids_vtp<2>(const std::filesystem::path&, const SimulationParams<2>&, double);
-template void write_solids_vtp<3>(const std::filesystem::path&, const SimulationParams<3>&, double);
-template void write_solids_ply<2>(const std::filesystem::path&, const SimulationParams<2>&, double);
-template void write_solids_ply<3>(const std::filesystem::path&, const SimulationParams<3>&, double);
+template void write_solids_vtp<2>(const std::filesystem::path&, const std::vector<Box<2>>&,
+                                  std::span<const RigidPose<2>>, double);
+template void write_solids_vtp<3>(const std::filesystem::path&, const std::vector<Box<3>>&,
+                                  std::span<const RigidPose<3>>, double);
+template void write_solids_ply<2>(const std::filesystem::path&, const std::vector<Box<2>>&,
+                                  std::span<const RigidPose<2>>, double);
+template void write_solids_ply<3>(const std::filesystem::path&, const std::vector<Box<3>>&,
+                                  std::span<const RigidPose<3>>, double);
 
 }  // namespace sph

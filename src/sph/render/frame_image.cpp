@@ -1,6 +1,7 @@
 #include <sph/render/frame_image.h>
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include <fmt/format.h>
@@ -8,6 +9,7 @@
 #include <sph/core/error.h>
 #include <sph/render/compose.h>
 #include <sph/render/font.h>
+#include <sph/solver/rigid_body.h>
 #include <sph/surface/surface.h>
 
 namespace sph {
@@ -32,9 +34,9 @@ std::vector<double> xy_of(const FrameData& frame) {
   return xy;
 }
 
-/// Obstacle k of `sim` placed at `time` (obstacle_solid).
+/// The box of obstacle k of `sim` placed by `pose`, as render_particles draws it.
 template <int D>
-SolidBox placed_obstacle(const SimulationParams<D>& sim, std::size_t k, double time) {
+SolidBox placed_box(const SimulationParams<D>& sim, std::size_t k, const RigidPose<D>& pose) {
   SPH_CHECK(k < sim.obstacles.size(), "no such obstacle");
   const Box<D>& box = sim.obstacles[k];
   SolidBox s;
@@ -42,9 +44,6 @@ SolidBox placed_obstacle(const SimulationParams<D>& sim, std::size_t k, double t
     s.lo[a] = box.lo[a];
     s.hi[a] = box.hi[a];
   }
-  const ObstacleMotion<D>& motion = obstacle_motion(sim, k);
-  if (!motion.moves()) return s;
-  const RigidPose<D> pose = pose_at(motion, time);
   // A 2D pose turns about z: its upper-left 2 x 2 is all that matters, and z stays.
   for (std::size_t r = 0; r < D; ++r)
     for (std::size_t c = 0; c < D; ++c) s.rotation[3 * r + c] = pose.rotation[3 * r + c];
@@ -55,20 +54,41 @@ SolidBox placed_obstacle(const SimulationParams<D>& sim, std::size_t k, double t
   return s;
 }
 
-}  // namespace
-
-SolidBox obstacle_solid(const SimulationParams<2>& sim, std::size_t k, double time) {
-  return placed_obstacle(sim, k, time);
+/// Obstacle k of `sim` placed at `time` (obstacle_solid): a floating body where `bodies` (a run's
+/// bodies.csv) has it at the frame nearest `time`.
+template <int D>
+SolidBox placed_obstacle(const SimulationParams<D>& sim, std::size_t k, double time,
+                         std::span<const BodyPoseRow> bodies) {
+  SPH_CHECK(k < sim.obstacles.size(), "no such obstacle");
+  if (!obstacle_body(sim, k).dynamic) return placed_box(sim, k, pose_at(obstacle_motion(sim, k), time));
+  const BodyPoseRow* nearest = nullptr;
+  for (const BodyPoseRow& r : bodies)
+    if (r.obstacle == k && (!nearest || std::abs(r.time - time) < std::abs(nearest->time - time))) nearest = &r;
+  if (!nearest) return placed_box(sim, k, RigidPose<D>{});  // (no table: where it started)
+  RigidBodyState<D> state;
+  for (int a = 0; a < D; ++a) state.position[a] = nearest->position[static_cast<std::size_t>(a)];
+  state.orientation = nearest->orientation;
+  const Box<D>& box = sim.obstacles[k];
+  return placed_box(sim, k, body_pose(state, (box.lo + box.hi) * 0.5));
 }
 
-SolidBox obstacle_solid(const SimulationParams<3>& sim, std::size_t k, double time) {
-  return placed_obstacle(sim, k, time);
+}  // namespace
+
+SolidBox obstacle_solid(const SimulationParams<2>& sim, std::size_t k, double time,
+                        std::span<const BodyPoseRow> bodies) {
+  return placed_obstacle(sim, k, time, bodies);
+}
+
+SolidBox obstacle_solid(const SimulationParams<3>& sim, std::size_t k, double time,
+                        std::span<const BodyPoseRow> bodies) {
+  return placed_obstacle(sim, k, time, bodies);
 }
 
 std::vector<SolidBox> run_obstacles(const RunDirectory& run, double time) {
   return run.scene.visit_body([&](const auto& body) {
     std::vector<SolidBox> out;
-    for (std::size_t k = 0; k < body.sim.obstacles.size(); ++k) out.push_back(obstacle_solid(body.sim, k, time));
+    for (std::size_t k = 0; k < body.sim.obstacles.size(); ++k)
+      out.push_back(obstacle_solid(body.sim, k, time, run.bodies));
     return out;
   });
 }

@@ -27,13 +27,17 @@ struct FrameStyle {
 };
 
 /// Obstacle k of `sim` (its box at rest) placed where its motion (obstacle_motion) puts it at
-/// `time` (s), as render_particles draws it; z is 0 in 2D. Precondition: k < sim.obstacles.size().
-SolidBox obstacle_solid(const SimulationParams<2>& sim, std::size_t k, double time);
-SolidBox obstacle_solid(const SimulationParams<3>& sim, std::size_t k, double time);
+/// `time` (s), or a floating body where `bodies` (its run's bodies.csv) has it at the frame
+/// nearest `time` (where it started if the table has no row of it), as render_particles draws it;
+/// z is 0 in 2D. Precondition: k < sim.obstacles.size().
+SolidBox obstacle_solid(const SimulationParams<2>& sim, std::size_t k, double time,
+                        std::span<const BodyPoseRow> bodies = {});
+SolidBox obstacle_solid(const SimulationParams<3>& sim, std::size_t k, double time,
+                        std::span<const BodyPoseRow> bodies = {});
 
 /// The scene's obstacles (its Obstacles) as render_particles draws them at `time` (s, a frame's
-/// simulated time), in the scene's order: each moving one where its motion puts it then, the
-/// others at rest (obstacle_solid).
+/// simulated time), in the scene's order: each moving one where its motion puts it then, each
+/// floating one where the run's bodies.csv has it, the others at rest (obstacle_solid).
 std::vector<SolidBox> run_obstacles(const RunDirectory& run, double time);
 
 /// The color range for `by` over whole runs (color_range of every run's values together), from

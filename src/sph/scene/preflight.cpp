@@ -95,6 +95,22 @@ void check_obstacles_inside(const ReadContext& ctx, const SimulationParams<D>& s
   }
 }
 
+/// A floating body (Obstacles[].dynamic) much lighter than the fluid draws a warning: the
+/// coupling, explicit between the fluid's step and the body's, grows unstable as the body's mass
+/// falls below the fluid it displaces (SPlisHSPlasH's Akinci coupling has the same limit). (Like
+/// every obstacle it starts inside the container: the scene reader refuses one that does not.)
+template <int D>
+void check_bodies(SceneDesc& desc, const SimulationParams<D>& sim) {
+  for (std::size_t k = 0; k < sim.obstacles.size(); ++k) {
+    const BodyParams<D>& b = obstacle_body(sim, k);
+    if (b.dynamic && b.density < 0.1 * sim.fluid.rest_density)
+      desc.warnings.push_back(fmt::format(
+          "Obstacles[{}]: a floating body of density {:g} is less than a tenth of the fluid's ({:g}): the coupling "
+          "between the fluid's step and the body's may grow unstable; make it denser, or expect to shorten the steps",
+          k, b.density, sim.fluid.rest_density));
+  }
+}
+
 /// A moving obstacle must stay inside the container: its corners are checked at 4,096 times
 /// evenly over the run (and at each key of keyframes), and one that goes farther than the kernel
 /// radius past a wall is refused (a unit mistake, or an amplitude too large for the tank), as is a
@@ -123,8 +139,7 @@ void check_motions(const ReadContext& ctx, SceneDesc& desc, const SimulationPara
     for (const double t : times) {
       const RigidPose<D> pose = pose_at(m, t);
       for (int corner = 0; corner < (1 << D); ++corner) {
-        Vec<D, double> X;
-        for (int d = 0; d < D; ++d) X[d] = corner >> d & 1 ? sim.obstacles[k].hi[d] : sim.obstacles[k].lo[d];
+        const Vec<D, double> X = box_corner<D>(sim.obstacles[k].lo, sim.obstacles[k].hi, corner);
         const Vec<D, double> x = pose.place(X);
         const double speed = std::sqrt(norm2(pose.velocity_at(x)));
         if (!all_finite(x) || !std::isfinite(speed))
@@ -320,6 +335,7 @@ void preflight(SceneDesc& desc, const detail::ReadContext& ctx) {
   const SimulationParams<D>& sim = body.sim;
   check_obstacles_inside<D>(ctx, sim);
   check_motions<D>(ctx, desc, sim);
+  check_bodies<D>(desc, sim);
   check_obstacles_leave_room<D>(ctx, sim);
   check_coordinates<D>(ctx, desc, sim);
   check_blocks_apart<D>(ctx, body);

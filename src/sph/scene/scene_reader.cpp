@@ -149,6 +149,37 @@ ObstacleMotion<D> read_motion(ObjectReader& o, const Box<D>& box) {
   return m;
 }
 
+/// Obstacles[].dynamic and its keys (docs/scene-format.md, "Floating bodies"), after the motion.
+template <int D>
+BodyParams<D> read_floating(ObjectReader& o, const ObstacleMotion<D>& motion) {
+  BodyParams<D> b;
+  b.dynamic = o.boolean("dynamic", "whether the obstacle floats, moved by the fluid, gravity and the container", false);
+  if (!b.dynamic) {
+    for (const char* key : {"density", "velocity", "angularVelocity"})
+      if (o.find(key))
+        o.ctx().fail(o.child(key),
+                     "only a floating obstacle takes this key; add \"dynamic\": true to the "
+                     "obstacle, or remove the key");
+    return b;
+  }
+  if (motion.type != MotionType::None)
+    o.ctx().fail(o.child("motion"),
+                 "a floating obstacle (\"dynamic\": true) is moved by the fluid and cannot also follow a prescribed "
+                 "motion; remove \"motion\" or \"dynamic\"");
+  o.require("density", "the body's density, kg/m^3 (in 2D in Fluid.density0's units), > 0");
+  b.density = o.positive("density", "the body's density, kg/m^3 (in 2D in Fluid.density0's units), > 0");
+  b.velocity = o.vec<D>("velocity", "the body's velocity at t = 0, m/s", Vec<D, double>{});
+  if constexpr (D == 2) {
+    if (const json* w = o.find("angularVelocity"))
+      b.angular_velocity[2] =
+          o.number(*w, "angularVelocity", "the body's angular velocity at t = 0, rad/s (counter-clockwise), a number");
+  } else {
+    b.angular_velocity =
+        o.vec<3>("angularVelocity", "the body's angular velocity at t = 0, rad/s (world axes)", Vec<3, double>{});
+  }
+  return b;
+}
+
 /// Configuration.outputEveryNSteps, outputFps, outputFormats, outputFields.
 void read_output(ObjectReader& c, SceneDesc& desc) {
   OutputDesc& out = desc.output;
@@ -557,8 +588,12 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
   root.array_of_objects("Obstacles", detail::kObstacleKeys, [&](ObjectReader& o, std::size_t) {
     sim.obstacles.push_back(read_box<D>(o, "obstacle"));
     sim.motions.push_back(read_motion<D>(o, sim.obstacles.back()));
+    sim.bodies.push_back(read_floating<D>(o, sim.motions.back()));
   });
-  if (!any_obstacle_moves(sim)) sim.motions.clear();  // (all at rest: as a scene without motions)
+  // (none moves, none floats: as a scene without motions or bodies)
+  if (std::none_of(sim.motions.begin(), sim.motions.end(), [](const ObstacleMotion<D>& m) { return m.moves(); }))
+    sim.motions.clear();
+  if (!any_dynamic_body(sim)) sim.bodies.clear();
   root.array_of_objects("Emitters", detail::emitter_keys(D), [&](ObjectReader& e, std::size_t) {
     sim.emitters.push_back(read_emitter<D>(e, sim));
     total += static_cast<double>(sim.emitters.back().max_particles);

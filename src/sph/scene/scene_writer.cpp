@@ -161,12 +161,22 @@ void write_body(const SceneDesc& desc, const SceneBody<D>& body, ObjectWriter& r
                          .put("end", vec_json<D>(b.box.hi))
                          .put("velocity", vec_json<D>(b.velocity))
                          .take());
-  for (std::size_t k = 0; k < sim.obstacles.size(); ++k)
-    obstacles.push_back(ObjectWriter(detail::kObstacleKeys)
-                            .put("start", vec_json<D>(sim.obstacles[k].lo))
-                            .put("end", vec_json<D>(sim.obstacles[k].hi))
-                            .put("motion", motion_json<D>(obstacle_motion(sim, k)))
-                            .take());
+  for (std::size_t k = 0; k < sim.obstacles.size(); ++k) {
+    ObjectWriter o(detail::kObstacleKeys);
+    o.put("start", vec_json<D>(sim.obstacles[k].lo))
+        .put("end", vec_json<D>(sim.obstacles[k].hi))
+        .put("motion", motion_json<D>(obstacle_motion(sim, k)));
+    const BodyParams<D>& b = obstacle_body(sim, k);
+    o.put("dynamic", b.dynamic);
+    if (b.dynamic) {  // (the body's keys only with it: the reader refuses them on a fixed obstacle)
+      o.put("density", b.density).put("velocity", vec_json<D>(b.velocity));
+      if constexpr (D == 2)
+        o.put("angularVelocity", b.angular_velocity[2]);
+      else
+        o.put("angularVelocity", vec_json<3>(b.angular_velocity));
+    }
+    obstacles.push_back(o.take());
+  }
   for (const EmitterParams<D>& e : sim.emitters) emitters.push_back(emitter_json<D>(e));
   root.put("Configuration", configuration_json<D>(desc, sim))
       .put("Fluid", fluid_json<D>(sim))

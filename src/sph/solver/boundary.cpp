@@ -187,7 +187,7 @@ BoundarySet<D, R> make_boundary(const SimulationParams<D>& params) {
   for (std::size_t b = 0; b < set.obstacle_begin[0]; ++b) still.push_back(set.position[b]), still_index.push_back(b);
   for (std::size_t k = 0; k < params.obstacles.size(); ++k) {
     const std::size_t b0 = set.obstacle_begin[k], b1 = set.obstacle_begin[k + 1];
-    if (obstacle_motion(params, k).moves()) {
+    if (obstacle_moves(params, k)) {
       const std::vector<Vec<D, R>> own(set.position.begin() + static_cast<std::ptrdiff_t>(b0),
                                        set.position.begin() + static_cast<std::ptrdiff_t>(b1));
       const std::vector<R> psi = boundary_psi<D, R>(own, params.fluid, h, rest_sites({params.obstacles[k]}));
@@ -201,17 +201,19 @@ BoundarySet<D, R> make_boundary(const SimulationParams<D>& params) {
   for (std::size_t i = 0; i < still.size(); ++i) set.psi[still_index[i]] = psi[i];
   set.rest_position = samples;
   set.velocity.assign(set.size(), Vec<D, R>{});
-  place_boundary(set, params, 0.0);
+  std::vector<RigidPose<D>> poses(params.obstacles.size());
+  for (std::size_t k = 0; k < params.obstacles.size(); ++k) poses[k] = pose_at(obstacle_motion(params, k), 0.0);
+  place_boundary<D, R>(set, params, poses);
   return set;
 }
 
 template <int D, std::floating_point R>
-void place_boundary(BoundarySet<D, R>& set, const SimulationParams<D>& params, double t) {
+void place_boundary(BoundarySet<D, R>& set, const SimulationParams<D>& params, std::span<const RigidPose<D>> poses) {
   if (!set.moving()) return;
+  SPH_CHECK(poses.size() == params.obstacles.size(), "place_boundary: one pose per obstacle");
   for (std::size_t k = 0; k < params.obstacles.size(); ++k) {
-    const ObstacleMotion<D>& motion = obstacle_motion(params, k);
-    if (!motion.moves()) continue;
-    const RigidPose<D> pose = pose_at(motion, t);
+    if (!obstacle_moves(params, k)) continue;
+    const RigidPose<D>& pose = poses[k];
     const std::size_t b = set.obstacle_begin[k], e = set.obstacle_begin[k + 1];
     parallel_for(e - b, [&](std::size_t s) {
       const Vec<D, double> x = pose.place(set.rest_position[b + s]);
@@ -231,7 +233,7 @@ template std::vector<Vec<3, double>> rest_fluid_sites<3>(const Box<3>&, const st
   template std::vector<R> boundary_psi<D, R>(std::span<const Vec<D, R>>, const FluidParams&, R, \
                                              std::span<const Vec<D, R>>);                       \
   template BoundarySet<D, R> make_boundary<D, R>(const SimulationParams<D>&);                   \
-  template void place_boundary<D, R>(BoundarySet<D, R>&, const SimulationParams<D>&, double);
+  template void place_boundary<D, R>(BoundarySet<D, R>&, const SimulationParams<D>&, std::span<const RigidPose<D>>);
 SPH_INSTANTIATE(2, float)
 SPH_INSTANTIATE(2, double)
 SPH_INSTANTIATE(3, float)

@@ -54,10 +54,11 @@ struct BoundarySet {
   bool moving() const { return !velocity.empty(); }
 };
 
-/// Places the moving obstacles' samples of `set` (make_boundary's for `params`) where their
-/// motions put them at time t, with their velocities. Nothing if no obstacle moves.
+/// Places the moving obstacles' samples of `set` (make_boundary's for `params`) where `poses` (one
+/// per obstacle: a motion's at a time, or a floating body's) put them, with their velocities.
+/// Nothing if no obstacle moves.
 template <int D, std::floating_point R>
-void place_boundary(BoundarySet<D, R>& set, const SimulationParams<D>& params, double t);
+void place_boundary(BoundarySet<D, R>& set, const SimulationParams<D>& params, std::span<const RigidPose<D>> poses);
 
 /// The lattice sites of fluid at rest next to the solids (BoundaryVolume::RestFluid): the
 /// container's interior sites within the layers' depth of a face, and each obstacle's sites

@@ -94,6 +94,12 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
   full_.resize(n);
   solid_.resize(n);
   solid_rate_.assign(boundary.velocity.empty() ? 0 : n, R(0));
+  // Floating bodies: each body's share of sum_b psi_b grad W_ib, whose pressure the solves record.
+  const bool bodies = boundary.active() && !boundary.body.empty() && boundary.body_acceleration;
+  bodies_ = bodies ? boundary.bodies : 0;
+  body_acceleration_ = bodies ? boundary.body_acceleration : nullptr;
+  body_velocity_change_ = bodies ? boundary.body_velocity_change : nullptr;
+  body_solid_.assign(n * bodies_, Vec<D, R>{});
   // The step's pairs within h, once: each solve iteration then reads m_j grad W_ij instead of
   // evaluating the kernel again (about half the entries of a list are within h).
   begin_.resize(n + 1);
@@ -124,6 +130,8 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
         [&](std::uint32_t b, const Vec<D, R>& g) {
           solid += g * boundary.psi[b];
           if (!boundary.velocity.empty()) solid_rate_[i] += boundary.psi[b] * dot(boundary.velocity[b], g);
+          if (bodies_ > 0 && boundary.body[b] != 0)
+            body_solid_[i * bodies_ + boundary.body[b] - 1] += g * boundary.psi[b];
           ++count;
         });
     sum += solid;
@@ -326,6 +334,11 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
     } else {
       ps.velocity[i] += acc_s_[i] * dt;
     }
+    // Floating bodies: body k's samples' share of a(s), -s_i sum_{b of k} psi_b grad W_ib.
+    Vec<D, R>* out = kDensity ? body_acceleration_ : body_velocity_change_;
+    if (out)
+      for (std::size_t k = 0; k < bodies_; ++k)
+        out[i * bodies_ + k] -= body_solid_[i * bodies_ + k] * (kDensity ? s_[i] : s_[i] * dt);
   });
   return stats;
 }

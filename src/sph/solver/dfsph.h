@@ -118,6 +118,12 @@ class DfsphSolver {
   // Moving obstacles: sum_b psi_b v_b . grad W_ib, the samples' share of the density rate (empty
   // when every sample is at rest).
   std::vector<R> solid_rate_;
+  // Floating bodies (BoundaryView::body): each particle's sum_b psi_b grad W_ib per body, and
+  // where the solves record the bodies' pressure (compute_factors' view's arrays; null: none).
+  std::size_t bodies_ = 0;
+  std::vector<Vec<D, R>> body_solid_;
+  Vec<D, R>* body_acceleration_ = nullptr;
+  Vec<D, R>* body_velocity_change_ = nullptr;
   std::vector<R> b_, s_, r_, z_, p_, as_, ap_;
   std::vector<Vec<D, R>> acc_s_, acc_p_;
   std::vector<double> partial_;  // per-chunk sums

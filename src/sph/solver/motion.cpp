@@ -90,14 +90,7 @@ RigidPose<D> pose_at(const ObstacleMotion<D>& m, double t) {
 template <int D>
 double max_surface_speed(const ObstacleMotion<D>& m, const Vec<D, double>& lo, const Vec<D, double>& hi, double t) {
   if (!m.moves()) return 0;
-  const RigidPose<D> p = pose_at(m, t);
-  double most = 0;
-  for (int corner = 0; corner < (1 << D); ++corner) {
-    Vec<D, double> X;
-    for (int d = 0; d < D; ++d) X[d] = corner >> d & 1 ? hi[d] : lo[d];
-    most = std::max(most, std::sqrt(norm2(p.velocity_at(p.place(X)))));
-  }
-  return most;
+  return pose_surface_speed<D>(pose_at(m, t), lo, hi);
 }
 
 template RigidPose<2> pose_at<2>(const ObstacleMotion<2>&, double);

@@ -9,7 +9,9 @@
 /// with c the motion's centre, t the translation and R the rotation; the velocity of the solid at
 /// a placed point x is u + w x (x - c - t) (u = dt/dt, w the angular velocity).
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <vector>
 
 #include <sph/core/vec.h>
@@ -108,6 +110,38 @@ struct RigidPose {
     return v;
   }
 };
+
+/// A floating rigid body (Obstacles[].dynamic, rigid_body.h): an obstacle moved by the fluid's
+/// pressure and friction, gravity and contact with the container, instead of a prescribed motion.
+template <int D>
+struct BodyParams {
+  bool dynamic = false;
+  double density = 0;                 ///< kg/m^3 (2D: kg/m^2, as Fluid.density)
+  Vec<D, double> velocity{};          ///< at t = 0, m/s
+  Vec<3, double> angular_velocity{};  ///< at t = 0, rad/s (2D: z only)
+
+  friend bool operator==(const BodyParams&, const BodyParams&) = default;
+};
+
+/// Corner c (0 .. 2^D - 1) of the box [lo, hi]: bit d of c chooses hi along axis d.
+template <int D>
+Vec<D, double> box_corner(const Vec<D, double>& lo, const Vec<D, double>& hi, int c) {
+  Vec<D, double> x;
+  for (int d = 0; d < D; ++d) x[d] = c >> d & 1 ? hi[d] : lo[d];
+  return x;
+}
+
+/// The largest speed of the box [lo, hi] (at rest) placed by `pose`: the largest of its corners'
+/// (a rigid motion's speed is convex in the point).
+template <int D>
+double pose_surface_speed(const RigidPose<D>& pose, const Vec<D, double>& lo, const Vec<D, double>& hi) {
+  double most = 0;
+  for (int c = 0; c < (1 << D); ++c) {
+    const Vec<D, double> v = pose.velocity_at(pose.place(box_corner<D>(lo, hi, c)));
+    most = std::max(most, std::sqrt(norm2(v)));
+  }
+  return most;
+}
 
 /// The pose of an obstacle moved by `m` at time t (s): the identity for MotionType::None;
 /// keyframes hold their first key before it and their last after it.

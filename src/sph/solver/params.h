@@ -220,6 +220,10 @@ struct SimulationParams {
   /// Each obstacle's prescribed motion (Obstacles[].motion), in the obstacles' order; shorter
   /// than `obstacles` (empty: none moves) means the others are at rest. See obstacle_motion().
   std::vector<ObstacleMotion<D>> motions;
+  /// Each obstacle's rigid body (Obstacles[].dynamic; rigid_body.h), in the obstacles' order;
+  /// shorter than `obstacles` (empty: none floats) means the others are not dynamic. A dynamic
+  /// obstacle has no motion. See obstacle_body().
+  std::vector<BodyParams<D>> bodies;
   std::vector<EmitterParams<D>> emitters;
   NeighborMode neighbors = NeighborMode::Standard;
   int full_rebuild_period = 200;  ///< adaptive mode
@@ -250,10 +254,31 @@ const ObstacleMotion<D>& obstacle_motion(const SimulationParams<D>& p, std::size
   return k < p.motions.size() ? p.motions[k] : kAtRest;
 }
 
-/// Whether any obstacle of `p` moves.
+/// Obstacle k's rigid body (not dynamic when it has none).
+template <int D>
+const BodyParams<D>& obstacle_body(const SimulationParams<D>& p, std::size_t k) {
+  static const BodyParams<D> kFixed;
+  return k < p.bodies.size() ? p.bodies[k] : kFixed;
+}
+
+/// Whether obstacle k moves: by a prescribed motion, or as a floating body.
+template <int D>
+bool obstacle_moves(const SimulationParams<D>& p, std::size_t k) {
+  return obstacle_motion(p, k).moves() || obstacle_body(p, k).dynamic;
+}
+
+/// Whether any obstacle of `p` moves (a prescribed motion, or a floating body).
 template <int D>
 bool any_obstacle_moves(const SimulationParams<D>& p) {
-  return std::any_of(p.motions.begin(), p.motions.end(), [](const ObstacleMotion<D>& m) { return m.moves(); });
+  for (std::size_t k = 0; k < p.obstacles.size(); ++k)
+    if (obstacle_moves(p, k)) return true;
+  return false;
+}
+
+/// Whether any obstacle of `p` is a floating body.
+template <int D>
+bool any_dynamic_body(const SimulationParams<D>& p) {
+  return std::any_of(p.bodies.begin(), p.bodies.end(), [](const BodyParams<D>& b) { return b.dynamic; });
 }
 
 }  // namespace sph

@@ -139,9 +139,10 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
         std::make_unique<DfsphSolver<D, R>>(params_.dfsph, particles_, static_cast<R>(2.0 * params_.particle_radius));
   }
   if (any_obstacle_moves(params_)) {
-    SPH_CHECK(params_.motions.size() <= params_.obstacles.size(), "one motion per obstacle");
-    for (std::size_t k = 0; k < params_.obstacles.size(); ++k)
-      moving_.push_back(obstacle_motion(params_, k).moves() ? 1 : 0);
+    SPH_CHECK(params_.motions.size() <= params_.obstacles.size() && params_.bodies.size() <= params_.obstacles.size(),
+              "one motion and one body per obstacle");
+    for (std::size_t k = 0; k < params_.obstacles.size(); ++k) moving_.push_back(obstacle_moves(params_, k) ? 1 : 0);
+    init_bodies();
     place_obstacles();
   }
   neighbors_ = make_neighbor_strategy<D, R>(params_.neighbors, opt);
@@ -167,24 +168,115 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
 }
 
 template <int D, std::floating_point R>
+void Simulation<D, R>::init_bodies() {
+  obstacle_body_.assign(params_.obstacles.size(), 0);
+  for (std::size_t k = 0; k < params_.obstacles.size(); ++k) {
+    const BodyParams<D>& b = obstacle_body(params_, k);
+    if (!b.dynamic) continue;
+    SPH_CHECK(!obstacle_motion(params_, k).moves(), "a floating body has no prescribed motion");
+    SPH_CHECK(body_obstacle_.size() < 65535, "too many floating bodies");
+    body_obstacle_.push_back(k);
+    obstacle_body_[k] = static_cast<std::uint16_t>(body_obstacle_.size());
+    bodies_.push_back(initial_body_state(params_.obstacles[k], b));
+    body_mass_.push_back(box_mass_properties(params_.obstacles[k], b.density));
+  }
+  if (body_obstacle_.empty()) {
+    obstacle_body_.clear();
+    return;
+  }
+  body_force_.assign(bodies_.size(), BodyLoad<D>{});
+  contact_rate_ = body_contact_rate(cfl() ? std::max(params_.time_step, params_.cfl.max_dt) : params_.time_step);
+  if (boundary_.size() > 0) {
+    sample_body_.assign(boundary_.size(), 0);
+    for (std::size_t k = 0; k < params_.obstacles.size(); ++k)
+      std::fill(sample_body_.begin() + static_cast<std::ptrdiff_t>(boundary_.obstacle_begin[k]),
+                sample_body_.begin() + static_cast<std::ptrdiff_t>(boundary_.obstacle_begin[k + 1]), obstacle_body_[k]);
+  }
+}
+
+template <int D, std::floating_point R>
+RigidPose<D> Simulation<D, R>::pose_now(std::size_t k) const {
+  if (!obstacle_body_.empty() && obstacle_body_[k] != 0) {
+    const std::size_t s = obstacle_body_[k] - 1u;
+    return body_pose(bodies_[s], body_mass_[s].center);
+  }
+  return pose_at(obstacle_motion(params_, k), time());
+}
+
+template <int D, std::floating_point R>
+std::vector<RigidPose<D>> Simulation<D, R>::obstacle_poses() const {
+  std::vector<RigidPose<D>> poses(params_.obstacles.size());
+  for (std::size_t k = 0; k < moving_.size(); ++k)
+    if (moving_[k]) poses[k] = pose_now(k);
+  return poses;
+}
+
+template <int D, std::floating_point R>
+void Simulation<D, R>::set_body_state(std::size_t s, const RigidBodyState<D>& state) {
+  SPH_CHECK(s < bodies_.size(), "no such floating body");
+  bodies_[s] = state;
+  neighbors_->invalidate();
+}
+
+template <int D, std::floating_point R>
 void Simulation<D, R>::place_obstacles() {
   if (moving_.empty()) return;
-  const double t = time();
   for (std::size_t k = 0; k < moving_.size(); ++k)
-    if (moving_[k]) poses_[k] = pose_at(obstacle_motion(params_, k), t);
-  place_boundary(boundary_, params_, t);
+    if (moving_[k]) poses_[k] = pose_now(k);
+  place_boundary<D, R>(boundary_, params_, poses_);
+}
+
+template <int D, std::floating_point R>
+void Simulation<D, R>::advance_bodies(double dt) {
+  const std::size_t nb = bodies_.size();
+  if (nb == 0) return;
+  // Per chunk and body: the fluid's momentum change from the body (D values) and its moment
+  // about the body's centre of mass (3), summed in chunk order (the same for any thread count).
+  constexpr std::size_t kPer = D + 3;
+  const std::size_t n = particles_.size();
+  const std::size_t chunks = chunk_count(n);
+  body_partial_.assign(chunks * nb * kPer, 0.0);
+  const bool dv = !body_velocity_change_.empty();
+  parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
+    double* out = &body_partial_[c * nb * kPer];
+    for (std::size_t i = b; i < e; ++i)
+      for (std::size_t s = 0; s < nb; ++s) {
+        Vec<D, double> change = vec_cast<double>(body_acceleration_[i * nb + s]) * dt;
+        if (dv) change += vec_cast<double>(body_velocity_change_[i * nb + s]);
+        if (norm2(change) == 0) continue;
+        change *= static_cast<double>(particles_.mass[i]);
+        Vec<3, double> moment{};
+        add_moment<D>(moment, vec_cast<double>(particles_.position[i]), bodies_[s].position, change);
+        double* o = out + s * kPer;
+        for (int d = 0; d < D; ++d) o[d] += change[d];
+        for (int a = 0; a < 3; ++a) o[D + a] += moment[a];
+      }
+  });
+  for (std::size_t s = 0; s < nb; ++s) {
+    BodyLoad<D> load;  // the body's: minus the fluid's
+    for (std::size_t c = 0; c < chunks; ++c) {
+      const double* o = &body_partial_[(c * nb + s) * kPer];
+      for (int d = 0; d < D; ++d) load.impulse[d] -= o[d];
+      for (int a = 0; a < 3; ++a) load.angular_impulse[a] -= o[D + a];
+    }
+    body_force_[s].impulse = load.impulse * (1.0 / dt);
+    body_force_[s].angular_impulse = load.angular_impulse * (1.0 / dt);
+    const std::size_t k = body_obstacle_[s];
+    add_container_contact(params_.container, params_.obstacles[k], bodies_[s], body_mass_[s], contact_rate_, dt, load);
+    advance_body(bodies_[s], body_mass_[s], load, params_.gravity, dt);
+  }
 }
 
 template <int D, std::floating_point R>
 void Simulation<D, R>::flag_near_moving_obstacles(double dt) {
   const std::span<std::uint8_t> flags = neighbors_->pair_exit_flags();
   if (moving_.empty() || flags.empty()) return;
-  const double h = params_.kernel_radius, t = time();
+  const double h = params_.kernel_radius;
   for (std::size_t k = 0; k < moving_.size(); ++k) {
     if (!moving_[k]) continue;
     const Box<D>& box = params_.obstacles[k];
     const RigidPose<D>& pose = poses_[k];
-    const double reach = h + max_surface_speed(obstacle_motion(params_, k), box.lo, box.hi, t) * dt;
+    const double reach = h + pose_surface_speed<D>(pose, box.lo, box.hi) * dt;
     parallel_for(particles_.size(), [&](std::size_t i) {
       // The distance from the particle to the box, in the box's frame.
       const Vec<D, double> X = pose.to_rest(vec_cast<double>(particles_.position[i]));
@@ -276,8 +368,7 @@ double Simulation<D, R>::next_time_step() const {
   // A moving obstacle's surface counts as a particle at its speed (it is about to push the fluid).
   for (std::size_t k = 0; k < moving_.size(); ++k)
     if (moving_[k])
-      u = std::max(
-          u, max_surface_speed(obstacle_motion(params_, k), params_.obstacles[k].lo, params_.obstacles[k].hi, time()));
+      u = std::max(u, pose_surface_speed<D>(pose_now(k), params_.obstacles[k].lo, params_.obstacles[k].hi));
   // Advective CFL: a particle moves at most 0.4 factor diameters (SPlisHSPlasH's rule).
   double dt = u > 0 ? c.factor * 0.4 * (2.0 * params_.particle_radius) / u : kNoLimit;
   // The scene's other limits (time_step.h's warning levels, as "auto" takes them: cfl_limit_),
@@ -364,7 +455,16 @@ const StepInfo& Simulation<D, R>::step() {
   info.seconds.grid = info.neighbors.grid_seconds + reorder_seconds;
   info.seconds.lists = info.neighbors.lists_seconds;
   const NeighborLists& lists = neighbors_->lists();
-  const BoundaryView<D, R> solid = boundary_view(neighbors_->boundary_lists());
+  BoundaryView<D, R> solid = boundary_view(neighbors_->boundary_lists());
+  if (!bodies_.empty()) {  // (what each floating body gives each particle in this step)
+    const std::size_t entries = particles_.size() * bodies_.size();
+    body_acceleration_.assign(entries, Vec<D, R>{});
+    body_velocity_change_.assign(dfsph_ ? entries : 0, Vec<D, R>{});
+    solid.body = sample_body_;
+    solid.bodies = bodies_.size();
+    solid.body_acceleration = body_acceleration_.data();
+    solid.body_velocity_change = dfsph_ ? body_velocity_change_.data() : nullptr;
+  }
   if (auditor_) {
     info.audited = true;
     info.audit = auditor_->audit(particles_.position, lists, h);
@@ -394,7 +494,8 @@ const StepInfo& Simulation<D, R>::step() {
   // Eq. 7 predicts (the body's push is not in its linear prediction).
   if (params_.neighbors == NeighborMode::Adaptive && params_.flag_near_moving) flag_near_moving_obstacles(st.dt);
   const WallContact<D, R> walls(params_.container, params_.obstacles, static_cast<R>(params_.particle_radius),
-                                params_.walls, params_.boundary.handling == BoundaryHandling::Penalty, poses_, moving_);
+                                params_.walls, params_.boundary.handling == BoundaryHandling::Penalty, poses_, moving_,
+                                obstacle_body_);
   compute_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity), walls,
                         neighbors_->pair_exit_flags(), dt, solid, neighbors_->pair_exit_radius(), !dfsph_);
   info.seconds.forces = watch.lap();
@@ -402,6 +503,8 @@ const StepInfo& Simulation<D, R>::step() {
     info.density_solve = last_density_solve_ = dfsph_->density_solve(particles_, rho0, dt);
     info.seconds.solve += watch.lap();
   }
+  // The floating bodies take the fluid's reaction (at the particles' positions before they move).
+  advance_bodies(st.dt);
   ++steps_;  // counted even if the checks below throw (as before the passes were fused)
   if (cfl()) {
     time_ = st.lands ? st.end : time_ + st.dt;
@@ -424,7 +527,7 @@ HealthStats Simulation<D, R>::integrate_and_check(R dt) {
   const std::size_t n = particles_.size();
   // (the particles are measured after their motion: the obstacles where they are then)
   for (std::size_t k = 0; k < moving_.size(); ++k)
-    if (moving_[k]) health_poses_[k] = pose_at(obstacle_motion(params_, k), time());
+    if (moving_[k]) health_poses_[k] = pose_now(k);
   const HealthProbe<D, R> probe(
       params_, SmoothingKernels<D, R>(params_.fluid.kernel, static_cast<R>(params_.kernel_radius)).w_zero(),
       health_poses_, moving_);
@@ -561,6 +664,7 @@ void Simulation<D, R>::save_state(StateWriter& out) const {
   out.put(last_density_solve_.error);
   out.put(static_cast<std::uint8_t>(last_density_solve_.converged));
   out.put(emitters_);
+  out.put(bodies_);
   particles_.save(out);
   neighbors_->save_state(out);
   monitor_.save_state(out);
@@ -584,6 +688,13 @@ void Simulation<D, R>::load_state(StateReader& in) {
   for (std::size_t k = 0; k < emitters_.size(); ++k)
     in.expect(emitters_[k].emitted >= 0 && emitters_[k].emitted <= params_.emitters[k].max_particles,
               "an emitter's count out of range");
+  const std::size_t body_count = bodies_.size();
+  in.get(bodies_);
+  in.expect(bodies_.size() == body_count, "a different number of floating bodies");
+  for (const RigidBodyState<D>& b : bodies_)
+    in.expect(all_finite(b.position) && all_finite(b.velocity) && all_finite(b.angular_velocity) &&
+                  std::isfinite(b.orientation[0] + b.orientation[1] + b.orientation[2] + b.orientation[3]),
+              "a floating body's state is not finite");
   particles_.load(in);
   neighbors_->load_state(in, particles_.size());
   monitor_.load_state(in);

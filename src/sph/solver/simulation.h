@@ -12,6 +12,7 @@
 #include <sph/solver/dfsph.h>
 #include <sph/solver/health.h>
 #include <sph/solver/params.h>
+#include <sph/solver/rigid_body.h>
 #include <sph/solver/wcsph.h>
 
 namespace sph {
@@ -122,6 +123,19 @@ class Simulation {
   const StepInfo& last_step() const { return info_; }
   const std::vector<EmitterState>& emitter_states() const { return emitters_; }
 
+  /// Every obstacle's pose now (motion.h): a prescribed motion's at time(), a floating body's from
+  /// its state, the identity for one at rest.
+  std::vector<RigidPose<D>> obstacle_poses() const;
+  /// The floating bodies (Obstacles[].dynamic), in the obstacles' order: body s is obstacle
+  /// body_obstacles()[s]; its state now, its mass properties, and what the fluid gave it in the
+  /// last step as a mean force, N, and moment about its centre of mass, N m (2D: per metre).
+  const std::vector<std::size_t>& body_obstacles() const { return body_obstacle_; }
+  const std::vector<RigidBodyState<D>>& bodies() const { return bodies_; }
+  const std::vector<MassProperties<D>>& body_masses() const { return body_mass_; }
+  const std::vector<BodyLoad<D>>& body_fluid_forces() const { return body_force_; }
+  /// Replaces body s's state between steps (the Python module): the next step places it there.
+  void set_body_state(std::size_t s, const RigidBodyState<D>& state);
+
   /// Total kinetic energy, J (J/m in 2D). Deterministic for any thread count. (This and the
   /// other reductions use a shared scratch buffer: do not call them concurrently.)
   double kinetic_energy() const;
@@ -159,6 +173,14 @@ class Simulation {
   void reserve_for_emitters();
   /// Places the moving obstacles (their poses, and their boundary samples) at the current time.
   void place_obstacles();
+  /// Obstacle k's pose now (obstacle_poses()).
+  RigidPose<D> pose_now(std::size_t k) const;
+  /// Sets up the floating bodies (constructor).
+  void init_bodies();
+  /// The fluid's reaction on each body over a step of dt (from body_acceleration_ and
+  /// body_velocity_change_, at the particles' positions before they move), plus the container's
+  /// contact; then each body takes its step.
+  void advance_bodies(double dt);
   /// Adaptive mode (SimulationParams::flag_near_moving): flags for a list rebuild every particle
   /// within h plus its travel in a step of dt of a moving obstacle.
   void flag_near_moving_obstacles(double dt);
@@ -177,6 +199,17 @@ class Simulation {
   std::vector<std::uint8_t> moving_;        // per obstacle: whether it moves (empty: none does)
   std::vector<RigidPose<D>> poses_;         // per obstacle: its pose at the current step's start
   std::vector<RigidPose<D>> health_poses_;  // per obstacle: its pose at the step's end (the health checks)
+  // Floating bodies: body s is obstacle body_obstacle_[s]; obstacle_body_[k] is s + 1 (0: none);
+  // sample_body_[b] the same for boundary sample b (empty without boundary particles).
+  std::vector<std::size_t> body_obstacle_;
+  std::vector<std::uint16_t> obstacle_body_, sample_body_;
+  std::vector<RigidBodyState<D>> bodies_;
+  std::vector<MassProperties<D>> body_mass_;
+  std::vector<BodyLoad<D>> body_force_;  // the last step's fluid force and moment on each body
+  double contact_rate_ = 0;              // body_contact_rate() of the run's longest step, 1/s
+  // What each body gave each particle in the step (BoundaryView::body_acceleration, ...).
+  std::vector<Vec<D, R>> body_acceleration_, body_velocity_change_;
+  std::vector<double> body_partial_;  // per-chunk sums of the bodies' loads
   std::unique_ptr<NeighborStrategy<D, R>> neighbors_;
   std::unique_ptr<ListAuditor<D, R>> auditor_;
   MortonOrder<D, R> morton_;

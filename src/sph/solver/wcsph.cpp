@@ -242,6 +242,9 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
   const R* bpos = solid ? flat(boundary.position) : nullptr;
   const R* psi = boundary.psi.data();
   const R* bvel = solid && !boundary.velocity.empty() ? flat(boundary.velocity) : nullptr;
+  // (floating bodies: what each body's samples give a particle is recorded, per lane)
+  const std::uint16_t* sample_body =
+      solid && boundary.body_acceleration && !boundary.body.empty() ? boundary.body.data() : nullptr;
   const P dtv = P::set1(dt);
   const PackKernel<K, D, R> kernel_value(h);
   const PackKernel<K, D, R>* kernel = &kernel_value;
@@ -370,6 +373,15 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
           pterm = w_v * (pi_sym_b + (boundary.clamp ? select(pb > zero, pb, zero) : pb));
         }
         const P fb = minus_one * psib * (pterm + pi_ib) * f;
+        if (sample_body) {
+          R fl[W], rl[D][W];
+          fb.store(fl);
+          for (int d = 0; d < D; ++d) rib[d].store(rl[d]);
+          Vec<D, R>* row = boundary.body_row(i);
+          for (std::size_t l = 0; l < static_cast<std::size_t>(W) && k0 + l < bnb.size(); ++l)
+            if (const std::uint16_t o = sample_body[bidx[k0 + l]]; o != 0)
+              for (int d = 0; d < D; ++d) row[o - 1][d] += rl[d][l] * fl[l];
+        }
         P q2 = zero;
         for (int d = 0; d < D; ++d) {
           acc[d] = acc[d] + rib[d] * fb;
@@ -386,7 +398,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
       if (flag_i) set_flag(i);
     Vec<D, R> a = gravity;
     for (int d = 0; d < D; ++d) a[d] += simd::sum_lanes(acc[d]);
-    a += walls(ps.position[i], ps.velocity[i]);
+    a += walls(ps.position[i], ps.velocity[i], boundary.body_row(i));
     ps.acceleration[i] = a;
   });
 }
@@ -481,6 +493,12 @@ void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, 
           for (int c = 0; c < D; ++c) gc += li[r * D + c] * g[c];
           acc[r] -= boundary.psi[b] * pib * gc;
         }
+        if (!boundary.body.empty() && boundary.body_acceleration && boundary.body[b] != 0)
+          for (int r = 0; r < D; ++r) {
+            R gc = 0;
+            for (int c = 0; c < D; ++c) gc += li[r * D + c] * g[c];
+            boundary.body_row(i)[boundary.body[b] - 1][r] -= boundary.psi[b] * pib * gc;
+          }
       }
     }
     ps.acceleration[i] += acc;

@@ -30,6 +30,18 @@ struct BoundaryView {
   /// Each sample's velocity (moving obstacles; empty: all at rest): the friction and the Eq. 7
   /// test see the fluid's velocity relative to it.
   std::span<const Vec<D, R>> velocity{};
+  /// Floating bodies (rigid_body.h): each sample's body (0: none, s + 1: body s; empty: no sample
+  /// floats) and the number of bodies. The passes add what each body gives each particle to
+  /// body_acceleration (an acceleration, m/s^2: `bodies` entries per particle, particle i's from
+  /// i * bodies; its boundary samples' pressure and friction terms, and with penalty walls the
+  /// body's push) and, DFSPH's divergence solve, to body_velocity_change (a velocity change, m/s,
+  /// laid out alike). Null: nothing is recorded.
+  std::span<const std::uint16_t> body{};
+  std::size_t bodies = 0;
+  Vec<D, R>* body_acceleration = nullptr;
+  Vec<D, R>* body_velocity_change = nullptr;
+  /// Particle i's entries of body_acceleration (null when nothing is recorded).
+  Vec<D, R>* body_row(std::size_t i) const { return body_acceleration ? body_acceleration + i * bodies : nullptr; }
   bool active() const { return lists != nullptr && lists->particle_count() > 0 && !position.empty(); }
 };
 
@@ -52,20 +64,25 @@ template <int D, std::floating_point R>
 class WallContact {
  public:
   /// `enabled` false (boundary particles): no wall acceleration at all. `poses`: each obstacle's
-  /// pose now (empty: all at rest); `moving[k]` whether obstacle k moves (empty: none).
+  /// pose now (empty: all at rest); `moving[k]` whether obstacle k moves (empty: none);
+  /// `body[k]` obstacle k's floating body (0: none, s + 1: body s; empty: none floats).
   WallContact(const Box<D>& container, const std::vector<Box<D>>& obstacles, R particle_radius, const WallParams& walls,
-              bool enabled = true, std::span<const RigidPose<D>> poses = {}, std::span<const std::uint8_t> moving = {})
+              bool enabled = true, std::span<const RigidPose<D>> poses = {}, std::span<const std::uint8_t> moving = {},
+              std::span<const std::uint16_t> body = {})
       : enabled_(enabled),
         lo_(vec_cast<R>(container.lo)),
         hi_(vec_cast<R>(container.hi)),
         obstacles_(&obstacles),
         poses_(poses),
         moving_(moving),
+        body_(body),
         radius_(particle_radius),
         ks_(static_cast<R>(walls.stiffness)),
         kd_(static_cast<R>(walls.damping)) {}
 
-  Vec<D, R> operator()(const Vec<D, R>& x, const Vec<D, R>& v) const {
+  /// The wall acceleration of a particle at x with velocity v; with `body_row` (the particle's
+  /// entries of BoundaryView::body_acceleration) each floating body's push is also added there.
+  Vec<D, R> operator()(const Vec<D, R>& x, const Vec<D, R>& v, Vec<D, R>* body_row = nullptr) const {
     Vec<D, R> a{};
     if (!enabled_) return a;
     // Container: particles inside the box, pushed back from each of its 2D faces.
@@ -86,7 +103,11 @@ class WallContact {
         const Vec<D, double> xb = pose.to_rest(xw);
         const Vec<D, double> vb = pose.unrotate(vec_cast<double>(v) - pose.velocity_at(xw));
         Vec<D, R> push{};
-        if (push_out(b, vec_cast<R>(xb), vec_cast<R>(vb), push)) a += vec_cast<R>(pose.rotate(vec_cast<double>(push)));
+        if (push_out(b, vec_cast<R>(xb), vec_cast<R>(vb), push)) {
+          const Vec<D, R> turned = vec_cast<R>(pose.rotate(vec_cast<double>(push)));
+          a += turned;
+          if (body_row && k < body_.size() && body_[k] != 0) body_row[body_[k] - 1] += turned;
+        }
         continue;
       }
       push_out(b, x, v, a);
@@ -122,6 +143,7 @@ class WallContact {
   const std::vector<Box<D>>* obstacles_;
   std::span<const RigidPose<D>> poses_;
   std::span<const std::uint8_t> moving_;
+  std::span<const std::uint16_t> body_;
   R radius_, ks_, kd_;
 };
 

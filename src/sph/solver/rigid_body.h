@@ -1,0 +1,117 @@
+#pragma once
+/// \file Floating rigid bodies (Obstacles[].dynamic; docs/physics.md "Floating bodies"): a box
+/// obstacle whose motion the fluid, gravity and the container decide (two-way coupling).
+///
+/// A body is its box at rest (the scene's `start` .. `end`) and a state: the centre of mass (the
+/// box's centre; the box is uniform), a unit quaternion for its orientation, and its linear and
+/// angular velocities. Its pose (motion.h) places the box at rest where the state puts it:
+///   x = c + (position - c) + R(q) (X - c),  c the centre at rest,
+/// so every mechanism of the moving obstacles (wall contact in the body's frame, boundary samples
+/// placed with their velocities, the health checks) serves the bodies unchanged.
+///
+/// Each step the fluid's reaction is gathered as impulses (BodyLoad): what the body's boundary
+/// samples or its penalty walls gave each fluid particle, times its mass and the step, with the
+/// opposite sign (so fluid and body exchange momentum exactly), and its moment about the centre of
+/// mass taken at the particle (the pair forces are central, along x_i - x_b, so the moment is the
+/// same as at the sample). Gravity and the container's contact with the box's corners are added,
+/// and advance_body() takes a symplectic Euler step, as the fluid's: velocities first, then the
+/// position and the orientation with the new velocities.
+
+#include <array>
+#include <span>
+#include <vector>
+
+#include <sph/solver/params.h>
+
+namespace sph {
+
+/// A body's state (part of a checkpoint).
+template <int D>
+struct RigidBodyState {
+  Vec<D, double> position{};                      ///< centre of mass, m
+  std::array<double, 4> orientation{1, 0, 0, 0};  ///< unit quaternion (w, x, y, z); 2D: about z only
+  Vec<D, double> velocity{};                      ///< of the centre of mass, m/s
+  Vec<3, double> angular_velocity{};              ///< rad/s, world frame (2D: z only)
+
+  friend bool operator==(const RigidBodyState&, const RigidBodyState&) = default;
+};
+
+/// A uniform box's mass, kg (2D: kg/m), and its principal moments of inertia about its centre
+/// along the box's own axes, kg m^2 (2D: only z counts).
+template <int D>
+struct MassProperties {
+  double mass = 0;
+  Vec<3, double> inertia{};
+  Vec<D, double> center{};  ///< the centre of mass at rest (the box's centre), m
+};
+
+template <int D>
+MassProperties<D> box_mass_properties(const Box<D>& box, double density);
+
+/// The state at t = 0: the box where the scene puts it, at its initial velocities.
+template <int D>
+RigidBodyState<D> initial_body_state(const Box<D>& box, const BodyParams<D>& params);
+
+/// The pose (motion.h) the state gives the box whose centre at rest is `center`.
+template <int D>
+RigidPose<D> body_pose(const RigidBodyState<D>& s, const Vec<D, double>& center);
+
+/// What acts on a body over one step: an impulse, N s (2D: N s / m), and an angular impulse about
+/// its centre of mass, N m s (2D: z only).
+template <int D>
+struct BodyLoad {
+  Vec<D, double> impulse{};
+  Vec<3, double> angular_impulse{};
+};
+
+/// The container's contact with a body: each corner of the box past a wall is pushed back by a
+/// damped spring, k pen - c v_n along the wall's normal (never pulling), with k = m w^2 and
+/// c = 2 m w (critically damped for one corner): `omega` (w) is body_contact_rate(). Adds the
+/// impulses of a step of dt to `load`.
+template <int D>
+void add_container_contact(const Box<D>& container, const Box<D>& box, const RigidBodyState<D>& s,
+                           const MassProperties<D>& mp, double omega, double dt, BodyLoad<D>& load);
+
+/// The contact's angular rate w, 1/s, for steps of at most `max_dt`: a contact oscillation takes 20
+/// of the longest steps (w dt <= pi / 10, stable for symplectic Euler with room to spare), so a
+/// body resting on the floor sinks g / w^2 into it (about a millimetre for 5 ms steps).
+double body_contact_rate(double max_dt);
+
+/// One symplectic Euler step of dt: v += impulse / m + g dt; w += I^-1 (angular impulse - dt w x I
+/// w) (I in the world's frame); then x += dt v and q += dt / 2 (0, w) q, normalized.
+template <int D>
+void advance_body(RigidBodyState<D>& s, const MassProperties<D>& mp, const BodyLoad<D>& load,
+                  const Vec<D, double>& gravity, double dt);
+
+/// The rotation matrix of a unit quaternion (row-major 3 x 3).
+std::array<double, 9> quaternion_matrix(const std::array<double, 4>& q);
+
+/// Adds m (x - c) x f to `moment` (2D: its z component), the moment about c of f at x.
+template <int D>
+void add_moment(Vec<3, double>& moment, const Vec<D, double>& x, const Vec<D, double>& c, const Vec<D, double>& f) {
+  const Vec<D, double> r = x - c;
+  if constexpr (D == 2) {
+    moment[2] += r[0] * f[1] - r[1] * f[0];
+  } else {
+    moment[0] += r[1] * f[2] - r[2] * f[1];
+    moment[1] += r[2] * f[0] - r[0] * f[2];
+    moment[2] += r[0] * f[1] - r[1] * f[0];
+  }
+}
+
+extern template MassProperties<2> box_mass_properties<2>(const Box<2>&, double);
+extern template MassProperties<3> box_mass_properties<3>(const Box<3>&, double);
+extern template RigidBodyState<2> initial_body_state<2>(const Box<2>&, const BodyParams<2>&);
+extern template RigidBodyState<3> initial_body_state<3>(const Box<3>&, const BodyParams<3>&);
+extern template RigidPose<2> body_pose<2>(const RigidBodyState<2>&, const Vec<2, double>&);
+extern template RigidPose<3> body_pose<3>(const RigidBodyState<3>&, const Vec<3, double>&);
+extern template void add_container_contact<2>(const Box<2>&, const Box<2>&, const RigidBodyState<2>&,
+                                              const MassProperties<2>&, double, double, BodyLoad<2>&);
+extern template void add_container_contact<3>(const Box<3>&, const Box<3>&, const RigidBodyState<3>&,
+                                              const MassProperties<3>&, double, double, BodyLoad<3>&);
+extern template void advance_body<2>(RigidBodyState<2>&, const MassProperties<2>&, const BodyLoad<2>&,
+                                     const Vec<2, double>&, double);
+extern template void advance_body<3>(RigidBodyState<3>&, const MassProperties<3>&, const BodyLoad<3>&,
+                                     const Vec<3, double>&, double);
+
+}  // namespace sph

@@ -1,0 +1,242 @@
+// Floating rigid bodies (Obstacles[].dynamic): a box of half the water's density floats at
+// Archimedes' draft, one of the water's density stays where it is, fluid and body exchange
+// momentum exactly (with boundary particles and with penalty walls), a body dropped on the floor
+// rests on it, and runs are the same for any thread count and resume bit for bit.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <sph/core/parallel.h>
+#include <sph/run/driver.h>
+#include <sph/run/resume.h>
+#include <sph/scene/scene_reader.h>
+
+#include "support/temp_dir.h"
+
+namespace sph {
+namespace {
+
+using test::entries;
+using test::slurp;
+using test::TempDir;
+
+/// A 2D tank 1.2 m wide of water at rest (spacing 2 cm, DFSPH, boundary particles) with a box
+/// 0.4 m x 0.2 m of `density` whose bottom is at `bottom`, the water filled around it to `level`.
+SceneDesc tank_with_box(double density, double bottom, double level, double stop,
+                        const std::string& extra_configuration = "") {
+  const double top = bottom + 0.2;
+  std::string blocks = fmt::format(
+      R"({{ "start": [0, 0], "end": [0.4, {0}] }}, {{ "start": [0.8, 0], "end": [1.2, {0}] }},
+         {{ "start": [0.4, 0], "end": [0.8, {1}] }})",
+      level, bottom);
+  if (level > top) blocks += fmt::format(R"(, {{ "start": [0.4, {}], "end": [0.8, {}] }})", top, level);
+  const std::string text = fmt::format(R"({{
+    "version": 1, "name": "floating", "dimension": 2,
+    "Configuration": {{ "precision": "double", "timeStepSize": 0.004, "stopAt": {}, "particleRadius": 0.01,
+      "kernelRadius": 0.04, "gravitation": [0, -9.81], "boundaryHandling": "particles", "kernel": "cubic",
+      "simulationMethod": "dfsph", "cflMaxTimeStepSize": 0.01, "outputFps": 10{} }},
+    "Fluid": {{ "density0": 1000, "viscosity": 1.0 }},
+    "Container": {{ "start": [0, 0], "end": [1.2, 0.8] }},
+    "FluidBlocks": [ {} ],
+    "Obstacles": [ {{ "start": [0.4, {}], "end": [0.8, {}], "dynamic": true, "density": {} }} ]
+  }})",
+                                       stop, extra_configuration, blocks, bottom, top, density);
+  return parse_scene(text, "floating.json");
+}
+
+/// Whether the run of `desc` has reached its end (a time, or fixed steps' count).
+bool finished(const SceneDesc& desc, const Simulation<2, double>& sim) {
+  return desc.end_time > 0 ? sim.time() >= desc.end_time * (1 - 1e-12) : sim.steps_done() >= desc.steps;
+}
+
+/// The deepest any particle's centre is inside any obstacle where it is now (m; negative: all
+/// outside).
+double deepest_inside(const Simulation<2, double>& sim) {
+  const SimulationParams<2>& p = sim.params();
+  const std::vector<RigidPose<2>> poses = sim.obstacle_poses();
+  double deepest = -1e300;
+  for (std::size_t k = 0; k < p.obstacles.size(); ++k)
+    for (const auto& x : sim.particles().position) {
+      const Vec<2, double> X = poses[k].to_rest(x);
+      double depth = 1e300;
+      for (int d = 0; d < 2; ++d) depth = std::min({depth, X[d] - p.obstacles[k].lo[d], p.obstacles[k].hi[d] - X[d]});
+      deepest = std::max(deepest, depth);
+    }
+  return deepest;
+}
+
+/// Runs `desc` to its end: the body's centre height and the free surface's away from it, averaged
+/// over the second half of the run, its largest tilt then (rad), and the deepest particle inside
+/// it over the run (checked every 10 steps).
+struct Settled {
+  double mean_y = 0, deepest = -1e300, tilt = 0, level = 0;
+  std::size_t particles = 0;
+};
+Settled settle(const SceneDesc& desc) {
+  RunDriver<2, double> run(desc, RunSettings{});
+  const Simulation<2, double>& sim = run.simulation();
+  Settled out;
+  double sum = 0;
+  int count = 0;
+  while (!finished(desc, sim)) {
+    run.step();
+    if (sim.steps_done() % 10 == 0) out.deepest = std::max(out.deepest, deepest_inside(sim));
+    if (sim.time() > 0.5 * desc.end_time) {  // (these scenes end at a time)
+      sum += sim.bodies().at(0).position[1];
+      ++count;
+      out.tilt = std::max(out.tilt, std::abs(2 * std::asin(sim.bodies()[0].orientation[3])));
+      // The free surface away from the body: each column's top particle plus a radius (columns of
+      // a spacing, 6 cm to 30 cm from either wall).
+      std::vector<double> top(60, -1);
+      for (const auto& x : sim.particles().position) {
+        const int c = static_cast<int>(x[0] / 0.02);
+        if (c >= 0 && c < 60) top[static_cast<std::size_t>(c)] = std::max(top[static_cast<std::size_t>(c)], x[1]);
+      }
+      double level = 0;
+      int cols = 0;
+      for (int c = 3; c < 57; ++c)
+        if (c < 15 || c > 44) level += top[static_cast<std::size_t>(c)] + 0.01, ++cols;
+      out.level += level / cols;
+    }
+  }
+  EXPECT_TRUE(sim.health().warnings().empty());
+  out.mean_y = sum / count;
+  out.level /= count;
+  out.particles = sim.particles().size();
+  return out;
+}
+
+TEST(FloatingBody, HalfTheWatersDensityFloatsAtArchimedesDraft) {
+  // Density 500, 0.2 m tall: its draft is 0.1 m. Started 2 cm from its balance (bottom at 0.32 m
+  // in water to 0.42 m, which its draft would leave level).
+  const Settled s = settle(tank_with_box(500, 0.34, 0.42, 3.0));
+  // The draft: from the free surface away from the body (each column's top particle plus a
+  // radius, averaged like the body's height) to the body's bottom.
+  const double bottom = s.mean_y - 0.1, draft = s.level - bottom;
+  std::printf("draft %.5f m (Archimedes: 0.1 m), level %.5f m, tilt %.4f rad, deepest %.5f m\n", draft, s.level, s.tilt,
+              s.deepest);
+  EXPECT_NEAR(draft, 0.1, 0.05 * 0.1) << "bottom " << bottom << " m";
+  EXPECT_LT(s.tilt, 0.05);  // (a box twice as wide as tall floats upright)
+  EXPECT_LE(s.deepest, 0.5 * 0.01);
+}
+
+TEST(FloatingBody, TheWatersDensityNeitherRisesNorSinks) {
+  // Submerged, 0.1 m below the surface and 0.1 m above the floor.
+  const Settled s = settle(tank_with_box(1000, 0.1, 0.5, 1.5));
+  EXPECT_NEAR(s.mean_y, 0.2, 0.02);  // within a particle spacing of where it started
+  EXPECT_LE(s.deepest, 0.5 * 0.01);
+}
+
+/// Without gravity, a block of fluid thrown at a free box: `method` "dfsph" (boundary particles)
+/// or "wcsph" (penalty walls).
+SceneDesc collision(const std::string& method) {
+  const bool dfsph = method == "dfsph";
+  const std::string text = fmt::format(R"({{
+    "version": 1, "name": "collision", "dimension": 2,
+    "Configuration": {{ "precision": "double", "timeStepSize": {}, "stopAt": 0.35, "particleRadius": 0.01,
+      "kernelRadius": 0.04, "gravitation": [0, 0], "outputFps": 0{} }},
+    "Fluid": {{ "density0": 1000, "stiffness": 2000, "viscosity": 1.0 }},
+    "Container": {{ "start": [0, 0], "end": [2, 2] }},
+    "FluidBlocks": [ {{ "start": [0.4, 0.8], "end": [0.7, 1.1], "velocity": [2, 0.3] }} ],
+    "Obstacles": [ {{ "start": [1.0, 0.9], "end": [1.1, 1.2], "dynamic": true, "density": 700,
+                     "angularVelocity": 0.5 }} ]
+  }})",
+                                       dfsph ? 0.002 : 0.0002,
+                                       dfsph ? R"(, "boundaryHandling": "particles", "kernel": "cubic",
+      "simulationMethod": "dfsph")"
+                                             : R"(, "cflMethod": "none")");
+  return parse_scene(text, "collision.json");
+}
+
+TEST(FloatingBody, FluidAndBodyExchangeMomentumExactly) {
+  for (const std::string method : {"dfsph", "wcsph"}) {
+    SCOPED_TRACE(method);
+    const SceneDesc desc = collision(method);
+    RunDriver<2, double> run(desc, RunSettings{});
+    const Simulation<2, double>& sim = run.simulation();
+    const auto total = [&] {
+      const double m = sim.body_masses()[0].mass;
+      return sim.momentum() + sim.bodies()[0].velocity * m;
+    };
+    const Vec<2, double> p0 = total();
+    while (!finished(desc, sim)) run.step();
+    const Vec<2, double> p1 = total();
+    // The fluid hit the box: it moves along +x, and took most of the fluid's momentum away.
+    const double body_px = sim.bodies()[0].velocity[0] * sim.body_masses()[0].mass;
+    EXPECT_GT(body_px, 0.05 * p0[0]);
+    for (int d = 0; d < 2; ++d) EXPECT_NEAR(p1[d], p0[d], 1e-9 * std::abs(p0[0])) << "axis " << d;
+    // Nowhere near a wall: only the fluid touched the box.
+    for (const auto& x : sim.particles().position) EXPECT_GT(std::min({x[0], x[1], 2 - x[0], 2 - x[1]}), 0.1);
+  }
+}
+
+TEST(FloatingBody, ABodyDroppedOnTheFloorRestsOnIt) {
+  // The fluid is far off, in a corner; the box falls 0.1 m onto the container's floor.
+  const SceneDesc desc = parse_scene(R"({
+    "version": 1, "name": "drop", "dimension": 2,
+    "Configuration": { "precision": "double", "timeStepSize": 0.004, "stopAt": 1.0, "particleRadius": 0.01,
+      "kernelRadius": 0.04, "gravitation": [0, -9.81], "boundaryHandling": "particles", "kernel": "cubic",
+      "simulationMethod": "dfsph", "outputFps": 0 },
+    "Container": { "start": [0, 0], "end": [1.2, 0.8] },
+    "FluidBlocks": [ { "start": [0, 0], "end": [0.1, 0.1] } ],
+    "Obstacles": [ { "start": [0.6, 0.1], "end": [0.9, 0.2], "dynamic": true, "density": 500 } ]
+  })",
+                                     "drop.json");
+  RunDriver<2, double> run(desc, RunSettings{});
+  const Simulation<2, double>& sim = run.simulation();
+  double lowest = 1;
+  while (!finished(desc, sim)) {
+    run.step();
+    lowest = std::min(lowest, sim.bodies()[0].position[1] - 0.05);
+  }
+  const RigidBodyState<2>& b = sim.bodies()[0];
+  // At rest on the floor: its bottom within a quarter spacing of it, and never far below it.
+  EXPECT_NEAR(b.position[1] - 0.05, 0.0, 0.005);
+  EXPECT_GT(lowest, -0.01);
+  EXPECT_LT(std::sqrt(norm2(b.velocity)), 0.01);
+  EXPECT_NEAR(b.position[0], 0.75, 1e-6);  // (it fell straight)
+}
+
+struct ThreadCount {
+  int saved = num_threads();
+  ~ThreadCount() { set_num_threads(saved); }
+};
+
+TEST(FloatingBody, TheThreadCountChangesNothingAndAStoppedRunResumesBitForBit) {
+  ThreadCount restore;
+  TempDir tmp;
+  const SceneDesc desc = tank_with_box(500, 0.36, 0.42, 0.5);
+  for (int threads : {1, 2}) {
+    set_num_threads(threads);
+    RunDriver<2, double> full(desc, RunSettings{tmp / fmt::format("full{}", threads)});
+    ASSERT_EQ(full.run().status, RunStatus::Completed);
+  }
+  EXPECT_TRUE(slurp(tmp / "full1" / "bodies.csv") == slurp(tmp / "full2" / "bodies.csv"));
+  RunCallbacks stop;
+  stop.stop_requested = [](std::int64_t done) { return done == 37 ? std::string("a test") : std::string(); };
+  {
+    RunDriver<2, double> part(desc, RunSettings{tmp / "part"});
+    ASSERT_EQ(part.run(stop).status, RunStatus::Interrupted);
+  }
+  RunToResume r = open_run_to_resume(tmp / "part");
+  RunDriver<2, double> resumed(r.desc, *r.checkpoint, RunSettings{tmp / "part", r.checkpoint_every});
+  ASSERT_EQ(resumed.run().status, RunStatus::Completed);
+  const std::vector<std::string> names = entries(tmp / "full1" / "frames");
+  ASSERT_EQ(names, entries(tmp / "part" / "frames"));
+  for (const auto& n : names)
+    EXPECT_TRUE(slurp(tmp / "full1" / "frames" / n) == slurp(tmp / "part" / "frames" / n)) << n << " differs";
+  // bodies.csv: a row per frame, the same whether the run stopped or not.
+  const std::string csv = slurp(tmp / "full1" / "bodies.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 6);  // header and frames at 0, 0.1, ..., 0.5 s
+  EXPECT_TRUE(csv == slurp(tmp / "part" / "bodies.csv"));
+}
+
+}  // namespace
+}  // namespace sph

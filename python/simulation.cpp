@@ -448,6 +448,41 @@ after the current step with KeyboardInterrupt; the simulation stays usable.)doc"
                              "The last step's stats.csv row as a dict {column: value} (sph.STATS_COLUMNS; the audit "
                              "columns None unless audited, t_output 0); empty before the first step.")
       .def_property_readonly(
+          "bodies",
+          [](const PySimulation& s) {
+            return s.visit([](const auto& d) {
+              const auto& sim = d.simulation();
+              constexpr int kDim = DriverTraits<std::decay_t<decltype(d)>>::kDim;
+              const auto list = [](const auto& v, int n) {
+                py::list l;
+                for (int a = 0; a < n; ++a) l.append(v[a]);
+                return l;
+              };
+              py::list out;
+              for (std::size_t b = 0; b < sim.bodies().size(); ++b) {
+                const auto& st = sim.bodies()[b];
+                const auto& f = sim.body_fluid_forces()[b];
+                py::dict e;
+                e["obstacle"] = sim.body_obstacles()[b];
+                e["mass"] = sim.body_masses()[b].mass;
+                e["position"] = list(st.position, kDim);
+                e["orientation"] = list(st.orientation, 4);
+                e["velocity"] = list(st.velocity, kDim);
+                e["angular_velocity"] = kDim == 2 ? py::object(py::float_(st.angular_velocity[2]))
+                                                  : py::object(list(st.angular_velocity, 3));
+                e["force"] = list(f.impulse, kDim);
+                e["moment"] =
+                    kDim == 2 ? py::object(py::float_(f.angular_impulse[2])) : py::object(list(f.angular_impulse, 3));
+                out.append(e);
+              }
+              return out;
+            });
+          },
+          "The floating bodies (Obstacles[].dynamic) now, one dict each: obstacle (its index in Obstacles), mass "
+          "(kg; 2D: kg/m), position (the centre of mass, m), orientation (a unit quaternion w, x, y, z), velocity "
+          "(m/s), angular_velocity (rad/s: 2D a number, 3D a list), force and moment (the fluid's, N and N m, the "
+          "mean over the last step); as bodies.csv's columns.")
+      .def_property_readonly(
           "warnings",
           [](const PySimulation& s) {
             return s.visit([](const auto& d) { return d.simulation().health().warnings(); });

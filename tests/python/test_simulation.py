@@ -181,3 +181,34 @@ def test_a_simulation_stepping_in_one_thread_refuses_the_others(small_2d):
     plain = sph.Simulation(small_2d, threads=1)
     plain.step(401 + extra)
     assert plain.positions.tobytes() == sim.positions.tobytes()
+
+
+def test_bodies_are_the_bodies_csv_rows(tmp_path):
+    """A floating box through the API: sim.bodies holds what `sph run` writes in bodies.csv."""
+    scene = sph.Scene.from_dict({
+        "version": 1, "name": "float", "dimension": 2,
+        "Configuration": {"precision": "double", "timeStepSize": 0.004, "numberOfSteps": 20,
+                          "particleRadius": 0.01, "kernelRadius": 0.04, "gravitation": [0, -9.81],
+                          "boundaryHandling": "particles", "kernel": "cubic", "simulationMethod": "dfsph"},
+        "Container": {"start": [0, 0], "end": [1.2, 0.8]},
+        "FluidBlocks": [{"start": [0, 0], "end": [1.2, 0.3]}],
+        "Obstacles": [{"start": [0.2, 0.3], "end": [0.4, 0.4]},
+                      {"start": [0.5, 0.32], "end": [0.9, 0.42], "dynamic": True, "density": 500}]})
+    out = tmp_path / "run"
+    run_sph("run", write_scene(scene, tmp_path / "scene.json"), "-o", out, "--steps", 20, "--every", 20,
+            "--no-progress")
+    sim = sph.Simulation(scene)
+    [body] = sim.bodies
+    assert body["obstacle"] == 1 and body["mass"] == pytest.approx(500 * 0.4 * 0.1)
+    assert body["position"] == pytest.approx([0.7, 0.37]) and body["orientation"] == [1, 0, 0, 0]
+    sim.step(20)
+    [body] = sim.bodies
+    rows = [line.split(",") for line in (out / "bodies.csv").read_text().splitlines()]
+    last = dict(zip(rows[0], map(float, rows[-1])))
+    assert last["frame"] == 1 and last["time"] == sim.time
+    # The run's own doubles (printed with 17 digits): equal.
+    assert [last["x"], last["y"]] == body["position"]
+    assert [last[k] for k in ("qw", "qx", "qy", "qz")] == body["orientation"]
+    assert [last["vx"], last["vy"]] == body["velocity"] and last["wz"] == body["angular_velocity"]
+    assert [last["fx"], last["fy"]] == body["force"] and last["mz"] == body["moment"]
+    assert body["velocity"][1] < 0  # it fell onto the water

@@ -42,6 +42,14 @@ Snapshot snapshot(const Simulation<D, R>& sim, bool with_velocity) {
   Snapshot s;
   s.step = sim.steps_done();
   s.time = sim.time();
+  for (std::size_t b = 0; with_velocity && b < sim.bodies().size(); ++b) {
+    BodyPoseRow row;
+    row.time = sim.time();
+    row.obstacle = sim.body_obstacles()[b];
+    for (int d = 0; d < D; ++d) row.position[static_cast<std::size_t>(d)] = sim.bodies()[b].position[d];
+    row.orientation = sim.bodies()[b].orientation;
+    s.bodies.push_back(row);
+  }
   const std::size_t ids = static_cast<std::size_t>(sim.particles().next_id());
   const std::array<double, 3> none{kNaN, kNaN, kNaN};
   s.position.assign(ids, none);
@@ -214,6 +222,13 @@ CompareResult run_all(const SceneDesc& desc, const CompareOptions& opt, const Co
   if (opt.perturbation > 0)
     res.runs.push_back(
         run_one<D, R>(desc, NeighborMode::Standard, true, opt, res.steps, res.image_steps, index++, count, progress));
+  // Floating bodies: the pictures draw them where the standard run had them at each picture's step.
+  if (any_dynamic_body(p))
+    for (std::size_t j = 0; j < res.image_steps.size(); ++j)
+      for (const Snapshot& snap : res.runs[0].samples)
+        if (snap.step == res.image_steps[j] && !snap.bodies.empty())
+          for (std::size_t k = 0; k < p.obstacles.size(); ++k)
+            res.image_obstacles[j][k] = obstacle_solid(p, k, snap.time, snap.bodies);
   res.divergence.resize(res.runs.size());
   for (std::size_t k = 1; k < res.runs.size(); ++k) res.divergence[k] = divergence(res.runs[0], res.runs[k], res.h);
   return res;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include <sph/io/run_directory.h>
 #include <sph/neighbors/strategy.h>
 #include <sph/render/particles.h>
 #include <sph/scene/scene_desc.h>
@@ -53,6 +54,7 @@ struct Snapshot {
   std::vector<std::array<double, 3>> position;  ///< by id; NaN for ids not yet emitted
   std::vector<std::array<double, 3>> velocity;  ///< by id; only for image steps
   std::vector<std::array<double, 3>> initial;   ///< by id; only for image steps
+  std::vector<BodyPoseRow> bodies;              ///< the floating bodies' poses; only for image steps
 };
 
 /// Everything recorded from one run.

@@ -129,7 +129,7 @@ TEST(FloatingBody, HalfTheWatersDensityFloatsAtArchimedesDraft) {
 
 TEST(FloatingBody, TheWatersDensityNeitherRisesNorSinks) {
   // Submerged, 0.1 m below the surface and 0.1 m above the floor.
-  const Settled s = settle(tank_with_box(1000, 0.1, 0.5, 1.5));
+  const Settled s = settle(tank_with_box(1000, 0.1, 0.5, 1.0));
   EXPECT_NEAR(s.mean_y, 0.2, 0.02);  // within a particle spacing of where it started
   EXPECT_LE(s.deepest, 0.5 * 0.01);
 }
@@ -175,6 +175,32 @@ TEST(FloatingBody, FluidAndBodyExchangeMomentumExactly) {
     // Nowhere near a wall: only the fluid touched the box.
     for (const auto& x : sim.particles().position) EXPECT_GT(std::min({x[0], x[1], 2 - x[0], 2 - x[1]}), 0.1);
   }
+}
+
+TEST(FloatingBody, In3DFluidAndATurningBodyExchangeMomentumExactly) {
+  // A block thrown off-centre at a box that spins about a tilted axis, without gravity.
+  const SceneDesc desc = parse_scene(R"({
+    "version": 1, "name": "collision_3d", "dimension": 3,
+    "Configuration": { "precision": "double", "timeStepSize": 0.004, "stopAt": 0.3, "particleRadius": 0.02,
+      "kernelRadius": 0.08, "gravitation": [0, 0, 0], "outputFps": 0, "boundaryHandling": "particles",
+      "kernel": "cubic", "simulationMethod": "dfsph" },
+    "Fluid": { "density0": 1000, "viscosity": 1.0 },
+    "Container": { "start": [0, 0, 0], "end": [2, 2, 2] },
+    "FluidBlocks": [ { "start": [0.4, 0.8, 0.8], "end": [0.64, 1.04, 1.04], "velocity": [2, 0, 0] } ],
+    "Obstacles": [ { "start": [0.9, 0.85, 0.7], "end": [1.1, 1.25, 1.1], "dynamic": true, "density": 600,
+                     "angularVelocity": [0.5, 1, -0.5] } ]
+  })",
+                                     "collision_3d.json");
+  RunDriver<3, double> run(desc, RunSettings{});
+  const Simulation<3, double>& sim = run.simulation();
+  const auto total = [&] { return sim.momentum() + sim.bodies()[0].velocity * sim.body_masses()[0].mass; };
+  const Vec<3, double> p0 = total();
+  while (sim.time() < desc.end_time * (1 - 1e-12)) run.step();
+  const Vec<3, double> p1 = total();
+  EXPECT_GT(sim.bodies()[0].velocity[0] * sim.body_masses()[0].mass, 0.05 * p0[0]);
+  for (int d = 0; d < 3; ++d) EXPECT_NEAR(p1[d], p0[d], 1e-9 * std::abs(p0[0])) << "axis " << d;
+  const auto& q = sim.bodies()[0].orientation;
+  EXPECT_NEAR(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3], 1.0, 1e-14);
 }
 
 TEST(FloatingBody, ABodyDroppedOnTheFloorRestsOnIt) {

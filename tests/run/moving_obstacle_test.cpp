@@ -215,7 +215,7 @@ TEST(MovingObstacle, EveryNeighborModeSeesTheSameBoundaryPairs) {
     SCOPED_TRACE(mode);
     SceneDesc desc = read_scene_file(
         SPH_SOURCE_DIR "/scenes/examples/wave_flume_2d.json",
-        {"Configuration.stopAt=1.5", "Configuration.outputFps=0",
+        {"Configuration.stopAt=0.6", "Configuration.outputFps=0",
          std::string("Configuration.neighbors=\"") + mode + "\"", "Configuration.fullRebuildPeriod=50"});
     desc.body<2>().sim.audit = true;  // (sph run --audit)
     RunDriver<2, double> run(desc, RunSettings{});

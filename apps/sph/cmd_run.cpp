@@ -147,8 +147,8 @@ class StopSignals {
 };
 
 /// The lines of the closing message that say where the frames are (none if none were written).
-std::string frames_hint(const OutputDesc& output, const std::filesystem::path& dir, std::size_t frames,
-                        bool obstacles) {
+std::string frames_hint(const OutputDesc& output, const std::filesystem::path& dir, std::size_t frames, bool obstacles,
+                        bool bodies) {
   std::string s;
   if (frames == 0) return s;
   for (FrameFormat f : output.formats) {
@@ -158,6 +158,11 @@ std::string frames_hint(const OutputDesc& output, const std::filesystem::path& d
   if (obstacles)
     s +=
         fmt::format("  {}/solids.pvd   the obstacles at each frame's time (ParaView, with the frames)\n", dir.string());
+  if (bodies)
+    s += fmt::format(
+        "  {}/bodies.csv   the floating bodies at each frame: position, orientation, velocities, the "
+        "fluid's force\n",
+        dir.string());
   return s;
 }
 
@@ -176,7 +181,8 @@ void print_done(const RunDriver<D, R>& run, const RunResult& result, bool audit)
              ran, run.simulation().particles().size(), result.wall_seconds,
              1e3 * result.wall_seconds / static_cast<double>(std::max<std::int64_t>(ran, 1)),
              result.first_step > 0 ? "The run now has" : "Wrote", out.frames_written(),
-             frames_hint(run.scene().output, dir, out.frames_written(), !run.simulation().params().obstacles.empty()),
+             frames_hint(run.scene().output, dir, out.frames_written(), !run.simulation().params().obstacles.empty(),
+                         !run.simulation().bodies().empty()),
              dir.string(), dir.string(),
              out.frames_written() > 0
                  ? fmt::format("  look at it: sph render {0} --mp4 (PNG frames, a movie); sph view {0} (a web page)\n",

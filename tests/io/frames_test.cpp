@@ -527,11 +527,15 @@ TEST(BodiesTable, ReadsWhatTheWriterWritesAndRefusesAnythingElse) {
   EXPECT_EQ(rows[0].obstacle, 1u);
   EXPECT_EQ(rows[0].position, (std::array<double, 3>{0.5, 0.75, 0}));
   EXPECT_EQ(rows[0].orientation, (std::array<double, 4>{1, 0, 0, 0}));
-  // A wrong header, a short row, a word, a negative or fractional obstacle: one error naming the file.
+  // A wrong header, a short row, a word, a negative, fractional or huge obstacle, a negative frame,
+  // an orientation that is not a unit quaternion: one error naming the file.
   for (const std::string& bad : {std::string("frame,time\n") + row, header + "3,0.25,1\n",
                                  header + "3,0.25,one,0.5,0.75,0,1,0,0,0,0.1,0,0,0,0,0.2,1,2,0,0,0,3\n",
                                  header + "3,0.25,-1,0.5,0.75,0,1,0,0,0,0.1,0,0,0,0,0.2,1,2,0,0,0,3\n",
-                                 header + "3,0.25,1.5,0.5,0.75,0,1,0,0,0,0.1,0,0,0,0,0.2,1,2,0,0,0,3\n"}) {
+                                 header + "3,0.25,1.5,0.5,0.75,0,1,0,0,0,0.1,0,0,0,0,0.2,1,2,0,0,0,3\n",
+                                 header + "3,0.25,1e300,0.5,0.75,0,1,0,0,0,0.1,0,0,0,0,0.2,1,2,0,0,0,3\n",
+                                 header + "-3,0.25,1,0.5,0.75,0,1,0,0,0,0.1,0,0,0,0,0.2,1,2,0,0,0,3\n",
+                                 header + "3,0.25,1,0.5,0.75,0,0,0,0,0,0.1,0,0,0,0,0.2,1,2,0,0,0,3\n"}) {
     test::spit(tmp / "bad.csv", bad);
     try {
       read_body_rows(tmp / "bad.csv");

@@ -76,8 +76,8 @@ TEST(OutputDirectory, RemovesOldRunFilesButKeepsOthers) {
   TempDir dir;
   const fs::path out = dir.path();
   fs::create_directories(out / "frames");
-  for (const char* f :
-       {"frames.pvd", "stats.csv", "summary.json", "scene.json", "notes.txt", "my_frame_000001.vtu", "stats.csv.bak"})
+  for (const char* f : {"frames.pvd", "stats.csv", "summary.json", "scene.json", "bodies.csv", "notes.txt",
+                        "my_frame_000001.vtu", "stats.csv.bak"})
     spit(out / f, "old");
   for (const char* f : {"frame_000000.vtu", "frame_000001.vtu", "frame_123456.vtu", "keep.vtu", "frame_notes.txt",
                         "other_frame_000000.vtu"})

@@ -98,9 +98,16 @@ std::vector<BodyPoseRow> read_body_rows(const fs::path& file) {
       }
       v.push_back(x);
     }
-    if (v.size() != std::size(kBodyColumns) || v[2] < 0 || v[2] != std::floor(v[2]))
-      throw Error(fmt::format("line {} is not a row of {} finite numbers (frame, time, obstacle, ...)", number,
-                              std::size(kBodyColumns)),
+    const auto index = [](double x) { return x >= 0 && x < 0x1p53 && x == std::floor(x); };
+    if (v.size() != std::size(kBodyColumns) || !index(v[0]) || !index(v[2]))
+      throw Error(fmt::format("line {} is not a row of {} finite numbers (frame and obstacle whole numbers >= 0, "
+                              "then time, position, orientation, ...)",
+                              number, std::size(kBodyColumns)),
+                  file.string());
+    const double q2 = v[6] * v[6] + v[7] * v[7] + v[8] * v[8] + v[9] * v[9];
+    if (std::abs(q2 - 1) > 1e-6)
+      throw Error(fmt::format("line {}: the orientation ({}, {}, {}, {}) is not a unit quaternion", number, v[6], v[7],
+                              v[8], v[9]),
                   file.string());
     BodyPoseRow r;
     r.time = v[1];
@@ -124,7 +131,16 @@ RunDirectory open_run_directory(const fs::path& dir, std::optional<FrameFormat> 
   run.dir = dir;
   run.scene = read_scene_file(scene_file.string());
   run.dimension = run.scene.dimension;
-  if (fs::is_regular_file(dir / "bodies.csv", ec)) run.bodies = read_body_rows(dir / "bodies.csv");
+  // (a scene with floating bodies only: a stray table beside any other run is not read)
+  const bool floating = run.scene.visit_body([](const auto& body) { return any_dynamic_body(body.sim); });
+  if (floating && fs::is_regular_file(dir / "bodies.csv", ec)) {
+    run.bodies = read_body_rows(dir / "bodies.csv");
+    const std::size_t obstacles = run.scene.visit_body([](const auto& body) { return body.sim.obstacles.size(); });
+    for (const BodyPoseRow& r : run.bodies)
+      if (r.obstacle >= obstacles)
+        throw Error(fmt::format("a row names obstacle {}, but the scene has {} obstacles", r.obstacle, obstacles),
+                    (dir / "bodies.csv").string());
+  }
   run.scene.visit_body([&]<int D>(const SceneBody<D>& body) {
     const SimulationParams<D>& sim = body.sim;
     run.particle_radius = sim.particle_radius;

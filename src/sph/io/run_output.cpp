@@ -105,7 +105,7 @@ void prepare_output_directory(const fs::path& dir) {
   remove_stale_temporaries(dir / "frames");
   // Remove what a previous run left, so that frames of two runs are never mixed.
   for (const char* name : {"frames.pvd", "solids.pvd", "stats.csv", "summary.json", "scene.json", "checkpoint.sphc",
-                           "run.json", "boundary.vtu"})
+                           "run.json", "boundary.vtu", "bodies.csv"})
     fs::remove(dir / name, ec);
   remove_pictures(dir);
   for (const auto& entry : fs::directory_iterator(dir / "frames", ec)) {

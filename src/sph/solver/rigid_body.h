@@ -66,7 +66,8 @@ struct BodyLoad {
 
 /// The container's contact with a body: each corner of the box past a wall is pushed back by a
 /// damped spring, k pen - c v_n along the wall's normal (never pulling), with k = m w^2 and
-/// c = 2 m w (critically damped for one corner): `omega` (w) is body_contact_rate(). Adds the
+/// c = m w (a damping ratio of 1/2 for one corner, so that four corners at once stay stable):
+/// `omega` (w) is body_contact_rate(). Adds the
 /// impulses of a step of dt to `load`.
 template <int D>
 void add_container_contact(const Box<D>& container, const Box<D>& box, const RigidBodyState<D>& s,

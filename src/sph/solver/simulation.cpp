@@ -212,13 +212,6 @@ std::vector<RigidPose<D>> Simulation<D, R>::obstacle_poses() const {
 }
 
 template <int D, std::floating_point R>
-void Simulation<D, R>::set_body_state(std::size_t s, const RigidBodyState<D>& state) {
-  SPH_CHECK(s < bodies_.size(), "no such floating body");
-  bodies_[s] = state;
-  neighbors_->invalidate();
-}
-
-template <int D, std::floating_point R>
 void Simulation<D, R>::place_obstacles() {
   if (moving_.empty()) return;
   for (std::size_t k = 0; k < moving_.size(); ++k)
@@ -264,6 +257,13 @@ void Simulation<D, R>::advance_bodies(double dt) {
     const std::size_t k = body_obstacle_[s];
     add_container_contact(params_.container, params_.obstacles[k], bodies_[s], body_mass_[s], contact_rate_, dt, load);
     advance_body(bodies_[s], body_mass_[s], load, params_.gravity, dt);
+    const RigidBodyState<D>& b = bodies_[s];
+    if (!all_finite(b.position) || !all_finite(b.velocity) || !all_finite(b.angular_velocity))
+      throw Error(fmt::format(
+          "simulation blew up at step {} (t = {:.6g} s): the floating body Obstacles[{}] has a position or velocity "
+          "that is not finite (the fluid's force on it: {:.6g} N). Lower Configuration.timeStepSize (or "
+          "cflMaxTimeStepSize), or make the body denser",
+          steps_, time(), k, std::sqrt(norm2(body_force_[s].impulse))));
   }
 }
 
@@ -504,8 +504,8 @@ const StepInfo& Simulation<D, R>::step() {
     info.seconds.solve += watch.lap();
   }
   // The floating bodies take the fluid's reaction (at the particles' positions before they move).
-  advance_bodies(st.dt);
-  ++steps_;  // counted even if the checks below throw (as before the passes were fused)
+  advance_bodies(static_cast<double>(dt));  // (the fluid's own dt, rounded as it moves with it)
+  ++steps_;                                 // counted even if the checks below throw (as before the passes were fused)
   if (cfl()) {
     time_ = st.lands ? st.end : time_ + st.dt;
     last_cfl_dt_ = st.cfl_dt;
@@ -691,10 +691,12 @@ void Simulation<D, R>::load_state(StateReader& in) {
   const std::size_t body_count = bodies_.size();
   in.get(bodies_);
   in.expect(bodies_.size() == body_count, "a different number of floating bodies");
-  for (const RigidBodyState<D>& b : bodies_)
+  for (const RigidBodyState<D>& b : bodies_) {
+    const auto& q = b.orientation;
     in.expect(all_finite(b.position) && all_finite(b.velocity) && all_finite(b.angular_velocity) &&
-                  std::isfinite(b.orientation[0] + b.orientation[1] + b.orientation[2] + b.orientation[3]),
-              "a floating body's state is not finite");
+                  std::abs(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] - 1) < 1e-9,
+              "a floating body's state is not finite, or its orientation not a unit quaternion");
+  }
   particles_.load(in);
   neighbors_->load_state(in, particles_.size());
   monitor_.load_state(in);

@@ -133,8 +133,6 @@ class Simulation {
   const std::vector<RigidBodyState<D>>& bodies() const { return bodies_; }
   const std::vector<MassProperties<D>>& body_masses() const { return body_mass_; }
   const std::vector<BodyLoad<D>>& body_fluid_forces() const { return body_force_; }
-  /// Replaces body s's state between steps (the Python module): the next step places it there.
-  void set_body_state(std::size_t s, const RigidBodyState<D>& state);
 
   /// Total kinetic energy, J (J/m in 2D). Deterministic for any thread count. (This and the
   /// other reductions use a shared scratch buffer: do not call them concurrently.)

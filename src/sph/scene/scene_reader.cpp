@@ -79,10 +79,12 @@ template <int D>
 Vec<D, double> read_unit(ObjectReader& r, const std::string& key, const std::string& what,
                          std::optional<Vec<D, double>> def = {}) {
   const Vec<D, double> v = r.vec<D>(key, what, def);
-  const double n = std::sqrt(norm2(v));
-  if (!(n > 0) || !std::isfinite(n))
+  // (the emitters' normalization: the writer writes detail::direction_giving, which reads back to
+  // the same unit vector bit for bit)
+  const std::optional<Vec<D, double>> unit = detail::unit_direction<D>(v);
+  if (!unit)
     r.ctx().fail(r.child(key), fmt::format("expected {}, got {} (it has no direction)", what, point_text<D>(v)));
-  return v * (1.0 / n);
+  return *unit;
 }
 
 /// Obstacles[].motion of the obstacle `box` (docs/scene-format.md, "Obstacles").

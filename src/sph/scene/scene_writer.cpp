@@ -124,7 +124,7 @@ OrderedJson motion_json(const ObstacleMotion<D>& m) {
     case MotionType::None:
       break;
     case MotionType::Oscillation:
-      w.put("direction", vec_json<D>(m.direction))
+      w.put("direction", vec_json<D>(detail::direction_giving<D>(m.direction)))
           .put("amplitude", m.amplitude)
           .put("period", m.period)
           .put("phase", m.phase)
@@ -132,7 +132,7 @@ OrderedJson motion_json(const ObstacleMotion<D>& m) {
       break;
     case MotionType::Rotation:
     case MotionType::Keyframes:
-      if constexpr (D == 3) w.put("axis", vec_json<3>(m.axis));
+      if constexpr (D == 3) w.put("axis", vec_json<3>(detail::direction_giving<3>(m.axis)));
       w.put("center", vec_json<D>(m.center));
       if (m.type == MotionType::Rotation) {
         w.put("angularVelocity", m.angular_velocity).put("rampTime", m.ramp_time);

@@ -230,6 +230,80 @@ TEST(FloatingBody, ABodyDroppedOnTheFloorRestsOnIt) {
   EXPECT_NEAR(b.position[0], 0.75, 1e-6);  // (it fell straight)
 }
 
+/// The deepest any corner of one obstacle is inside another (m; negative: none is).
+double deepest_corner(const Simulation<2, double>& sim) {
+  const SimulationParams<2>& p = sim.params();
+  const std::vector<RigidPose<2>> poses = sim.obstacle_poses();
+  double deepest = -1e300;
+  for (std::size_t a = 0; a < p.obstacles.size(); ++a)
+    for (std::size_t b = 0; b < p.obstacles.size(); ++b)
+      for (int c = 0; a != b && c < 4; ++c) {
+        const Vec<2, double> X =
+            poses[b].to_rest(poses[a].place(box_corner<2>(p.obstacles[a].lo, p.obstacles[a].hi, c)));
+        double depth = 1e300;
+        for (int d = 0; d < 2; ++d) depth = std::min({depth, X[d] - p.obstacles[b].lo[d], p.obstacles[b].hi[d] - X[d]});
+        deepest = std::max(deepest, depth);
+      }
+  return deepest;
+}
+
+TEST(FloatingBody, BodiesMeetEachOtherAndTheRestingObstacles) {
+  // Without gravity, two boxes meet head on (1 m/s apart, off-centre), far from the fluid: they
+  // bounce apart, no corner gets a spacing deep into the other, and their momentum is kept. Then,
+  // with gravity, a box dropped onto a resting obstacle stays on top of it.
+  const SceneDesc meet = parse_scene(R"({
+    "version": 1, "name": "meet", "dimension": 2,
+    "Configuration": { "precision": "double", "timeStepSize": 0.004, "stopAt": 1.0, "particleRadius": 0.01,
+      "kernelRadius": 0.04, "gravitation": [0, 0], "boundaryHandling": "particles", "kernel": "cubic",
+      "simulationMethod": "dfsph", "outputFps": 0 },
+    "Fluid": { "density0": 1000, "stiffness": 1000, "viscosity": 1.0 },
+    "Container": { "start": [0, 0], "end": [2, 1] },
+    "FluidBlocks": [ { "start": [0, 0], "end": [0.1, 0.1] } ],
+    "Obstacles": [ { "start": [0.6, 0.5], "end": [0.8, 0.6], "dynamic": true, "density": 500, "velocity": [0.5, 0] },
+                   { "start": [1.2, 0.53], "end": [1.4, 0.63], "dynamic": true, "density": 800, "velocity": [-0.5, 0] } ]
+  })",
+                                     "meet.json");
+  {
+    RunDriver<2, double> run(meet, RunSettings{});
+    const Simulation<2, double>& sim = run.simulation();
+    const auto momentum = [&] {
+      return sim.bodies()[0].velocity * sim.body_masses()[0].mass +
+             sim.bodies()[1].velocity * sim.body_masses()[1].mass;
+    };
+    const Vec<2, double> p0 = momentum();
+    double deepest = -1;
+    while (!finished(meet, sim)) {
+      run.step();
+      deepest = std::max(deepest, deepest_corner(sim));
+    }
+    std::printf("deepest corner %.4f m, closing 1 m/s, parting %.4f m/s\n", deepest,
+                sim.bodies()[1].velocity[0] - sim.bodies()[0].velocity[0]);
+    EXPECT_GT(deepest, 0);     // they did meet
+    EXPECT_LT(deepest, 0.02);  // by less than a spacing
+    // and parted again (the contact's damping takes most of the closing speed: restitution ~0.16)
+    EXPECT_GT(sim.bodies()[1].velocity[0] - sim.bodies()[0].velocity[0], 0.05);
+    const Vec<2, double> p1 = momentum();
+    for (int d = 0; d < 2; ++d) EXPECT_NEAR(p1[d], p0[d], 1e-12) << d;
+  }
+  const SceneDesc stack = parse_scene(R"({
+    "version": 1, "name": "stack", "dimension": 2,
+    "Configuration": { "precision": "double", "timeStepSize": 0.004, "stopAt": 1.0, "particleRadius": 0.01,
+      "kernelRadius": 0.04, "gravitation": [0, -9.81], "boundaryHandling": "particles", "kernel": "cubic",
+      "simulationMethod": "dfsph", "outputFps": 0 },
+    "Container": { "start": [0, 0], "end": [1.2, 0.8] },
+    "FluidBlocks": [ { "start": [0, 0], "end": [0.1, 0.1] } ],
+    "Obstacles": [ { "start": [0.5, 0], "end": [1.0, 0.2] },
+                   { "start": [0.6, 0.3], "end": [0.9, 0.4], "dynamic": true, "density": 500 } ]
+  })",
+                                      "stack.json");
+  RunDriver<2, double> run(stack, RunSettings{});
+  const Simulation<2, double>& sim = run.simulation();
+  while (!finished(stack, sim)) run.step();
+  const RigidBodyState<2>& b = sim.bodies()[0];
+  EXPECT_NEAR(b.position[1] - 0.05, 0.2, 0.005);  // its bottom on the obstacle's top
+  EXPECT_LT(std::sqrt(norm2(b.velocity)), 0.01);
+}
+
 struct ThreadCount {
   int saved = num_threads();
   ~ThreadCount() { set_num_threads(saved); }

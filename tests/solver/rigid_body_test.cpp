@@ -109,5 +109,36 @@ TEST(RigidBody, TheContainerHoldsARestingBoxAtItsSpringsSag) {
   EXPECT_EQ(load.impulse, (Vec<2, double>{}));
 }
 
+TEST(RigidBody, TwoBoxesInContactArePushedApartEquallyAndOppositely) {
+  // a's right side overlaps b's left side by 1 cm, b turned a little: each is pushed out of the
+  // other, the impulses are opposite, and so are the moments about a common point.
+  const Box<2> box_a{{{0, 0}}, {{0.2, 0.1}}}, box_b{{{0.19, 0.02}}, {{0.39, 0.12}}};
+  RigidBodyState<2> sa = initial_body_state(box_a, BodyParams<2>{true, 500, {{0.3, 0}}, {}});
+  RigidBodyState<2> sb = initial_body_state(box_b, BodyParams<2>{true, 800, {{-0.1, 0}}, {}});
+  const double turn = 0.05;
+  sb.orientation = {std::cos(turn / 2), 0, 0, std::sin(turn / 2)};
+  const MassProperties<2> ma = box_mass_properties<2>(box_a, 500), mb = box_mass_properties<2>(box_b, 800);
+  const ContactBox<2> a{box_a, body_pose(sa, ma.center), ma.mass}, b{box_b, body_pose(sb, mb.center), mb.mass};
+  BodyLoad<2> la, lb;
+  add_body_contact(a, b, 50.0, 1e-3, la, &lb);
+  EXPECT_LT(la.impulse[0], 0);  // a pushed back to the left, b to the right
+  EXPECT_GT(lb.impulse[0], 0);
+  EXPECT_NEAR(la.impulse[0] + lb.impulse[0], 0, 1e-15);
+  EXPECT_NEAR(la.impulse[1] + lb.impulse[1], 0, 1e-15);
+  // Moments about the origin: each body's about its centre plus its centre x its impulse.
+  const double about_origin = la.angular_impulse[2] + sa.position[0] * la.impulse[1] - sa.position[1] * la.impulse[0] +
+                              lb.angular_impulse[2] + sb.position[0] * lb.impulse[1] - sb.position[1] * lb.impulse[0];
+  EXPECT_NEAR(about_origin, 0, 1e-15);
+  // Against an obstacle that does not give way, only a is pushed, by the same law.
+  BodyLoad<2> alone;
+  add_body_contact<2>(a, ContactBox<2>{box_b, b.pose, 0.0}, 50.0, 1e-3, alone, nullptr);
+  EXPECT_LT(alone.impulse[0], 0);
+  // Apart, nothing.
+  BodyLoad<2> none;
+  add_body_contact<2>(a, ContactBox<2>{Box<2>{{{0.5, 0}}, {{0.6, 0.1}}}, RigidPose<2>{}, 1.0}, 50.0, 1e-3, none,
+                      nullptr);
+  EXPECT_EQ(none.impulse, (Vec<2, double>{}));
+}
+
 }  // namespace
 }  // namespace sph

@@ -1,6 +1,7 @@
 #include <sph/solver/rigid_body.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <sph/core/error.h>
@@ -97,6 +98,58 @@ void add_container_contact(const Box<D>& container, const Box<D>& box, const Rig
 }
 
 template <int D>
+void add_body_contact(const ContactBox<D>& a, const ContactBox<D>& b, double omega, double dt, BodyLoad<D>& load_a,
+                      BodyLoad<D>* load_b) {
+  const double m = b.mass > 0 ? a.mass * b.mass / (a.mass + b.mass) : a.mass;
+  const double k = m * omega * omega, c = m * omega;
+  const Vec<D, double> ca = a.pose.center + a.pose.translation, cb = b.pose.center + b.pose.translation;
+  // The corners of `of` inside `in`: the push on the corner, out of `in`, and where it acts.
+  const auto meet = [&](const ContactBox<D>& of, const ContactBox<D>& in, auto&& push) {
+    for (int corner = 0; corner < (1 << D); ++corner) {
+      const Vec<D, double> x = of.pose.place(box_corner<D>(of.box.lo, of.box.hi, corner));
+      const Vec<D, double> X = in.pose.to_rest(x);
+      double depth = std::numeric_limits<double>::infinity();
+      int face = -1;
+      double sign = 0;
+      for (int d = 0; d < D; ++d) {
+        const double below = X[d] - in.box.lo[d], above = in.box.hi[d] - X[d];
+        if (!(below > 0 && above > 0)) {
+          face = -1;
+          break;
+        }
+        if (below < depth) depth = below, face = d, sign = -1;
+        if (above < depth) depth = above, face = d, sign = 1;
+      }
+      if (face < 0) continue;
+      Vec<D, double> normal{};
+      normal[face] = sign;
+      normal = in.pose.rotate(normal);  // out of `in`, in the world's frame
+      const double vn = dot(of.pose.velocity_at(x) - in.pose.velocity_at(x), normal);
+      const double f = std::max(0.0, k * depth - c * vn);
+      if (f > 0) push(x, normal * (f * dt));
+    }
+  };
+  // a's corners in b: a is pushed out of b, b back.
+  meet(a, b, [&](const Vec<D, double>& x, const Vec<D, double>& j) {
+    load_a.impulse += j;
+    add_moment<D>(load_a.angular_impulse, x, ca, j);
+    if (load_b) {
+      load_b->impulse -= j;
+      add_moment<D>(load_b->angular_impulse, x, cb, j * -1.0);
+    }
+  });
+  // b's corners in a: b is pushed out of a, a back.
+  meet(b, a, [&](const Vec<D, double>& x, const Vec<D, double>& j) {
+    load_a.impulse -= j;
+    add_moment<D>(load_a.angular_impulse, x, ca, j * -1.0);
+    if (load_b) {
+      load_b->impulse += j;
+      add_moment<D>(load_b->angular_impulse, x, cb, j);
+    }
+  });
+}
+
+template <int D>
 void advance_body(RigidBodyState<D>& s, const MassProperties<D>& mp, const BodyLoad<D>& load,
                   const Vec<D, double>& gravity, double dt) {
   s.velocity += load.impulse * (1.0 / mp.mass) + gravity * dt;
@@ -139,6 +192,10 @@ template void add_container_contact<2>(const Box<2>&, const Box<2>&, const Rigid
                                        double, double, BodyLoad<2>&);
 template void add_container_contact<3>(const Box<3>&, const Box<3>&, const RigidBodyState<3>&, const MassProperties<3>&,
                                        double, double, BodyLoad<3>&);
+template void add_body_contact<2>(const ContactBox<2>&, const ContactBox<2>&, double, double, BodyLoad<2>&,
+                                  BodyLoad<2>*);
+template void add_body_contact<3>(const ContactBox<3>&, const ContactBox<3>&, double, double, BodyLoad<3>&,
+                                  BodyLoad<3>*);
 template void advance_body<2>(RigidBodyState<2>&, const MassProperties<2>&, const BodyLoad<2>&, const Vec<2, double>&,
                               double);
 template void advance_body<3>(RigidBodyState<3>&, const MassProperties<3>&, const BodyLoad<3>&, const Vec<3, double>&,

@@ -73,6 +73,27 @@ template <int D>
 void add_container_contact(const Box<D>& container, const Box<D>& box, const RigidBodyState<D>& s,
                            const MassProperties<D>& mp, double omega, double dt, BodyLoad<D>& load);
 
+/// A box another body's corners can meet (add_body_contact): the box at rest, its pose now, and
+/// its mass, kg (0: it does not give way: a resting or prescribed-motion obstacle).
+template <int D>
+struct ContactBox {
+  Box<D> box;
+  RigidPose<D> pose;
+  double mass = 0;
+};
+
+/// The contact of two boxes, a floating body `a` and a box `b` (another body, or an obstacle that
+/// does not give way): each corner of either inside the other is pushed out through the nearest
+/// face of the other (in its frame), by a damped spring k pen - c v_n along that face's normal
+/// (never pulling), v_n the corner's velocity relative to the other box's surface there, k = m
+/// w^2 and c = m w with m the pair's reduced mass (a's own against an obstacle). The impulses over
+/// dt and their moments about each body's centre of mass (the pose's c + t) are added to `load_a`
+/// and, opposite, to `load_b` (null: `b` takes nothing). Corners against faces only: in 3D two
+/// boxes meeting edge to edge with no corner inside the other pass through each other there.
+template <int D>
+void add_body_contact(const ContactBox<D>& a, const ContactBox<D>& b, double omega, double dt, BodyLoad<D>& load_a,
+                      BodyLoad<D>* load_b);
+
 /// The contact's angular rate w, 1/s, for steps of at most `max_dt`: a contact oscillation takes 20
 /// of the longest steps (w dt <= pi / 10, stable for symplectic Euler with room to spare), so a
 /// body resting on the floor sinks g / w^2 into it (about a millimetre for 5 ms steps).
@@ -110,6 +131,10 @@ extern template void add_container_contact<2>(const Box<2>&, const Box<2>&, cons
                                               const MassProperties<2>&, double, double, BodyLoad<2>&);
 extern template void add_container_contact<3>(const Box<3>&, const Box<3>&, const RigidBodyState<3>&,
                                               const MassProperties<3>&, double, double, BodyLoad<3>&);
+extern template void add_body_contact<2>(const ContactBox<2>&, const ContactBox<2>&, double, double, BodyLoad<2>&,
+                                         BodyLoad<2>*);
+extern template void add_body_contact<3>(const ContactBox<3>&, const ContactBox<3>&, double, double, BodyLoad<3>&,
+                                         BodyLoad<3>*);
 extern template void advance_body<2>(RigidBodyState<2>&, const MassProperties<2>&, const BodyLoad<2>&,
                                      const Vec<2, double>&, double);
 extern template void advance_body<3>(RigidBodyState<3>&, const MassProperties<3>&, const BodyLoad<3>&,

@@ -245,8 +245,10 @@ void Simulation<D, R>::advance_bodies(double dt) {
         for (int a = 0; a < 3; ++a) o[D + a] += moment[a];
       }
   });
+  std::vector<BodyLoad<D>>& loads = body_loads_;
+  loads.assign(nb, BodyLoad<D>{});
   for (std::size_t s = 0; s < nb; ++s) {
-    BodyLoad<D> load;  // the body's: minus the fluid's
+    BodyLoad<D>& load = loads[s];  // the body's: minus the fluid's
     for (std::size_t c = 0; c < chunks; ++c) {
       const double* o = &body_partial_[(c * nb + s) * kPer];
       for (int d = 0; d < D; ++d) load.impulse[d] -= o[d];
@@ -256,7 +258,23 @@ void Simulation<D, R>::advance_bodies(double dt) {
     body_force_[s].angular_impulse = load.angular_impulse * (1.0 / dt);
     const std::size_t k = body_obstacle_[s];
     add_container_contact(params_.container, params_.obstacles[k], bodies_[s], body_mass_[s], contact_rate_, dt, load);
-    advance_body(bodies_[s], body_mass_[s], load, params_.gravity, dt);
+  }
+  // Contacts between bodies (each pair once, in a fixed order), and with the obstacles that do not
+  // float (they do not give way), all from the states at the step's start.
+  const auto contact_box = [&](std::size_t k) {
+    const std::size_t s = obstacle_body_[k];
+    return ContactBox<D>{params_.obstacles[k], pose_now(k), s != 0 ? body_mass_[s - 1].mass : 0.0};
+  };
+  for (std::size_t s = 0; s < nb; ++s) {
+    const ContactBox<D> a = contact_box(body_obstacle_[s]);
+    for (std::size_t t = s + 1; t < nb; ++t)
+      add_body_contact(a, contact_box(body_obstacle_[t]), contact_rate_, dt, loads[s], &loads[t]);
+    for (std::size_t k = 0; k < params_.obstacles.size(); ++k)
+      if (obstacle_body_[k] == 0) add_body_contact<D>(a, contact_box(k), contact_rate_, dt, loads[s], nullptr);
+  }
+  for (std::size_t s = 0; s < nb; ++s) {
+    const std::size_t k = body_obstacle_[s];
+    advance_body(bodies_[s], body_mass_[s], loads[s], params_.gravity, dt);
     const RigidBodyState<D>& b = bodies_[s];
     if (!all_finite(b.position) || !all_finite(b.velocity) || !all_finite(b.angular_velocity))
       throw Error(fmt::format(

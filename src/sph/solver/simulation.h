@@ -177,7 +177,8 @@ class Simulation {
   void init_bodies();
   /// The fluid's reaction on each body over a step of dt (from body_acceleration_ and
   /// body_velocity_change_, at the particles' positions before they move), plus the container's
-  /// contact; then each body takes its step.
+  /// contact and the contacts between bodies and with the other obstacles; then each body takes
+  /// its step.
   void advance_bodies(double dt);
   /// Adaptive mode (SimulationParams::flag_near_moving): flags for a list rebuild every particle
   /// within h plus its travel in a step of dt of a moving obstacle.
@@ -204,6 +205,7 @@ class Simulation {
   std::vector<RigidBodyState<D>> bodies_;
   std::vector<MassProperties<D>> body_mass_;
   std::vector<BodyLoad<D>> body_force_;  // the last step's fluid force and moment on each body
+  std::vector<BodyLoad<D>> body_loads_;  // each body's impulses in the step (kept: no allocation per step)
   double contact_rate_ = 0;              // body_contact_rate() of the run's longest step, 1/s
   // What each body gave each particle in the step (BoundaryView::body_acceleration, ...).
   std::vector<Vec<D, R>> body_acceleration_, body_velocity_change_;

@@ -15,14 +15,13 @@
 #include <sph/run/resume.h>
 #include <sph/scene/scene_reader.h>
 
+#include "support/resume.h"
 #include "support/temp_dir.h"
 
 namespace sph {
 namespace {
 
 namespace fs = std::filesystem;
-using test::entries;
-using test::slurp;
 using test::TempDir;
 
 /// The paper's 2D dam break to `stop` seconds in CFL steps, `fps` frames per second.
@@ -106,28 +105,12 @@ TEST(CflSteps, EmitterBatchesComeOnTheirTimes) {
 TEST(CflSteps, AStoppedRunResumesBitForBit) {
   TempDir tmp;
   const SceneDesc desc = dam_break_cfl(0.04, 250, "adaptive");
-  {
-    RunDriver<2, double> full(desc, RunSettings{tmp / "full"});
-    ASSERT_EQ(full.run().status, RunStatus::Completed);
-  }
-  RunCallbacks stop;
-  stop.stop_requested = [](std::int64_t done) { return done == 37 ? std::string("a test") : std::string(); };
-  {
-    RunDriver<2, double> part(desc, RunSettings{tmp / "part"});
-    const RunResult r = part.run(stop);
-    ASSERT_EQ(r.status, RunStatus::Interrupted);
-    EXPECT_NE(r.message.find("(t = "), std::string::npos) << r.message;
-  }
-  RunToResume r = open_run_to_resume(tmp / "part");
-  EXPECT_EQ(r.desc.end_time, 0.04);
-  RunDriver<2, double> resumed(r.desc, *r.checkpoint, RunSettings{tmp / "part", r.checkpoint_every});
-  ASSERT_EQ(resumed.run().status, RunStatus::Completed);
-  const std::vector<std::string> names = entries(tmp / "full" / "frames");
-  ASSERT_EQ(names, entries(tmp / "part" / "frames"));
-  ASSERT_EQ(names.size(), 11u);
-  for (const auto& n : names)
-    EXPECT_TRUE(slurp(tmp / "full" / "frames" / n) == slurp(tmp / "part" / "frames" / n)) << n << " differs";
-  EXPECT_EQ(slurp(tmp / "full" / "frames.pvd"), slurp(tmp / "part" / "frames.pvd"));
+  const std::vector<std::string> names = test::expect_resume_gives_the_same_files<2>(
+      desc, tmp.path(), 37, {"frames.pvd"}, [](const RunResult& stopped, const RunToResume& r) {
+        EXPECT_NE(stopped.message.find("(t = "), std::string::npos) << stopped.message;
+        EXPECT_EQ(r.desc.end_time, 0.04);
+      });
+  EXPECT_EQ(names.size(), 11u);
 }
 
 TEST(CflSteps, TheThreadCountChangesNothing) {

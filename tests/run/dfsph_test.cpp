@@ -13,16 +13,14 @@
 
 #include <sph/core/parallel.h>
 #include <sph/run/driver.h>
-#include <sph/run/resume.h>
 #include <sph/scene/scene_reader.h>
 
+#include "support/resume.h"
 #include "support/temp_dir.h"
 
 namespace sph {
 namespace {
 
-using test::entries;
-using test::slurp;
 using test::TempDir;
 
 /// The validation's 2D DFSPH tank at twice its spacing (20 x 20 particles), to `stop` seconds.
@@ -134,24 +132,7 @@ TEST(Dfsph, AStoppedRunResumesBitForBit) {
   const SceneDesc desc = read_scene_file(
       SPH_SOURCE_DIR "/scenes/dfsph/tank_fill_3d.json",
       {"Configuration.stopAt=0.08", "Configuration.outputFps=100", "Configuration.neighbors=\"adaptive\""});
-  {
-    RunDriver<3, double> full(desc, RunSettings{tmp / "full"});
-    ASSERT_EQ(full.run().status, RunStatus::Completed);
-  }
-  RunCallbacks stop;
-  stop.stop_requested = [](std::int64_t done) { return done == 21 ? std::string("a test") : std::string(); };
-  {
-    RunDriver<3, double> part(desc, RunSettings{tmp / "part"});
-    ASSERT_EQ(part.run(stop).status, RunStatus::Interrupted);
-  }
-  RunToResume r = open_run_to_resume(tmp / "part");
-  RunDriver<3, double> resumed(r.desc, *r.checkpoint, RunSettings{tmp / "part", r.checkpoint_every});
-  ASSERT_EQ(resumed.run().status, RunStatus::Completed);
-  const std::vector<std::string> names = entries(tmp / "full" / "frames");
-  ASSERT_EQ(names, entries(tmp / "part" / "frames"));
-  ASSERT_EQ(names.size(), 9u);
-  for (const auto& n : names)
-    EXPECT_TRUE(slurp(tmp / "full" / "frames" / n) == slurp(tmp / "part" / "frames" / n)) << n << " differs";
+  EXPECT_EQ(test::expect_resume_gives_the_same_files<3>(desc, tmp.path(), 21).size(), 9u);
 }
 
 }  // namespace

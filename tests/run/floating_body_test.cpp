@@ -15,15 +15,14 @@
 
 #include <sph/core/parallel.h>
 #include <sph/run/driver.h>
-#include <sph/run/resume.h>
 #include <sph/scene/scene_reader.h>
 
+#include "support/resume.h"
 #include "support/temp_dir.h"
 
 namespace sph {
 namespace {
 
-using test::entries;
 using test::slurp;
 using test::TempDir;
 
@@ -313,29 +312,22 @@ TEST(FloatingBody, TheThreadCountChangesNothingAndAStoppedRunResumesBitForBit) {
   ThreadCount restore;
   TempDir tmp;
   const SceneDesc desc = tank_with_box(500, 0.36, 0.42, 0.5);
-  for (int threads : {1, 2}) {
-    set_num_threads(threads);
-    RunDriver<2, double> full(desc, RunSettings{tmp / fmt::format("full{}", threads)});
-    ASSERT_EQ(full.run().status, RunStatus::Completed);
-  }
-  EXPECT_TRUE(slurp(tmp / "full1" / "bodies.csv") == slurp(tmp / "full2" / "bodies.csv"));
-  RunCallbacks stop;
-  stop.stop_requested = [](std::int64_t done) { return done == 37 ? std::string("a test") : std::string(); };
+  set_num_threads(1);
   {
-    RunDriver<2, double> part(desc, RunSettings{tmp / "part"});
-    ASSERT_EQ(part.run(stop).status, RunStatus::Interrupted);
+    RunDriver<2, double> one(desc, RunSettings{tmp / "one_thread"});
+    ASSERT_EQ(one.run().status, RunStatus::Completed);
   }
-  RunToResume r = open_run_to_resume(tmp / "part");
-  RunDriver<2, double> resumed(r.desc, *r.checkpoint, RunSettings{tmp / "part", r.checkpoint_every});
-  ASSERT_EQ(resumed.run().status, RunStatus::Completed);
-  const std::vector<std::string> names = entries(tmp / "full1" / "frames");
-  ASSERT_EQ(names, entries(tmp / "part" / "frames"));
+  // Two threads, whole and stopped and resumed: all three write the same files.
+  set_num_threads(2);
+  const std::vector<std::string> names =
+      test::expect_resume_gives_the_same_files<2>(desc, tmp.path(), 37, {"bodies.csv"});
+  EXPECT_EQ(names.size(), 12u);  // frames at 0, 0.1, ..., 0.5 s, each with the solids
   for (const auto& n : names)
-    EXPECT_TRUE(slurp(tmp / "full1" / "frames" / n) == slurp(tmp / "part" / "frames" / n)) << n << " differs";
-  // bodies.csv: a row per frame, the same whether the run stopped or not.
-  const std::string csv = slurp(tmp / "full1" / "bodies.csv");
-  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 6);  // header and frames at 0, 0.1, ..., 0.5 s
-  EXPECT_TRUE(csv == slurp(tmp / "part" / "bodies.csv"));
+    EXPECT_TRUE(slurp(tmp / "one_thread" / "frames" / n) == slurp(tmp / "full" / "frames" / n)) << n << " differs";
+  // bodies.csv: a row per frame.
+  const std::string csv = slurp(tmp / "one_thread" / "bodies.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 6);
+  EXPECT_TRUE(csv == slurp(tmp / "full" / "bodies.csv"));
 }
 
 }  // namespace

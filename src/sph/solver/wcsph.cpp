@@ -351,6 +351,9 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
       const P nu_i = P::set1(fc.friction * h * fc.c0 * R(0.5) * inv_rhoi);
       const auto bnb = boundary.lists->of(i);
       const std::uint32_t* bidx = bnb.data();
+      // (recorded only for the particles that have a floating body's sample in their list)
+      const bool record =
+          sample_body && std::any_of(bnb.begin(), bnb.end(), [&](std::uint32_t b) { return sample_body[b] != 0; });
       for (std::size_t k0 = 0; k0 < bnb.size(); k0 += W) {
         const Mask valid = simd::first_lanes<R>(bnb.size() - k0);
         P rib[D];
@@ -373,7 +376,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
           pterm = w_v * (pi_sym_b + (boundary.clamp ? select(pb > zero, pb, zero) : pb));
         }
         const P fb = minus_one * psib * (pterm + pi_ib) * f;
-        if (sample_body) {
+        if (record) {
           R fl[W], rl[D][W];
           fb.store(fl);
           for (int d = 0; d < D; ++d) rib[d].store(rl[d]);

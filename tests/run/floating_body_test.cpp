@@ -227,6 +227,14 @@ TEST(FloatingBody, ABodyDroppedOnTheFloorRestsOnIt) {
   EXPECT_GT(lowest, -0.01);
   EXPECT_LT(std::sqrt(norm2(b.velocity)), 0.01);
   EXPECT_NEAR(b.position[0], 0.75, 1e-6);  // (it fell straight)
+  // The energy watch is on (a floating body's energy counts with the fluid's): the body's fall
+  // turns its potential energy into kinetic and the contact's damping takes it, so the total never
+  // rises above its start, and ends at least the body's weight times its fall lower (the small
+  // block of fluid in the corner spreads out too).
+  EXPECT_TRUE(health_scene(sim.params()).closed);
+  const double e0 = sim.health().initial_energy(), fall = 0.1 * sim.body_masses()[0].mass * 9.81;
+  EXPECT_LE(sim.health().max_energy(), e0 + 1e-3 * fall);
+  EXPECT_LT(sim.last_step().health.energy, e0 - 0.95 * fall);
 }
 
 /// The deepest any corner of one obstacle is inside another (m; negative: none is).

@@ -72,7 +72,10 @@ HealthScene health_scene(const SimulationParams<D>& p) {
     for (int d = 0; d < D; ++d) head += std::abs(p.gravity[d]) * (p.container.hi[d] - p.container.lo[d]);
     s.head = head / s.gravity;
   }
-  s.closed = p.emitters.empty() && !any_obstacle_moves(p);  // (a moving obstacle does work on the fluid)
+  // (an obstacle on a prescribed motion does work on the fluid; a floating body's energy is counted
+  // with the fluid's)
+  s.closed = p.emitters.empty() &&
+             std::none_of(p.motions.begin(), p.motions.end(), [](const ObstacleMotion<D>& m) { return m.moves(); });
   s.tension = p.fluid.negative_pressure == NegativePressure::Allow;
   s.incompressible = p.method == SimulationMethod::Dfsph;
   s.boundary_particles = p.boundary.handling == BoundaryHandling::Particles;

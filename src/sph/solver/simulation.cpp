@@ -164,7 +164,7 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
   // start off rest density releases; the steps' energy leaves it out (it is >= 0).
   double energy = 0, mass = 0;
   for (const detail::HealthChunk& c : health_chunks_) energy += c.energy + c.internal, mass += c.mass;
-  monitor_.set_initial(energy, mass);
+  monitor_.set_initial(energy + body_energy(), mass);
 }
 
 template <int D, std::floating_point R>
@@ -579,7 +579,39 @@ HealthStats Simulation<D, R>::integrate_and_check(R dt) {
                       static_cast<double>(particles_.density[i]), static_cast<double>(particles_.pressure[i])));
     }
   }
-  return reduce_health();
+  HealthStats s = reduce_health();
+  s.energy += body_energy();
+  return s;
+}
+
+template <int D, std::floating_point R>
+double Simulation<D, R>::body_energy() const {
+  double e = 0, low = 0;  // (gravity's zero where the particles' is: the container's lowest point along g)
+  for (int d = 0; d < D; ++d)
+    low += std::max(params_.gravity[d] * params_.container.lo[d], params_.gravity[d] * params_.container.hi[d]);
+  for (std::size_t s = 0; s < bodies_.size(); ++s) {
+    const RigidBodyState<D>& b = bodies_[s];
+    const MassProperties<D>& mp = body_mass_[s];
+    // Kinetic (w . I_w w, in the body's frame), gravity's, and the container contact's springs.
+    const std::array<double, 9> r = quaternion_matrix(b.orientation);
+    double spin = 0;
+    for (int a = 0; a < 3; ++a) {
+      double w = 0;  // (R^T w)_a
+      for (int c = 0; c < 3; ++c) w += r[static_cast<std::size_t>(3 * c + a)] * b.angular_velocity[c];
+      spin += mp.inertia[a] * w * w;
+    }
+    e += 0.5 * mp.mass * norm2(b.velocity) + 0.5 * spin + mp.mass * (low - dot(params_.gravity, b.position));
+    const RigidPose<D> pose = body_pose(b, mp.center);
+    const Box<D>& box = params_.obstacles[body_obstacle_[s]];
+    for (int c = 0; c < (1 << D); ++c) {
+      const Vec<D, double> x = pose.place(box_corner<D>(box.lo, box.hi, c));
+      for (int d = 0; d < D; ++d) {
+        const double pen = std::max({params_.container.lo[d] - x[d], x[d] - params_.container.hi[d], 0.0});
+        e += 0.5 * mp.mass * contact_rate_ * contact_rate_ * pen * pen;
+      }
+    }
+  }
+  return e;
 }
 
 template <int D, std::floating_point R>

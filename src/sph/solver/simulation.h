@@ -191,6 +191,10 @@ class Simulation {
   HealthStats integrate_and_check(R dt);
   /// Folds the per-chunk statistics (in chunk order: the same for any thread count).
   HealthStats reduce_health() const;
+  /// The floating bodies' energy, J (J/m in 2D): kinetic (translation and rotation), gravity's
+  /// (from the container's lowest point along g, as the particles'), and the container contact's
+  /// springs. Part of the health monitor's energy.
+  double body_energy() const;
 
   SimulationParams<D> params_;
   ParticleSet<D, R> particles_;

@@ -18,11 +18,13 @@
 #include <sph/scene/scene_reader.h>
 
 #include "support/resume.h"
+#include "support/solids.h"
 #include "support/temp_dir.h"
 
 namespace sph {
 namespace {
 
+using test::deepest_inside;
 using test::slurp;
 using test::TempDir;
 
@@ -53,22 +55,6 @@ SceneDesc tank_with_box(double density, double bottom, double level, double stop
 /// Whether the run of `desc` has reached its end (a time, or fixed steps' count).
 bool finished(const SceneDesc& desc, const Simulation<2, double>& sim) {
   return desc.end_time > 0 ? sim.time() >= desc.end_time * (1 - 1e-12) : sim.steps_done() >= desc.steps;
-}
-
-/// The deepest any particle's centre is inside any obstacle where it is now (m; negative: all
-/// outside).
-double deepest_inside(const Simulation<2, double>& sim) {
-  const SimulationParams<2>& p = sim.params();
-  const std::vector<RigidPose<2>> poses = sim.obstacle_poses();
-  double deepest = -1e300;
-  for (std::size_t k = 0; k < p.obstacles.size(); ++k)
-    for (const auto& x : sim.particles().position) {
-      const Vec<2, double> X = poses[k].to_rest(x);
-      double depth = 1e300;
-      for (int d = 0; d < 2; ++d) depth = std::min({depth, X[d] - p.obstacles[k].lo[d], p.obstacles[k].hi[d] - X[d]});
-      deepest = std::max(deepest, depth);
-    }
-  return deepest;
 }
 
 /// Runs `desc` to its end: the body's centre height and the free surface's away from it, averaged
@@ -202,18 +188,26 @@ TEST(FloatingBody, In3DFluidAndATurningBodyExchangeMomentumExactly) {
   EXPECT_NEAR(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3], 1.0, 1e-14);
 }
 
+/// A 2D tank 1.2 m x 0.8 m with gravity, DFSPH and boundary particles, its fluid a small block
+/// out of the way in a corner, and `obstacles` (the Obstacles array's entries).
+SceneDesc dry_tank(const std::string& name, const std::string& obstacles) {
+  return parse_scene(fmt::format(R"({{
+    "version": 1, "name": "{}", "dimension": 2,
+    "Configuration": {{ "precision": "double", "timeStepSize": 0.004, "stopAt": 1.0, "particleRadius": 0.01,
+      "kernelRadius": 0.04, "gravitation": [0, -9.81], "boundaryHandling": "particles", "kernel": "cubic",
+      "simulationMethod": "dfsph", "outputFps": 0 }},
+    "Container": {{ "start": [0, 0], "end": [1.2, 0.8] }},
+    "FluidBlocks": [ {{ "start": [0, 0], "end": [0.1, 0.1] }} ],
+    "Obstacles": [ {} ]
+  }})",
+                                 name, obstacles),
+                     name + ".json");
+}
+
 TEST(FloatingBody, ABodyDroppedOnTheFloorRestsOnIt) {
   // The fluid is far off, in a corner; the box falls 0.1 m onto the container's floor.
-  const SceneDesc desc = parse_scene(R"({
-    "version": 1, "name": "drop", "dimension": 2,
-    "Configuration": { "precision": "double", "timeStepSize": 0.004, "stopAt": 1.0, "particleRadius": 0.01,
-      "kernelRadius": 0.04, "gravitation": [0, -9.81], "boundaryHandling": "particles", "kernel": "cubic",
-      "simulationMethod": "dfsph", "outputFps": 0 },
-    "Container": { "start": [0, 0], "end": [1.2, 0.8] },
-    "FluidBlocks": [ { "start": [0, 0], "end": [0.1, 0.1] } ],
-    "Obstacles": [ { "start": [0.6, 0.1], "end": [0.9, 0.2], "dynamic": true, "density": 500 } ]
-  })",
-                                     "drop.json");
+  const SceneDesc desc =
+      dry_tank("drop", R"({ "start": [0.6, 0.1], "end": [0.9, 0.2], "dynamic": true, "density": 500 })");
   RunDriver<2, double> run(desc, RunSettings{});
   const Simulation<2, double>& sim = run.simulation();
   double lowest = 1;
@@ -292,17 +286,8 @@ TEST(FloatingBody, BodiesMeetEachOtherAndTheRestingObstacles) {
     const Vec<2, double> p1 = momentum();
     for (int d = 0; d < 2; ++d) EXPECT_NEAR(p1[d], p0[d], 1e-12) << d;
   }
-  const SceneDesc stack = parse_scene(R"({
-    "version": 1, "name": "stack", "dimension": 2,
-    "Configuration": { "precision": "double", "timeStepSize": 0.004, "stopAt": 1.0, "particleRadius": 0.01,
-      "kernelRadius": 0.04, "gravitation": [0, -9.81], "boundaryHandling": "particles", "kernel": "cubic",
-      "simulationMethod": "dfsph", "outputFps": 0 },
-    "Container": { "start": [0, 0], "end": [1.2, 0.8] },
-    "FluidBlocks": [ { "start": [0, 0], "end": [0.1, 0.1] } ],
-    "Obstacles": [ { "start": [0.5, 0], "end": [1.0, 0.2] },
-                   { "start": [0.6, 0.3], "end": [0.9, 0.4], "dynamic": true, "density": 500 } ]
-  })",
-                                      "stack.json");
+  const SceneDesc stack = dry_tank("stack", R"({ "start": [0.5, 0], "end": [1.0, 0.2] },
+      { "start": [0.6, 0.3], "end": [0.9, 0.4], "dynamic": true, "density": 500 })");
   RunDriver<2, double> run(stack, RunSettings{});
   const Simulation<2, double>& sim = run.simulation();
   while (!finished(stack, sim)) run.step();

@@ -16,35 +16,19 @@
 #include <sph/scene/scene_reader.h>
 
 #include "support/resume.h"
+#include "support/solids.h"
 #include "support/temp_dir.h"
 
 namespace sph {
 namespace {
 
+using test::deepest_inside;
 using test::TempDir;
 
 struct ThreadCount {
   int saved = num_threads();
   ~ThreadCount() { set_num_threads(saved); }
 };
-
-/// The deepest any particle's centre is inside any moving obstacle, where its motion puts it at
-/// the simulation's time (m; negative: all outside).
-template <int D, std::floating_point R>
-double deepest_inside(const Simulation<D, R>& sim) {
-  const SimulationParams<D>& p = sim.params();
-  double deepest = -1e300;
-  for (std::size_t k = 0; k < p.obstacles.size(); ++k) {
-    const RigidPose<D> pose = pose_at(obstacle_motion(p, k), sim.time());
-    for (const auto& xr : sim.particles().position) {
-      const Vec<D, double> X = pose.to_rest(vec_cast<double>(xr));
-      double depth = 1e300;
-      for (int d = 0; d < D; ++d) depth = std::min({depth, X[d] - p.obstacles[k].lo[d], p.obstacles[k].hi[d] - X[d]});
-      deepest = std::max(deepest, depth);
-    }
-  }
-  return deepest;
-}
 
 /// Whether the time is on the scene's frame schedule (CFL steps land on it exactly).
 bool on_frame(double t, double fps) { return std::abs(t * fps - std::round(t * fps)) < 1e-6; }

@@ -7,6 +7,8 @@ packages=(
   build-essential cmake ninja-build pkg-config
   nlohmann-json3-dev libcli11-dev libfmt-dev libomp-dev
   libgtest-dev libgmock-dev libpng-dev
+  # Mesh obstacles (Obstacles[].geometryFile: OBJ, STL, PLY) through assimp.
+  libassimp-dev
   python3 python3-vtk9 python3-numpy
   # Surfaces (sph surface): OpenVDB's level sets (its CMake module needs Boost.Iostreams), and
   # its Python module, with which the tests read the .vdb files back.

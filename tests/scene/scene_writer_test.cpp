@@ -54,7 +54,11 @@ json every_key_3d() {
                      "motion": { "type": "rotation", "axis": [0, 0.6, 0.8], "center": [0.35, 0.1, 0.35],
                                  "angularVelocity": -1.5, "rampTime": 0.25 } },
                    { "start": [0.6, 0.3, 0.3], "end": [0.7, 0.35, 0.4], "dynamic": true, "density": 650,
-                     "velocity": [0.1, -0.2, 0.3], "angularVelocity": [0.5, -0.25, 2] } ],
+                     "velocity": [0.1, -0.2, 0.3], "angularVelocity": [0.5, -0.25, 2] },
+                   { "geometryFile": ")" SPH_SOURCE_DIR R"(/tests/data/meshes/cube.ply", "scale": [0.1, 0.2, 0.15],
+                     "translation": [0.7, 0.6, 0.45], "rotationAxis": [1, 2, 3], "rotationAngle": 0.3 },
+                   { "geometryFile": ")" SPH_SOURCE_DIR R"(/tests/data/meshes/cube.stl", "scale": [0.9, 1, 0.6],
+                     "translation": [-0.1, 0.1, 0], "inverted": true } ],
     "Emitters": [ { "translation": [0.05, 0.8, 0.35], "direction": [1, -0.3, 0.1], "velocity": 4.5, "width": 3,
                     "height": 2, "emitEveryNSteps": 40, "maxParticles": 120, "emitStartTime": 0.001,
                     "emitEndTime": 0.5 } ]
@@ -86,7 +90,10 @@ json every_key_2d() {
                                  "keys": [ { "time": 0.001, "translation": [0, 0], "rotation": 0 },
                                            { "time": 0.004, "translation": [0.05, 0.1], "rotation": 0.2 } ] } },
                    { "start": [0.85, 0.5], "end": [0.95, 0.55], "dynamic": true, "density": 700,
-                     "velocity": [-0.5, 0.25], "angularVelocity": 1.5 } ],
+                     "velocity": [-0.5, 0.25], "angularVelocity": 1.5 },
+                   { "polygon": [[0.3, 0.6], [0.6, 0.6], [0.5, 0.7], [0.6, 0.85], [0.3, 0.85]],
+                     "motion": { "type": "rotation", "angularVelocity": 0.5 } },
+                   { "polygon": [[-0.2, -0.2], [1.2, -0.2], [1.2, 1.2], [-0.2, 1.2]], "inverted": true } ],
     "Emitters": [ { "translation": [0.05, 0.5], "direction": [3, 7], "velocity": 20.0, "width": 4,
                     "emitEveryNSteps": 12, "maxParticles": 100, "emitStartTime": 0.25, "emitEndTime": 1e300 } ]
   })");
@@ -178,7 +185,13 @@ TEST(SceneWriter, WritesEveryDeclaredKeyOfEveryObject) {
       obstacle_keys.insert(keys.begin(), keys.end());
       EXPECT_EQ(keys.count("density"), o["dynamic"].get<bool>() ? 1u : 0u);
     }
-    EXPECT_EQ(obstacle_keys, set_of(sph::detail::kObstacleKeys));
+    // (a 2D obstacle has no mesh keys, a 3D one no polygon)
+    std::set<std::string> expected = set_of(sph::detail::kObstacleKeys);
+    if (d.dimension == 2)
+      for (const char* k : {"geometryFile", "translation", "rotationAxis", "rotationAngle", "scale"}) expected.erase(k);
+    else
+      expected.erase("polygon");
+    EXPECT_EQ(obstacle_keys, expected);
     for (const json& o : w["Obstacles"]) {  // each motion with every key of its type
       const sph::MotionType type =
           sph::detail::value_named(sph::detail::kMotionTypeNames, o["motion"]["type"].get<std::string>());

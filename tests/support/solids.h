@@ -9,8 +9,8 @@
 
 namespace sph::test {
 
-/// The deepest any particle's centre is inside any obstacle, measured in the obstacle's own frame
-/// (m; negative: all outside).
+/// The deepest any particle's centre is inside any obstacle (a box or a shape), measured in the
+/// obstacle's own frame (m; negative: all outside, by at least that much).
 template <int D, std::floating_point R>
 double deepest_inside(const Simulation<D, R>& sim) {
   const SimulationParams<D>& p = sim.params();
@@ -19,9 +19,8 @@ double deepest_inside(const Simulation<D, R>& sim) {
   for (std::size_t k = 0; k < p.obstacles.size(); ++k)
     for (const auto& xr : sim.particles().position) {
       const Vec<D, double> X = poses[k].to_rest(vec_cast<double>(xr));
-      double depth = 1e300;
-      for (int d = 0; d < D; ++d) depth = std::min({depth, X[d] - p.obstacles[k].lo[d], p.obstacles[k].hi[d] - X[d]});
-      deepest = std::max(deepest, depth);
+      // (a box's or a shape's signed distance, exact inside the solid)
+      deepest = std::max(deepest, -obstacle_distance(p, k, X, 0.0).distance);
     }
   return deepest;
 }

@@ -79,10 +79,10 @@ void FrameWriter<D, R>::write(const Simulation<D, R>& sim) {
     write_frame(f, dir_ / frame_name(index, f), sim.particles(), sim.time(), fields_);
   if (!sim.params().obstacles.empty()) {
     const std::vector<RigidPose<D>> poses = sim.obstacle_poses();
-    write_solids_vtp<D>(dir_ / solids_name(index), sim.params().obstacles, poses, sim.time());
+    write_solids_vtp<D>(dir_ / solids_name(index), sim.params().obstacles, poses, sim.time(), sim.params().shapes);
     if (std::find(output_.formats.begin(), output_.formats.end(), FrameFormat::Ply) != output_.formats.end())
       write_solids_ply<D>(dir_ / fmt::format("frames/solids_{:06d}.ply", index), sim.params().obstacles, poses,
-                          sim.time());
+                          sim.time(), sim.params().shapes);
     solids_ = true;
   }
   // The floating bodies: a row each in bodies.csv (kBodyColumns).

@@ -51,6 +51,16 @@ SolidBox placed_box(const SimulationParams<D>& sim, std::size_t k, const RigidPo
     s.center[a] = pose.center[a];
     s.translation[a] = pose.translation[a];
   }
+  if (const ObstacleShape<D>* shape = obstacle_shape(sim, k)) {
+    for (const auto& v : shape->vertices) {
+      std::array<double, 3> x{};
+      for (int a = 0; a < D; ++a) x[static_cast<std::size_t>(a)] = v[a];
+      s.vertices.push_back(x);
+    }
+    if constexpr (D == 3)
+      for (const auto& t : shape->faces) s.triangles.push_back(t);
+    s.inverted = shape->inverted;
+  }
   return s;
 }
 

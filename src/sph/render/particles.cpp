@@ -99,6 +99,8 @@ constexpr double kFaceDiffuse = 0.45;
 /// with its depth, affine over the face: depth(x, y) = w0 + gx (x - q[0].x) + gy (y - q[0].y).
 struct Face {
   std::array<std::array<double, 2>, 4> q{};
+  int n = 4;            // corners: 4, or 3 (a mesh's triangle)
+  bool outline = true;  // the outline along its sides (a box's faces; not a mesh's triangles)
   double w0 = 0, gx = 0, gy = 0;
   Rgb color;
 };
@@ -114,17 +116,17 @@ struct PixelBounds {
 /// is nearer than `depth` holds, which it then updates. A face of no area paints nothing.
 void fill_face(Image& img, const Face& f, double edge, std::vector<float>* depth, PixelBounds& painted) {
   double area2 = 0;  // twice the signed area: its sign tells which side of each edge is inside
-  for (int k = 0; k < 4; ++k) {
+  for (int k = 0; k < f.n; ++k) {
     const auto& a = f.q[k];
-    const auto& b = f.q[(k + 1) % 4];
+    const auto& b = f.q[(k + 1) % f.n];
     area2 += a[0] * b[1] - a[1] * b[0];
   }
   if (!(std::abs(area2) > 1e-9)) return;
-  // Inward unit normals of the four sides (nx, ny) and offsets: distance = nx x + ny y - off.
+  // Inward unit normals of the sides (nx, ny) and offsets: distance = nx x + ny y - off.
   std::array<std::array<double, 3>, 4> side{};
-  for (int k = 0; k < 4; ++k) {
+  for (int k = 0; k < f.n; ++k) {
     const auto& a = f.q[k];
-    const auto& b = f.q[(k + 1) % 4];
+    const auto& b = f.q[(k + 1) % f.n];
     const double ex = b[0] - a[0], ey = b[1] - a[1], len = std::hypot(ex, ey);
     if (!(len > 0)) return;
     const double sign = area2 > 0 ? 1.0 : -1.0;
@@ -132,7 +134,8 @@ void fill_face(Image& img, const Face& f, double edge, std::vector<float>* depth
     side[k] = {nx, ny, nx * a[0] + ny * a[1]};
   }
   double lo_x = f.q[0][0], hi_x = lo_x, lo_y = f.q[0][1], hi_y = lo_y;
-  for (const auto& c : f.q) {
+  for (int k = 0; k < f.n; ++k) {
+    const auto& c = f.q[k];
     lo_x = std::min(lo_x, c[0]);
     hi_x = std::max(hi_x, c[0]);
     lo_y = std::min(lo_y, c[1]);
@@ -146,7 +149,7 @@ void fill_face(Image& img, const Face& f, double edge, std::vector<float>* depth
     for (int x = xa; x <= xb; ++x) {
       const double px = x + 0.5;
       double inside = HUGE_VAL;  // distance to the nearest side, negative outside
-      for (const auto& s : side) inside = std::min(inside, s[0] * px + s[1] * py - s[2]);
+      for (int k = 0; k < f.n; ++k) inside = std::min(inside, side[k][0] * px + side[k][1] * py - side[k][2]);
       if (inside < 0.0) continue;
       if (depth != nullptr) {
         const float w = static_cast<float>(f.w0 + f.gx * (px - f.q[0][0]) + f.gy * (py - f.q[0][1]));
@@ -154,7 +157,7 @@ void fill_face(Image& img, const Face& f, double edge, std::vector<float>* depth
         if (!(w > held)) continue;
         held = w;
       }
-      row[x] = inside < edge ? kSolidEdgeColor : f.color;
+      row[x] = f.outline && inside < edge ? kSolidEdgeColor : f.color;
       painted.x0 = std::min(painted.x0, x);
       painted.x1 = std::max(painted.x1, x);
       painted.y0 = std::min(painted.y0, y);
@@ -171,6 +174,42 @@ double solid_edge_width(const Image& img) { return 0.75 + std::min(img.width(), 
 /// face is turned to the camera by its rotated normal R e_a.
 std::vector<Face> solid_faces(const SolidBox& box, int dim, const ParticleCamera& cam) {
   std::vector<Face> faces;
+  if (dim == 3 && !box.vertices.empty()) {
+    // A mesh: its triangles turned to the camera (away from it when inverted), flat-shaded.
+    const auto& axes = cam.axes();
+    for (const auto& t : box.triangles) {
+      Vec3 p[3];
+      for (int k = 0; k < 3; ++k) p[k] = box.place(box.vertices[t[static_cast<std::size_t>(k)]], 3);
+      const Vec3 u{p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
+      const Vec3 v{p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
+      Vec3 normal{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+      const double length = std::sqrt(dot(normal, normal));
+      if (!(length > 0)) continue;
+      const double sign = box.inverted ? -1.0 : 1.0;
+      for (double& c : normal) c *= sign / length;
+      const Vec3 n_cam{dot(normal, axes[0]), dot(normal, axes[1]), dot(normal, axes[2])};
+      if (!(n_cam[2] > 1e-9)) continue;
+      Face f;
+      f.n = 3;
+      f.outline = false;
+      std::array<double, 3> w{};
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 s = cam.project(p[k]);
+        f.q[k] = {s[0], s[1]};
+        w[k] = s[2];
+      }
+      const double ax = f.q[1][0] - f.q[0][0], ay = f.q[1][1] - f.q[0][1];
+      const double bx = f.q[2][0] - f.q[0][0], by = f.q[2][1] - f.q[0][1];
+      const double det = ax * by - ay * bx;
+      if (!(std::abs(det) > 1e-12)) continue;
+      f.w0 = w[0];
+      f.gx = ((w[1] - w[0]) * by - (w[2] - w[0]) * ay) / det;
+      f.gy = ((w[2] - w[0]) * ax - (w[1] - w[0]) * bx) / det;
+      f.color = scaled(kSolidColor, kFaceAmbient + kFaceDiffuse * std::max(0.0, dot(n_cam, kFaceLight)));
+      faces.push_back(f);
+    }
+    return faces;
+  }
   if (dim == 2) {
     Face f;
     const Vec3 corners[4] = {
@@ -216,6 +255,40 @@ std::vector<Face> solid_faces(const SolidBox& box, int dim, const ParticleCamera
     }
   }
   return faces;
+}
+
+/// A 2D polygon solid: filled with kSolidColor (pixels whose centers it holds, by the even-odd
+/// rule), unless it is inverted, and outlined in kSolidEdgeColor.
+void draw_polygon(Image& img, const SolidBox& s, const ParticleCamera& cam) {
+  std::vector<std::array<double, 2>> q;
+  for (const auto& v : s.vertices) {
+    const Vec3 p = cam.project(s.place(v, 2));
+    q.push_back({p[0], p[1]});
+  }
+  const std::size_t n = q.size();
+  if (!s.inverted) {
+    double lo_y = q[0][1], hi_y = lo_y;
+    for (const auto& c : q) lo_y = std::min(lo_y, c[1]), hi_y = std::max(hi_y, c[1]);
+    const int ya = detail::floor_clamped(lo_y, 0, img.height()), yb = detail::ceil_clamped(hi_y, -1, img.height() - 1);
+    std::vector<double> xs;
+    for (int y = ya; y <= yb; ++y) {
+      const double py = y + 0.5;
+      xs.clear();
+      for (std::size_t k = 0; k < n; ++k) {
+        const auto& a = q[k];
+        const auto& b = q[(k + 1) % n];
+        if ((a[1] <= py) != (b[1] <= py)) xs.push_back(a[0] + (py - a[1]) / (b[1] - a[1]) * (b[0] - a[0]));
+      }
+      std::sort(xs.begin(), xs.end());
+      for (std::size_t k = 0; k + 1 < xs.size(); k += 2) {
+        const int xa = detail::floor_clamped(xs[k] - 0.5, -1, img.width() - 1) + 1;
+        const int xb = detail::ceil_clamped(xs[k + 1] - 0.5, 0, img.width()) - 1;
+        for (int x = std::max(xa, 0); x <= std::min(xb, img.width() - 1); ++x) img.set(x, y, kSolidColor);
+      }
+    }
+  }
+  for (std::size_t k = 0; k < n; ++k)
+    img.draw_line(q[k][0], q[k][1], q[(k + 1) % n][0], q[(k + 1) % n][1], kSolidEdgeColor, solid_edge_width(img));
 }
 
 /// Throws sph::Error for a solid with non-finite corners or placement, or lo > hi.
@@ -448,8 +521,13 @@ Image render_particles(std::span<const double> xyz, int dim, std::span<const Rgb
   // monitor, not the picture, is what reports a leak).
   if (dim == 2) {
     PixelBounds painted;
-    for (const SolidBox& s : solids)
+    for (const SolidBox& s : solids) {
+      if (!s.vertices.empty()) {
+        draw_polygon(img, s, cam);
+        continue;
+      }
       for (const Face& f : solid_faces(s, dim, cam)) fill_face(img, f, solid_edge_width(img), nullptr, painted);
+    }
   }
   return img;
 }

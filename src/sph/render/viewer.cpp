@@ -425,12 +425,27 @@ std::string json_vec3(const std::array<double, 3>& v) {
   return fmt::format("[{},{},{}]", json_number(v[0]), json_number(v[1]), json_number(v[2]));
 }
 
-/// The scene's obstacles at rest as [{"lo": [x, y, z], "hi": [x, y, z]}, ...] (z = 0 in 2D); a
+/// The scene's obstacles at rest as [{"lo": [x, y, z], "hi": [x, y, z]}, ...] (z = 0 in 2D), a polygon or
+/// mesh with its vertices "v", triangles "f" (3D) and "inv" (inverted); a
 /// moving one's frames place them ("poses", poses_json).
 std::string obstacles_json(const RunDirectory& run) {
   std::string out = "[";
-  for (const SolidBox& b : run_obstacles(run, 0.0))
-    out += fmt::format("{}{{\"lo\":{},\"hi\":{}}}", out.size() > 1 ? "," : "", json_vec3(b.lo), json_vec3(b.hi));
+  for (const SolidBox& b : run_obstacles(run, 0.0)) {
+    out += fmt::format("{}{{\"lo\":{},\"hi\":{}", out.size() > 1 ? "," : "", json_vec3(b.lo), json_vec3(b.hi));
+    if (!b.vertices.empty()) {  // a polygon or mesh: its vertices at rest ("v"), triangles ("f"), "inv"
+      out += ",\"v\":[";
+      for (std::size_t i = 0; i < b.vertices.size(); ++i) out += (i ? "," : "") + json_vec3(b.vertices[i]);
+      out += "]";
+      if (!b.triangles.empty()) {
+        out += ",\"f\":[";
+        for (std::size_t i = 0; i < b.triangles.size(); ++i)
+          out += fmt::format("{}[{},{},{}]", i ? "," : "", b.triangles[i][0], b.triangles[i][1], b.triangles[i][2]);
+        out += "]";
+      }
+      out += fmt::format(",\"inv\":{}", b.inverted);
+    }
+    out += '}';
+  }
   out += ']';
   return out;
 }

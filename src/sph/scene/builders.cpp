@@ -15,17 +15,65 @@ std::array<std::int64_t, D> lattice_counts(const Box<D>& b, double dx) {
   for (int d = 0; d < D; ++d) n[d] = static_cast<std::int64_t>(std::floor((b.hi[d] - b.lo[d]) / dx + 1e-9));
   return n;
 }
+
+/// Calls f(x) for each lattice site of block `blk` (spacing dx, the first half a spacing inside its
+/// lower corner), x fastest.
+template <int D, class F>
+void for_each_block_site(const FluidBlockDesc<D>& blk, double dx, F&& f) {
+  const auto n = lattice_counts<D>(blk.box, dx);
+  std::array<std::int64_t, 3> m{n[0], n[1], D == 3 ? n[D - 1] : 1};
+  for (std::int64_t k = 0; k < m[2]; ++k)
+    for (std::int64_t j = 0; j < m[1]; ++j)
+      for (std::int64_t i = 0; i < m[0]; ++i) {
+        Vec<D, double> x;
+        const std::int64_t idx[3] = {i, j, k};
+        for (int d = 0; d < D; ++d) x[d] = blk.box.lo[d] + (static_cast<double>(idx[d]) + 0.5) * dx;
+        f(x);
+      }
+}
+
+template <int D>
+std::size_t lattice_size(const FluidBlockDesc<D>& blk, double dx) {
+  std::size_t c = 1;
+  for (auto k : lattice_counts<D>(blk.box, dx)) c *= static_cast<std::size_t>(k);
+  return c;
+}
 }  // namespace
 
 template <int D>
-std::size_t count_block_particles(const SceneBody<D>& body) {
+bool block_particle_kept(const SimulationParams<D>& sim, const Vec<D, double>& x) {
+  const double r = sim.particle_radius;
+  for (std::size_t k = 0; k < sim.shapes.size(); ++k)
+    if (obstacle_shape(sim, k) && obstacle_distance(sim, k, x, r).distance < r) return false;
+  return true;
+}
+
+template <int D>
+std::vector<BlockCount> count_block_particles_kept(const SceneBody<D>& body) {
   const double dx = 2.0 * body.sim.particle_radius;
-  std::size_t total = 0;
+  std::vector<BlockCount> out;
   for (const auto& blk : body.blocks) {
-    std::size_t c = 1;
-    for (auto k : lattice_counts<D>(blk.box, dx)) c *= static_cast<std::size_t>(k);
-    total += c;
+    BlockCount c;
+    c.lattice = lattice_size<D>(blk, dx);
+    if (!any_shape(body.sim)) {
+      c.kept = c.lattice;
+    } else {
+      for_each_block_site<D>(blk, dx, [&](const Vec<D, double>& x) { c.kept += block_particle_kept(body.sim, x); });
+    }
+    out.push_back(c);
   }
+  return out;
+}
+
+template <int D>
+std::size_t count_block_particles(const SceneBody<D>& body) {
+  std::size_t total = 0;
+  if (any_shape(body.sim)) {
+    for (const BlockCount& c : count_block_particles_kept<D>(body)) total += c.kept;
+    return total;
+  }
+  const double dx = 2.0 * body.sim.particle_radius;
+  for (const auto& blk : body.blocks) total += lattice_size<D>(blk, dx);
   return total;
 }
 
@@ -34,26 +82,22 @@ ParticleSet<D, R> build_particles(const SceneBody<D>& body) {
   const double dx = 2.0 * body.sim.particle_radius;
   ParticleSet<D, R> ps;
   ps.reserve(count_block_particles<D>(body));
+  const bool shapes = any_shape(body.sim);
   for (std::size_t bi = 0; bi < body.blocks.size(); ++bi) {
     const auto& blk = body.blocks[bi];
-    const auto n = lattice_counts<D>(blk.box, dx);
-    std::array<std::int64_t, 3> m{n[0], n[1], D == 3 ? n[D - 1] : 1};
-    for (std::int64_t k = 0; k < m[2]; ++k)
-      for (std::int64_t j = 0; j < m[1]; ++j)
-        for (std::int64_t i = 0; i < m[0]; ++i) {
-          Vec<D, double> x;
-          const std::int64_t idx[3] = {i, j, k};
-          for (int d = 0; d < D; ++d) x[d] = blk.box.lo[d] + (static_cast<double>(idx[d]) + 0.5) * dx;
-          for (std::size_t oi = 0; oi < body.sim.obstacles.size(); ++oi) {
-            const auto& o = body.sim.obstacles[oi];
-            bool in = true;
-            for (int d = 0; d < D; ++d) in = in && x[d] > o.lo[d] && x[d] < o.hi[d];
-            if (in)
-              throw Error(fmt::format("the fluid block overlaps Obstacles[{}]; move the block or the obstacle", oi),
-                          fmt::format("FluidBlocks[{}]", bi));
-          }
-          ps.add(vec_cast<R>(x), vec_cast<R>(blk.velocity), static_cast<R>(body.sim.particle_mass));
-        }
+    for_each_block_site<D>(blk, dx, [&](const Vec<D, double>& x) {
+      if (shapes && !block_particle_kept(body.sim, x)) return;
+      for (std::size_t oi = 0; oi < body.sim.obstacles.size(); ++oi) {
+        if (obstacle_shape(body.sim, oi)) continue;
+        const auto& o = body.sim.obstacles[oi];
+        bool in = true;
+        for (int d = 0; d < D; ++d) in = in && x[d] > o.lo[d] && x[d] < o.hi[d];
+        if (in)
+          throw Error(fmt::format("the fluid block overlaps Obstacles[{}]; move the block or the obstacle", oi),
+                      fmt::format("FluidBlocks[{}]", bi));
+      }
+      ps.add(vec_cast<R>(x), vec_cast<R>(blk.velocity), static_cast<R>(body.sim.particle_mass));
+    });
   }
   return ps;
 }
@@ -109,6 +153,10 @@ double estimated_run_bytes(const SceneDesc& desc) {
 
 template std::size_t count_block_particles<2>(const SceneBody<2>&);
 template std::size_t count_block_particles<3>(const SceneBody<3>&);
+template bool block_particle_kept<2>(const SimulationParams<2>&, const Vec<2, double>&);
+template bool block_particle_kept<3>(const SimulationParams<3>&, const Vec<3, double>&);
+template std::vector<BlockCount> count_block_particles_kept<2>(const SceneBody<2>&);
+template std::vector<BlockCount> count_block_particles_kept<3>(const SceneBody<3>&);
 #define SPH_INSTANTIATE(D, R)                                            \
   template ParticleSet<D, R> build_particles<D, R>(const SceneBody<D>&); \
   template Simulation<D, R> make_simulation<D, R>(const SceneDesc&);

@@ -8,10 +8,23 @@
 namespace sph {
 
 /// Fills each fluid block with particles on a lattice of spacing 2 * particleRadius, the first
-/// particle half a spacing inside the block's lower corner. Particles get ids in block order.
-/// Throws sph::Error if a block overlaps an obstacle.
+/// particle half a spacing inside the block's lower corner, leaving out the sites in or near an
+/// obstacle's shape (block_particle_kept). Particles get ids in block order.
+/// Throws sph::Error if a block overlaps a box obstacle.
 template <int D, std::floating_point R>
 ParticleSet<D, R> build_particles(const SceneBody<D>& body);
+
+/// Whether a fluid block's lattice site x keeps its particle: not inside an obstacle's shape
+/// (shape.h), nor closer than a particle radius to its surface (box obstacles refuse the block).
+template <int D>
+bool block_particle_kept(const SimulationParams<D>& sim, const Vec<D, double>& x);
+
+/// A block's lattice sites, and the particles build_particles keeps of them.
+struct BlockCount {
+  std::size_t lattice = 0, kept = 0;
+};
+template <int D>
+std::vector<BlockCount> count_block_particles_kept(const SceneBody<D>& body);
 
 /// The number of particles build_particles would create (without creating them).
 template <int D>

@@ -77,7 +77,9 @@ void check_obstacles_inside(const ReadContext& ctx, const SimulationParams<D>& s
       inside = inside && o.lo[d] >= c.lo[d] && o.hi[d] <= c.hi[d];
       apart = apart || o.hi[d] <= c.lo[d] || o.lo[d] >= c.hi[d];
     }
-    if (inside) continue;
+    // (a shape may reach past the walls: its samples and springs there are dropped, so a mesh
+    // floor wider than the container is fine)
+    if (inside || (obstacle_shape(sim, i) && !apart)) continue;
     const std::string where = fmt::format("Obstacles[{}]", i);
     if (apart)
       ctx.fail(where, fmt::format("the obstacle {} lies wholly outside the container {}: it can never touch the "
@@ -178,7 +180,7 @@ void check_motions(const ReadContext& ctx, SceneDesc& desc, const SimulationPara
 template <int D>
 void check_obstacles_leave_room(const ReadContext& ctx, const SimulationParams<D>& sim) {
   if (sim.obstacles.empty()) return;
-  const double free = detail::free_volume<D>(sim.container, sim.obstacles);
+  const double free = detail::free_volume<D>(sim.container, detail::box_obstacles(sim));
   if (free > 1e-9 * detail::volume<D>(sim.container)) return;
   ctx.fail("Obstacles", fmt::format("the {} obstacles cover the whole container {}: there is no room for the fluid; "
                                     "make them smaller or the container larger",
@@ -249,12 +251,30 @@ void check_blocks_apart(const ReadContext& ctx, const SceneBody<D>& body) {
     }
 }
 
-/// A block with a particle inside an obstacle (build_particles refuses it too, later).
+/// A block with a particle inside a box obstacle is refused (build_particles refuses it too,
+/// later); the particles of a block in or near a shape are left out (block_particle_kept), with a
+/// warning that says how many, and a block left with none is refused.
 template <int D>
-void check_blocks_clear_of_obstacles(const ReadContext& ctx, const SceneBody<D>& body) {
+void check_blocks_clear_of_obstacles(const ReadContext& ctx, SceneDesc& desc, const SceneBody<D>& body) {
   const double dx = 2.0 * body.sim.particle_radius;
+  if (any_shape(body.sim)) {
+    const std::vector<BlockCount> counts = count_block_particles_kept<D>(body);
+    for (std::size_t bi = 0; bi < counts.size(); ++bi) {
+      const BlockCount& c = counts[bi];
+      if (c.lattice == c.kept) continue;
+      if (c.kept == 0)
+        ctx.fail(fmt::format("FluidBlocks[{}]", bi),
+                 "the fluid block lies wholly inside the obstacles' shapes (or "
+                 "within a particle radius of them): move it");
+      desc.warnings.push_back(fmt::format(
+          "FluidBlocks[{}]: {} of its {} particles are inside an obstacle's shape or within a particle radius of its "
+          "surface, and are left out",
+          bi, c.lattice - c.kept, c.lattice));
+    }
+  }
   for (std::size_t bi = 0; bi < body.blocks.size(); ++bi)
     for (std::size_t oi = 0; oi < body.sim.obstacles.size(); ++oi) {
+      if (obstacle_shape(body.sim, oi)) continue;
       const Box<D>& b = body.blocks[bi].box;
       const Box<D>& o = body.sim.obstacles[oi];
       if (!lattice_enters<D>(b, dx, o)) continue;
@@ -295,7 +315,7 @@ void check_allow_on_free_surface(SceneDesc& desc, const SceneBody<D>& body) {
   const SimulationParams<D>& sim = body.sim;
   if (sim.fluid.negative_pressure != NegativePressure::Allow) return;
   const double dx = 2.0 * sim.particle_radius;
-  const double room = detail::free_volume<D>(sim.container, sim.obstacles);
+  const double room = detail::free_volume<D>(sim.container, detail::box_obstacles(sim));
   const double fluid = static_cast<double>(count_block_particles<D>(body)) * std::pow(dx, D);
   const double filled = room > 0 ? fluid / room : 1;
   if (sim.emitters.empty() && filled >= 0.99) return;  // the fluid fills the container: no free surface
@@ -339,7 +359,7 @@ void preflight(SceneDesc& desc, const detail::ReadContext& ctx) {
   check_obstacles_leave_room<D>(ctx, sim);
   check_coordinates<D>(ctx, desc, sim);
   check_blocks_apart<D>(ctx, body);
-  check_blocks_clear_of_obstacles<D>(ctx, body);
+  check_blocks_clear_of_obstacles<D>(ctx, desc, body);
   detail::check_emitters<D>(ctx, desc, body);
   check_mass<D>(ctx, desc, sim);
   check_allow_on_free_surface<D>(desc, body);

@@ -137,13 +137,27 @@ void check_inside(const ReadContext& ctx, const Nozzle<D>& n, const SimulationPa
                                box_text<D>(sim.container), r, advice));
 }
 
+/// The first nozzle particle (shifted) inside obstacle k or closer than r to it: its box grown by r
+/// (particle_in), or for a shape (shape.h) its signed distance below r.
+template <int D>
+std::optional<std::array<int, 2>> particle_in_obstacle(const Nozzle<D>& n, const Vec<D, double>& shift,
+                                                       const SimulationParams<D>& sim, std::size_t k, double r) {
+  const ObstacleShape<D>* shape = obstacle_shape(sim, k);
+  if (!shape) return particle_in<D>(n, shift, grown<D>(sim.obstacles[k], r));
+  if (!shape->inverted && !particle_in<D>(n, shift, grown<D>(sim.obstacles[k], r))) return std::nullopt;
+  for (int b = 0; b < n.rows(); ++b)
+    for (int a = 0; a < n.e.width; ++a)
+      if (obstacle_distance(sim, k, n.at(a, b) + shift, r).distance < r) return std::array<int, 2>{a, b};
+  return std::nullopt;
+}
+
 /// Every nozzle particle clear (by a particle radius) of every obstacle and of the initial fluid.
 template <int D>
 void check_clear(const ReadContext& ctx, const Nozzle<D>& n, const SceneBody<D>& body) {
   const SimulationParams<D>& sim = body.sim;
   const double r = sim.particle_radius, dx = 2 * r;
   for (std::size_t i = 0; i < sim.obstacles.size(); ++i)
-    if (const auto p = particle_in<D>(n, Vec<D, double>{}, grown<D>(sim.obstacles[i], r)))
+    if (const auto p = particle_in_obstacle<D>(n, Vec<D, double>{}, sim, i, r))
       ctx.fail(n.name, fmt::format("the nozzle's particle {}, at {}, is inside Obstacles[{}] {} or closer "
                                    "than a particle radius ({:g} m) to it: the emitter would place particles in the "
                                    "solid; move \"translation\" or the obstacle",
@@ -181,6 +195,7 @@ void check_swept(SceneDesc& desc, const Nozzle<D>& n, const SceneDesc& scene, co
       for (int b = 0; b < n.rows(); ++b)
         for (int a = 0; a < n.e.width; ++a)
           if (const Vec<D, double> X = pose.to_rest(n.at(a, b)); [&] {
+                if (obstacle_shape(sim, k)) return obstacle_distance(sim, k, X, r).distance < r;
                 for (int d = 0; d < D; ++d)
                   if (!(X[d] > solid.lo[d] && X[d] < solid.hi[d])) return false;
                 return true;
@@ -208,7 +223,7 @@ void check_path(SceneDesc& desc, const Nozzle<D>& n, const SceneBody<D>& body) {
     const Vec<D, double> shift = n.e.direction * ahead;
     std::string hit;
     for (std::size_t i = 0; i < sim.obstacles.size() && hit.empty(); ++i)
-      if (particle_in<D>(n, shift, grown<D>(sim.obstacles[i], r)))
+      if (particle_in_obstacle<D>(n, shift, sim, i, r))
         hit = fmt::format("Obstacles[{}] {}", i, box_text<D>(sim.obstacles[i]));
     for (std::size_t i = 0; i < body.blocks.size() && hit.empty(); ++i)
       if (particle_in<D>(n, shift, grown<D>(filled_box<D>(body.blocks[i].box, dx), r)))
@@ -283,7 +298,7 @@ void check_room(const ReadContext& ctx, const SceneDesc& desc, const SceneBody<D
   const double blocks = static_cast<double>(count_block_particles<D>(body));
   double emitted = 0;
   for (const auto& e : sim.emitters) emitted += static_cast<double>(emitted_in_run<D>(e, desc.steps, sim.time_step));
-  const double room = free_volume<D>(sim.container, sim.obstacles);
+  const double room = free_volume<D>(sim.container, box_obstacles(sim));
   if ((blocks + emitted) * cell <= room * (1 + 1e-9)) return;
   ctx.fail("Emitters", fmt::format("the {:.0f} particles of the fluid blocks and the {:.0f} the emitters add in the "
                                    "run take {:.4g} m^{} at rest (a spacing^{} each), more than the {:.4g} m^{} the "

@@ -50,6 +50,16 @@ Box<D> intersection(const Box<D>& a, const Box<D>& b) {
   return r;
 }
 
+/// The obstacles that are boxes: the room checks leave the shapes (shape.h) out, whose bounds
+/// are all they know of them as boxes.
+template <int D>
+std::vector<Box<D>> box_obstacles(const SimulationParams<D>& sim) {
+  std::vector<Box<D>> boxes;
+  for (std::size_t k = 0; k < sim.obstacles.size(); ++k)
+    if (!obstacle_shape(sim, k)) boxes.push_back(sim.obstacles[k]);
+  return boxes;
+}
+
 /// The volume of the container not covered by any obstacle: exact (the cells between the
 /// obstacles' coordinates) while that grid has at most ~1e7 cells x obstacles; beyond it the
 /// container's volume less the largest obstacle's (an upper bound, so that a refusal on it is

@@ -46,8 +46,9 @@ inline const std::vector<std::string> kFluidKeys{
     "negativePressure", "pressureForce", "gradientCorrection", "particleMass"};
 inline const std::vector<std::string> kContainerKeys{"start", "end", "wallStiffness", "wallDamping"};
 inline const std::vector<std::string> kFluidBlockKeys{"start", "end", "velocity"};
-inline const std::vector<std::string> kObstacleKeys{"start",   "end",      "motion",         "dynamic",
-                                                    "density", "velocity", "angularVelocity"};
+inline const std::vector<std::string> kObstacleKeys{
+    "start",   "end",      "geometryFile", "translation", "rotationAxis", "rotationAngle", "scale",
+    "polygon", "inverted", "motion",       "dynamic",     "density",      "velocity",      "angularVelocity"};
 /// The keys of an obstacle's motion of each type (Obstacles[].motion; "type" first), in D
 /// dimensions: a 2D rotation turns about the z axis, so it has no "axis".
 inline std::vector<std::string> motion_keys(MotionType type, int dimension) {

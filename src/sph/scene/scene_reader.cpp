@@ -15,6 +15,7 @@
 #include <sph/neighbors/neighbor_mode.h>
 #include <sph/scene/direction.h>
 #include <sph/scene/json_source.h>
+#include <sph/scene/mesh_reader.h>
 #include <sph/scene/object_reader.h>
 #include <sph/scene/overrides.h>
 #include <sph/scene/preflight.h>
@@ -149,6 +150,126 @@ ObstacleMotion<D> read_motion(ObjectReader& o, const Box<D>& box) {
     }
   });
   return m;
+}
+
+/// A path in a scene, relative to the scene file's directory (to the working directory for a
+/// scene given as text), as an absolute path.
+std::string scene_relative_path(const std::string& source, const std::string& file) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path p(file);
+  if (p.is_relative() && fs::is_regular_file(fs::path(source), ec)) p = fs::path(source).parent_path() / p;
+  return fs::absolute(p, ec).lexically_normal().string();
+}
+
+/// The keys of a mesh obstacle's transform (3D).
+constexpr std::array<const char*, 4> kMeshTransformKeys{"translation", "rotationAxis", "rotationAngle", "scale"};
+
+/// An obstacle's solid: its box ("start", "end"), or its shape (3D: "geometryFile" and its
+/// transform; 2D: "polygon"; either may be "inverted"), with `box` its bounds.
+template <int D>
+ObstacleShape<D> read_solid(ObjectReader& o, Box<D>& box) {
+  const bool mesh = o.find("geometryFile") != nullptr, polygon = o.find("polygon") != nullptr;
+  const char* shape_key = mesh ? "geometryFile" : "polygon";
+  if (mesh && polygon)
+    o.ctx().fail(o.child("polygon"),
+                 "an obstacle is a box (\"start\", \"end\"), a mesh (\"geometryFile\", 3D) or a "
+                 "polygon (\"polygon\", 2D); give one");
+  if (!mesh && !polygon) {
+    for (const char* key : kMeshTransformKeys)
+      if (o.find(key))
+        o.ctx().fail(o.child(key),
+                     "only a mesh obstacle (\"geometryFile\") takes this key; a box is placed by "
+                     "\"start\" and \"end\"");
+    if (o.find("inverted"))
+      o.ctx().fail(o.child("inverted"),
+                   "only a mesh or polygon obstacle can be inverted (the fluid inside it); the "
+                   "container box already holds the fluid inside a box");
+    box = read_box<D>(o, "obstacle");
+    return {};
+  }
+  for (const char* key : {"start", "end"})
+    if (o.find(key))
+      o.ctx().fail(o.child(key), fmt::format("an obstacle with \"{}\" takes its place from it; remove \"{}\" (its "
+                                             "bounds are the shape's)",
+                                             shape_key, key));
+  const bool inverted = o.boolean(
+      "inverted", "whether the solid is outside the closed surface (the fluid held inside it, as a container)", false);
+  ObstacleShape<D> shape;
+  if constexpr (D == 2) {
+    if (mesh)
+      o.ctx().fail(o.child("geometryFile"),
+                   "mesh files are for 3D scenes; a 2D obstacle of any shape is a "
+                   "\"polygon\": [[x, y], ...] (its vertices in order, m)");
+    for (const char* key : kMeshTransformKeys)
+      if (o.find(key))
+        o.ctx().fail(o.child(key), "only a 3D mesh obstacle takes this key; give a polygon's vertices where they are");
+    const json& v = o.require("polygon", "the polygon's vertices in order around it, [[x, y], ...], m");
+    const std::string expect = "the polygon's vertices in order around it, an array of [x, y] pairs of numbers, m";
+    if (!v.is_array()) o.ctx().fail(o.child("polygon"), "expected " + expect + ", got " + detail::describe(v));
+    std::vector<Vec<2, double>> points;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const json& e = v[i];
+      if (!e.is_array() || e.size() != 2 || !e[0].is_number() || !e[1].is_number() ||
+          !std::isfinite(e[0].get<double>()) || !std::isfinite(e[1].get<double>()))
+        o.ctx().fail(fmt::format("{}[{}]", o.child("polygon"), i),
+                     "expected " + expect + ", got " + detail::describe(e));
+      points.push_back(Vec<2, double>{{e[0].get<double>(), e[1].get<double>()}});
+    }
+    try {
+      shape = polygon_shape(std::move(points), inverted);
+    } catch (const Error& e) {
+      o.ctx().fail(o.child("polygon"), "the polygon " + e.message());
+    }
+  } else {
+    if (polygon)
+      o.ctx().fail(o.child("polygon"),
+                   "polygons are for 2D scenes; a 3D obstacle of any shape is a mesh file, "
+                   "\"geometryFile\" (OBJ, STL or PLY)");
+    MeshSource src;
+    const std::string given = o.string("geometryFile",
+                                       "the path of a closed triangle mesh, .obj, .stl or .ply (relative "
+                                       "to the scene file)");
+    if (given.empty())
+      o.ctx().fail(o.child("geometryFile"), "expected the path of a .obj, .stl or .ply file, got \"\"");
+    src.file = scene_relative_path(o.ctx().source, given);
+    src.translation = o.vec<3>("translation", "the mesh's translation, m", Vec<3, double>{});
+    src.rotation_axis =
+        read_unit<3>(o, "rotationAxis", "the axis the mesh turns about, a non-zero vector", Vec<3, double>{{0, 0, 1}});
+    if (const json* a = o.find("rotationAngle"))
+      src.rotation_angle = o.number(*a, "rotationAngle", "the mesh's rotation about rotationAxis, rad, a number");
+    src.scale =
+        o.vec<3>("scale", "the mesh's scale along x, y and z (applied first), each > 0", Vec<3, double>{{1, 1, 1}});
+    for (int d = 0; d < 3; ++d)
+      if (!(src.scale[d] > 0))
+        o.ctx().fail(o.child("scale"), fmt::format("each factor must be > 0; got {}", point_text<3>(src.scale)));
+    TriangleMesh m;
+    try {
+      m = read_mesh_file(src.file);
+    } catch (const Error& e) {
+      o.ctx().fail(o.child("geometryFile"), e.message());
+    }
+    // x = t + R (s * X): Rodrigues' rotation.
+    const Vec<3, double>& k = src.rotation_axis;
+    const double c = std::cos(src.rotation_angle), sn = std::sin(src.rotation_angle);
+    for (Vec<3, double>& x : m.vertices) {
+      Vec<3, double> v;
+      for (int d = 0; d < 3; ++d) v[d] = x[d] * src.scale[d];
+      const Vec<3, double> kxv{{k[1] * v[2] - k[2] * v[1], k[2] * v[0] - k[0] * v[2], k[0] * v[1] - k[1] * v[0]}};
+      const double kv = dot(k, v);
+      for (int d = 0; d < 3; ++d) x[d] = src.translation[d] + v[d] * c + kxv[d] * sn + k[d] * kv * (1 - c);
+    }
+    try {
+      shape = make_shape<3>(std::move(m.vertices), std::move(m.triangles), inverted, src);
+    } catch (const Error& e) {
+      o.ctx().fail(o.child("geometryFile"), fmt::format("the mesh '{}' {}", src.file, e.message()));
+    }
+  }
+  box = shape_bounds(shape);
+  for (int d = 0; d < D; ++d)
+    if (!(box.hi[d] > box.lo[d]))
+      o.ctx().fail(o.child(shape_key), "the shape is flat: it has no extent along some axis");
+  return shape;
 }
 
 /// Obstacles[].dynamic and its keys (docs/scene-format.md, "Floating bodies"), after the motion.
@@ -588,10 +709,17 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
   read_container<D>(root, sim, derived);
   double total = read_blocks<D>(root, body);
   root.array_of_objects("Obstacles", detail::kObstacleKeys, [&](ObjectReader& o, std::size_t) {
-    sim.obstacles.push_back(read_box<D>(o, "obstacle"));
+    Box<D> box;
+    sim.shapes.push_back(read_solid<D>(o, box));
+    sim.obstacles.push_back(box);
     sim.motions.push_back(read_motion<D>(o, sim.obstacles.back()));
     sim.bodies.push_back(read_floating<D>(o, sim.motions.back()));
+    if (sim.bodies.back().dynamic && !sim.shapes.back().empty())
+      o.ctx().fail(o.child("dynamic"),
+                   "a floating obstacle must be a box (\"start\", \"end\"): floating meshes and "
+                   "polygons are not supported");
   });
+  if (!any_shape(sim)) sim.shapes.clear();
   // (none moves, none floats: as a scene without motions or bodies)
   if (std::none_of(sim.motions.begin(), sim.motions.end(), [](const ObstacleMotion<D>& m) { return m.moves(); }))
     sim.motions.clear();

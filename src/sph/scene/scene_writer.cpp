@@ -163,9 +163,24 @@ void write_body(const SceneDesc& desc, const SceneBody<D>& body, ObjectWriter& r
                          .take());
   for (std::size_t k = 0; k < sim.obstacles.size(); ++k) {
     ObjectWriter o(detail::kObstacleKeys);
-    o.put("start", vec_json<D>(sim.obstacles[k].lo))
-        .put("end", vec_json<D>(sim.obstacles[k].hi))
-        .put("motion", motion_json<D>(obstacle_motion(sim, k)));
+    if (const ObstacleShape<D>* shape = obstacle_shape(sim, k)) {
+      if constexpr (D == 2) {
+        OrderedJson polygon = OrderedJson::array();
+        for (const Vec<2, double>& v : shape->vertices) polygon.push_back(vec_json<2>(v));
+        o.put("polygon", std::move(polygon));
+      } else {
+        const MeshSource& m = shape->source;
+        o.put("geometryFile", m.file)
+            .put("translation", vec_json<3>(m.translation))
+            .put("rotationAxis", vec_json<3>(detail::direction_giving<3>(m.rotation_axis)))
+            .put("rotationAngle", m.rotation_angle)
+            .put("scale", vec_json<3>(m.scale));
+      }
+      o.put("inverted", shape->inverted);
+    } else {
+      o.put("start", vec_json<D>(sim.obstacles[k].lo)).put("end", vec_json<D>(sim.obstacles[k].hi));
+    }
+    o.put("motion", motion_json<D>(obstacle_motion(sim, k)));
     const BodyParams<D>& b = obstacle_body(sim, k);
     o.put("dynamic", b.dynamic);
     if (b.dynamic) {  // (the body's keys only with it: the reader refuses them on a fixed obstacle)

@@ -44,6 +44,37 @@ void for_each_site(const std::array<AxisSites, D>& axes, F&& f) {
   }
 }
 
+/// The shape of obstacle k of a list, or nullptr (a box).
+template <int D>
+const ObstacleShape<D>* shape_of(std::span<const ObstacleShape<D>* const> shapes, std::size_t k) {
+  return k < shapes.size() ? shapes[k] : nullptr;
+}
+
+/// The layers of sites next to a shape's surface: each site of a lattice of spacing dx over the
+/// shape's bounds grown by `grow` (x fastest) whose signed distance to the solid s is within
+/// `layers` spacings of the surface on the solid's side (`inside`: -layers dx <= s < 0) or the
+/// fluid's (0 < s <= layers dx) is moved along the surface's normal to the middle of its layer,
+/// |s| = (k + 1/2) dx, as a box's layers lie, and visited. The first layer is then dx / 2 from the
+/// surface everywhere, as on a box, so that the fluid rests a particle radius off the surface
+/// wherever the lattice happens to fall.
+template <int D, class F>
+void for_each_shape_site(const ObstacleShape<D>& shape, double dx, double grow, int layers, bool inside, F&& f) {
+  const Box<D> b = shape_bounds(shape);
+  const double depth = layers * dx;
+  std::array<AxisSites, D> axes;
+  for (int d = 0; d < D; ++d) axes[d] = axis_sites(b.lo[d] - grow, b.hi[d] + grow, dx, 0, false);
+  for_each_site<D>(axes, [&](const std::array<int, D>& idx) {
+    Vec<D, double> x;
+    for (int d = 0; d < D; ++d) x[d] = axes[d].x[static_cast<std::size_t>(idx[d])];
+    const SurfaceDistance<D> s = shape.solid_distance(x, depth);
+    const double away = inside ? -s.distance : s.distance;  // how far on the wanted side
+    if (!(away > 0 && away <= depth)) return;
+    const double layer = std::min(std::floor(away / dx), layers - 1.0);
+    const double target = (layer + 0.5) * dx;
+    f(x + s.normal * (inside ? away - target : target - away));
+  });
+}
+
 }  // namespace
 
 int boundary_layers(double spacing, double h) {
@@ -53,7 +84,8 @@ int boundary_layers(double spacing, double h) {
 
 template <int D>
 std::vector<Vec<D, double>> sample_boundary(const Box<D>& container, const std::vector<Box<D>>& obstacles,
-                                            double spacing, double h, std::vector<std::size_t>* obstacle_begin) {
+                                            double spacing, double h, std::vector<std::size_t>* obstacle_begin,
+                                            std::span<const ObstacleShape<D>* const> shapes) {
   const int layers = boundary_layers(spacing, h);
   std::vector<Vec<D, double>> out;
   // The container's shell: sites outside the box on at least one axis.
@@ -71,7 +103,23 @@ std::vector<Vec<D, double>> sample_boundary(const Box<D>& container, const std::
   });
   // Each obstacle: its sites within `layers` of a face, inside the container.
   if (obstacle_begin) obstacle_begin->assign(1, out.size());
-  for (const Box<D>& b : obstacles) {
+  const auto in_container = [&](const Vec<D, double>& x) {
+    for (int d = 0; d < D; ++d)
+      if (!(x[d] >= container.lo[d] && x[d] <= container.hi[d])) return false;
+    return true;
+  };
+  for (std::size_t k = 0; k < obstacles.size(); ++k) {
+    const Box<D>& b = obstacles[k];
+    if (const ObstacleShape<D>* shape = shape_of<D>(shapes, k)) {
+      // A shape: the sites of a lattice over its bounds within `layers` spacings of its surface
+      // on the solid's side (outside the surface too when it is inverted).
+      for_each_shape_site<D>(*shape, spacing, shape->inverted ? layers * spacing : 0.0, layers, true,
+                             [&](const Vec<D, double>& x) {
+                               if (in_container(x)) out.push_back(x);
+                             });
+      if (obstacle_begin) obstacle_begin->push_back(out.size());
+      continue;
+    }
     for (int d = 0; d < D; ++d) axes[d] = axis_sites(b.lo[d], b.hi[d], spacing, layers, false);
     for_each_site<D>(axes, [&](const std::array<int, D>& idx) {
       bool near_face = false, in_container = true;
@@ -91,7 +139,8 @@ std::vector<Vec<D, double>> sample_boundary(const Box<D>& container, const std::
 
 template <int D>
 std::vector<Vec<D, double>> rest_fluid_sites(const Box<D>& container, const std::vector<Box<D>>& obstacles,
-                                             double spacing, double h) {
+                                             double spacing, double h,
+                                             std::span<const ObstacleShape<D>* const> shapes) {
   const int layers = boundary_layers(spacing, h);
   const double depth = layers * spacing;
   const auto in_box = [](const Vec<D, double>& x, const Box<D>& b) {
@@ -100,7 +149,14 @@ std::vector<Vec<D, double>> rest_fluid_sites(const Box<D>& container, const std:
     return true;
   };
   const auto in_obstacle = [&](const Vec<D, double>& x) {
-    return std::any_of(obstacles.begin(), obstacles.end(), [&](const Box<D>& b) { return in_box(x, b); });
+    for (std::size_t k = 0; k < obstacles.size(); ++k) {
+      if (const ObstacleShape<D>* shape = shape_of<D>(shapes, k)) {
+        if (shape->solid_distance(x, 0).distance < 0) return true;
+      } else if (in_box(x, obstacles[k])) {
+        return true;
+      }
+    }
+    return false;
   };
   std::vector<Vec<D, double>> out;
   std::array<AxisSites, D> axes;
@@ -116,7 +172,16 @@ std::vector<Vec<D, double>> rest_fluid_sites(const Box<D>& container, const std:
   });
   Box<D> core = container;  // the container's sites cover the depth next to its faces
   for (int d = 0; d < D; ++d) core.lo[d] += depth, core.hi[d] -= depth;
-  for (const Box<D>& b : obstacles) {
+  for (std::size_t k = 0; k < obstacles.size(); ++k) {
+    const Box<D>& b = obstacles[k];
+    if (const ObstacleShape<D>* shape = shape_of<D>(shapes, k)) {
+      // A shape: its lattice's sites within the depth of its surface on the fluid's side.
+      for_each_shape_site<D>(*shape, spacing, shape->inverted ? 0.0 : depth, layers, false,
+                             [&](const Vec<D, double>& x) {
+                               if (in_box(x, core) && !in_obstacle(x)) out.push_back(x);
+                             });
+      continue;
+    }
     for (int d = 0; d < D; ++d) axes[d] = axis_sites(b.lo[d], b.hi[d], spacing, layers, true);
     for_each_site<D>(axes, [&](const std::array<int, D>& idx) {
       Vec<D, double> x;
@@ -158,22 +223,25 @@ template <int D, std::floating_point R>
 BoundarySet<D, R> make_boundary(const SimulationParams<D>& params) {
   BoundarySet<D, R> set;
   if (params.boundary.handling != BoundaryHandling::Particles) return set;
-  const std::vector<Vec<D, double>> samples = sample_boundary<D>(
-      params.container, params.obstacles, 2.0 * params.particle_radius, params.kernel_radius, &set.obstacle_begin);
+  std::vector<const ObstacleShape<D>*> shapes(params.obstacles.size());
+  for (std::size_t k = 0; k < shapes.size(); ++k) shapes[k] = obstacle_shape(params, k);
+  const std::vector<Vec<D, double>> samples =
+      sample_boundary<D>(params.container, params.obstacles, 2.0 * params.particle_radius, params.kernel_radius,
+                         &set.obstacle_begin, shapes);
   for (const auto& x : samples) set.position.push_back(vec_cast<R>(x));
   SPH_CHECK(set.position.size() < (std::size_t{1} << 31) / D, "too many boundary samples for 32-bit gather offsets");
   const R h = static_cast<R>(params.kernel_radius);
   const double dx = 2.0 * params.particle_radius;
   const bool rest_fluid = params.boundary.volume == BoundaryVolume::RestFluid;
-  const auto rest_sites = [&](const std::vector<Box<D>>& obstacles) {
+  const auto rest_sites = [&](const std::vector<Box<D>>& obstacles, std::span<const ObstacleShape<D>* const> of) {
     std::vector<Vec<D, R>> rest;
     if (rest_fluid)
-      for (const auto& x : rest_fluid_sites<D>(params.container, obstacles, dx, params.kernel_radius))
+      for (const auto& x : rest_fluid_sites<D>(params.container, obstacles, dx, params.kernel_radius, of))
         rest.push_back(vec_cast<R>(x));
     return rest;
   };
   if (!any_obstacle_moves(params)) {
-    set.psi = boundary_psi<D, R>(set.position, params.fluid, h, rest_sites(params.obstacles));
+    set.psi = boundary_psi<D, R>(set.position, params.fluid, h, rest_sites(params.obstacles, shapes));
     return set;
   }
   // Moving obstacles: psi counts only what moves with the sample. The container's and the resting
@@ -184,20 +252,23 @@ BoundarySet<D, R> make_boundary(const SimulationParams<D>& params) {
   std::vector<Vec<D, R>> still;
   std::vector<std::size_t> still_index;
   std::vector<Box<D>> still_boxes;
+  std::vector<const ObstacleShape<D>*> still_shapes;
   for (std::size_t b = 0; b < set.obstacle_begin[0]; ++b) still.push_back(set.position[b]), still_index.push_back(b);
   for (std::size_t k = 0; k < params.obstacles.size(); ++k) {
     const std::size_t b0 = set.obstacle_begin[k], b1 = set.obstacle_begin[k + 1];
     if (obstacle_moves(params, k)) {
       const std::vector<Vec<D, R>> own(set.position.begin() + static_cast<std::ptrdiff_t>(b0),
                                        set.position.begin() + static_cast<std::ptrdiff_t>(b1));
-      const std::vector<R> psi = boundary_psi<D, R>(own, params.fluid, h, rest_sites({params.obstacles[k]}));
+      const ObstacleShape<D>* own_shape[1] = {shapes[k]};
+      const std::vector<R> psi = boundary_psi<D, R>(own, params.fluid, h, rest_sites({params.obstacles[k]}, own_shape));
       std::copy(psi.begin(), psi.end(), set.psi.begin() + static_cast<std::ptrdiff_t>(b0));
       continue;
     }
     still_boxes.push_back(params.obstacles[k]);
+    still_shapes.push_back(shapes[k]);
     for (std::size_t b = b0; b < b1; ++b) still.push_back(set.position[b]), still_index.push_back(b);
   }
-  const std::vector<R> psi = boundary_psi<D, R>(still, params.fluid, h, rest_sites(still_boxes));
+  const std::vector<R> psi = boundary_psi<D, R>(still, params.fluid, h, rest_sites(still_boxes, still_shapes));
   for (std::size_t i = 0; i < still.size(); ++i) set.psi[still_index[i]] = psi[i];
   set.rest_position = samples;
   set.velocity.assign(set.size(), Vec<D, R>{});
@@ -224,11 +295,15 @@ void place_boundary(BoundarySet<D, R>& set, const SimulationParams<D>& params, s
 }
 
 template std::vector<Vec<2, double>> sample_boundary<2>(const Box<2>&, const std::vector<Box<2>>&, double, double,
-                                                        std::vector<std::size_t>*);
+                                                        std::vector<std::size_t>*,
+                                                        std::span<const ObstacleShape<2>* const>);
 template std::vector<Vec<3, double>> sample_boundary<3>(const Box<3>&, const std::vector<Box<3>>&, double, double,
-                                                        std::vector<std::size_t>*);
-template std::vector<Vec<2, double>> rest_fluid_sites<2>(const Box<2>&, const std::vector<Box<2>>&, double, double);
-template std::vector<Vec<3, double>> rest_fluid_sites<3>(const Box<3>&, const std::vector<Box<3>>&, double, double);
+                                                        std::vector<std::size_t>*,
+                                                        std::span<const ObstacleShape<3>* const>);
+template std::vector<Vec<2, double>> rest_fluid_sites<2>(const Box<2>&, const std::vector<Box<2>>&, double, double,
+                                                         std::span<const ObstacleShape<2>* const>);
+template std::vector<Vec<3, double>> rest_fluid_sites<3>(const Box<3>&, const std::vector<Box<3>>&, double, double,
+                                                         std::span<const ObstacleShape<3>* const>);
 #define SPH_INSTANTIATE(D, R)                                                                   \
   template std::vector<R> boundary_psi<D, R>(std::span<const Vec<D, R>>, const FluidParams&, R, \
                                              std::span<const Vec<D, R>>);                       \

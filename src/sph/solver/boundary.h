@@ -30,11 +30,16 @@ int boundary_layers(double spacing, double h);
 
 /// The sample positions of the container's shell and the obstacles (in that order, each in a
 /// fixed lattice order), m. With `obstacle_begin`, obstacle k's samples are
-/// [(*obstacle_begin)[k], (*obstacle_begin)[k + 1]) (obstacles.size() + 1 entries).
+/// [(*obstacle_begin)[k], (*obstacle_begin)[k + 1]) (obstacles.size() + 1 entries). `shapes[k]`
+/// (when given and not null) is obstacle k's shape (shape.h; `obstacles[k]` its bounds): its
+/// samples are the sites of a lattice of spacing `spacing` over its bounds that lie within the
+/// layers' depth of its surface on the solid's side, each moved along the surface's normal to the
+/// middle of its layer (the first dx / 2 behind the surface, as a box's).
 template <int D>
 std::vector<Vec<D, double>> sample_boundary(const Box<D>& container, const std::vector<Box<D>>& obstacles,
                                             double spacing, double h,
-                                            std::vector<std::size_t>* obstacle_begin = nullptr);
+                                            std::vector<std::size_t>* obstacle_begin = nullptr,
+                                            std::span<const ObstacleShape<D>* const> shapes = {});
 
 /// The boundary of a run: sample positions and each sample's psi, kg (kg/m in 2D). The samples of
 /// moving obstacles (motion.h) are placed at each step's time by place_boundary(); their psi is
@@ -64,10 +69,12 @@ void place_boundary(BoundarySet<D, R>& set, const SimulationParams<D>& params, s
 /// container's interior sites within the layers' depth of a face, and each obstacle's sites
 /// within that depth outside it (on its own lattice, continued outwards), leaving out sites in
 /// an obstacle and, for an obstacle's, sites the container's already cover (within the depth of
-/// a container face), m.
+/// a container face), m. A shape's (`shapes` as in sample_boundary) are its lattice's sites within
+/// that depth of its surface on the fluid's side.
 template <int D>
 std::vector<Vec<D, double>> rest_fluid_sites(const Box<D>& container, const std::vector<Box<D>>& obstacles,
-                                             double spacing, double h);
+                                             double spacing, double h,
+                                             std::span<const ObstacleShape<D>* const> shapes = {});
 
 /// psi_b = rho0 / delta_b, delta_b = sum_k W(x_b - x_k) over the samples within h (b included)
 /// and the `rest` points within h, W the run's density kernel (FluidParams::kernel).

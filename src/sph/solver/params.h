@@ -11,6 +11,7 @@
 #include <sph/core/vec.h>
 #include <sph/neighbors/strategy.h>
 #include <sph/solver/motion.h>
+#include <sph/solver/shape.h>
 
 namespace sph {
 
@@ -224,6 +225,10 @@ struct SimulationParams {
   /// shorter than `obstacles` (empty: none floats) means the others are not dynamic. A dynamic
   /// obstacle has no motion. See obstacle_body().
   std::vector<BodyParams<D>> bodies;
+  /// Each obstacle's shape when it is not a box (Obstacles[].polygon, Obstacles[].geometryFile;
+  /// shape.h), in the obstacles' order; `obstacles[k]` is then the shape's bounding box. Shorter
+  /// than `obstacles` (empty: all are boxes), or an empty shape, means a box. See obstacle_shape().
+  std::vector<ObstacleShape<D>> shapes;
   std::vector<EmitterParams<D>> emitters;
   NeighborMode neighbors = NeighborMode::Standard;
   int full_rebuild_period = 200;  ///< adaptive mode
@@ -259,6 +264,49 @@ template <int D>
 const BodyParams<D>& obstacle_body(const SimulationParams<D>& p, std::size_t k) {
   static const BodyParams<D> kFixed;
   return k < p.bodies.size() ? p.bodies[k] : kFixed;
+}
+
+/// Obstacle k's shape, or nullptr when it is a box (`obstacles[k]`).
+template <int D>
+const ObstacleShape<D>* obstacle_shape(const SimulationParams<D>& p, std::size_t k) {
+  return k < p.shapes.size() && !p.shapes[k].empty() ? &p.shapes[k] : nullptr;
+}
+
+/// Whether any obstacle of `p` has a shape other than a box.
+template <int D>
+bool any_shape(const SimulationParams<D>& p) {
+  return std::any_of(p.shapes.begin(), p.shapes.end(), [](const ObstacleShape<D>& s) { return !s.empty(); });
+}
+
+/// The signed distance of the point X (in obstacle k's frame at rest, m) to obstacle k's solid,
+/// negative inside it, and the solid's outward normal there: exact for a box; for a shape, exact
+/// where X may be within `reach` of the surface or is inside the solid, elsewhere a lower bound
+/// above `reach` (ObstacleShape::solid_distance). A box's normal inside it is its nearest face's.
+template <int D>
+SurfaceDistance<D> obstacle_distance(const SimulationParams<D>& p, std::size_t k, const Vec<D, double>& X,
+                                     double reach) {
+  if (const ObstacleShape<D>* shape = obstacle_shape(p, k)) return shape->solid_distance(X, reach);
+  const Box<D>& b = p.obstacles[k];
+  SurfaceDistance<D> s;
+  double out2 = 0, in = std::numeric_limits<double>::infinity();
+  int face = 0;
+  double face_sign = 1;
+  for (int d = 0; d < D; ++d) {
+    const double below = b.lo[d] - X[d], above = X[d] - b.hi[d];
+    if (below > 0) out2 += below * below, s.normal[d] = -below;
+    if (above > 0) out2 += above * above, s.normal[d] = above;
+    if (-below < in) in = -below, face = d, face_sign = -1;
+    if (-above < in) in = -above, face = d, face_sign = 1;
+  }
+  if (out2 > 0) {
+    s.distance = std::sqrt(out2);
+    s.normal = s.normal * (1.0 / s.distance);
+    return s;
+  }
+  s.distance = -in;
+  s.normal = Vec<D, double>{};
+  s.normal[face] = face_sign;
+  return s;
 }
 
 /// Whether obstacle k moves: by a prescribed motion, or as a floating body.

@@ -105,24 +105,33 @@ void add_body_contact(const ContactBox<D>& a, const ContactBox<D>& b, double ome
   const Vec<D, double> ca = a.pose.center + a.pose.translation, cb = b.pose.center + b.pose.translation;
   // The corners of `of` inside `in`: the push on the corner, out of `in`, and where it acts.
   const auto meet = [&](const ContactBox<D>& of, const ContactBox<D>& in, auto&& push) {
-    for (int corner = 0; corner < (1 << D); ++corner) {
-      const Vec<D, double> x = of.pose.place(box_corner<D>(of.box.lo, of.box.hi, corner));
+    const std::size_t corners = of.shape ? of.shape->vertices.size() : std::size_t{1} << D;
+    for (std::size_t corner = 0; corner < corners; ++corner) {
+      const Vec<D, double> x = of.pose.place(of.shape ? of.shape->vertices[corner]
+                                                      : box_corner<D>(of.box.lo, of.box.hi, static_cast<int>(corner)));
       const Vec<D, double> X = in.pose.to_rest(x);
       double depth = std::numeric_limits<double>::infinity();
-      int face = -1;
-      double sign = 0;
-      for (int d = 0; d < D; ++d) {
-        const double below = X[d] - in.box.lo[d], above = in.box.hi[d] - X[d];
-        if (!(below > 0 && above > 0)) {
-          face = -1;
-          break;
-        }
-        if (below < depth) depth = below, face = d, sign = -1;
-        if (above < depth) depth = above, face = d, sign = 1;
-      }
-      if (face < 0) continue;
       Vec<D, double> normal{};
-      normal[face] = sign;
+      if (in.shape) {
+        const SurfaceDistance<D> s = in.shape->solid_distance(X, 0);
+        if (!(s.distance < 0)) continue;
+        depth = -s.distance;
+        normal = s.normal;
+      } else {
+        int face = -1;
+        double sign = 0;
+        for (int d = 0; d < D; ++d) {
+          const double below = X[d] - in.box.lo[d], above = in.box.hi[d] - X[d];
+          if (!(below > 0 && above > 0)) {
+            face = -1;
+            break;
+          }
+          if (below < depth) depth = below, face = d, sign = -1;
+          if (above < depth) depth = above, face = d, sign = 1;
+        }
+        if (face < 0) continue;
+        normal[face] = sign;
+      }
       normal = in.pose.rotate(normal);  // out of `in`, in the world's frame
       const double vn = dot(of.pose.velocity_at(x) - in.pose.velocity_at(x), normal);
       const double f = std::max(0.0, k * depth - c * vn);

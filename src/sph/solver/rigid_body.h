@@ -80,13 +80,17 @@ struct ContactBox {
   Box<D> box;
   RigidPose<D> pose;
   double mass = 0;
+  /// An obstacle's shape when it is not its box (shape.h): its vertices meet the other's faces,
+  /// and the other's corners meet its surface.
+  const ObstacleShape<D>* shape = nullptr;
 };
 
 /// The contact of two boxes, a floating body `a` and a box `b` (another body, or an obstacle that
 /// does not give way): each corner of either inside the other is pushed out through the nearest
 /// face of the other (in its frame), by a damped spring k pen - c v_n along that face's normal
 /// (never pulling), v_n the corner's velocity relative to the other box's surface there, k = m
-/// w^2 and c = m w with m the pair's reduced mass (a's own against an obstacle). The impulses over
+/// w^2 and c = m w with m the pair's reduced mass (a's own against an obstacle). A shape takes part
+/// with its vertices for corners and its surface (signed distance and normal) for faces. The impulses over
 /// dt and their moments about each body's centre of mass (the pose's c + t) are added to `load_a`
 /// and, opposite, to `load_b` (null: `b` takes nothing). Corners against faces only: in 3D two
 /// boxes meeting edge to edge with no corner inside the other pass through each other there.

@@ -73,9 +73,14 @@ class HealthProbe {
       // (a moving obstacle: measured in its own frame, where its pose puts the particle)
       const Vec<D, double> x = k < moving_.size() && moving_[k] ? poses_[k].to_rest(x_world) : x_world;
       double in = kNoLimit, grown = kNoLimit;  // depth inside the box, and inside the box grown by r
-      for (int d = 0; d < D; ++d) {
-        in = std::min({in, x[d] - b.lo[d], b.hi[d] - x[d]});
-        grown = std::min({grown, x[d] - (b.lo[d] - r_), (b.hi[d] + r_) - x[d]});
+      if (obstacle_shape(p_, k)) {             // (a shape: its signed distance, exact within r of it)
+        const double s = obstacle_distance(p_, k, x, r_).distance;
+        in = -s, grown = r_ - s;
+      } else {
+        for (int d = 0; d < D; ++d) {
+          in = std::min({in, x[d] - b.lo[d], b.hi[d] - x[d]});
+          grown = std::min({grown, x[d] - (b.lo[d] - r_), (b.hi[d] + r_) - x[d]});
+        }
       }
       if (in > tol_) ++c.inside;
       if (in > 0 && in > c.inside_depth) c.inside_depth = in, c.inside_i = i;
@@ -263,7 +268,8 @@ void Simulation<D, R>::advance_bodies(double dt) {
   // float (they do not give way), all from the states at the step's start.
   const auto contact_box = [&](std::size_t k) {
     const std::size_t s = obstacle_body_[k];
-    return ContactBox<D>{params_.obstacles[k], pose_now(k), s != 0 ? body_mass_[s - 1].mass : 0.0};
+    return ContactBox<D>{params_.obstacles[k], pose_now(k), s != 0 ? body_mass_[s - 1].mass : 0.0,
+                         obstacle_shape(params_, k)};
   };
   for (std::size_t s = 0; s < nb; ++s) {
     const ContactBox<D> a = contact_box(body_obstacle_[s]);
@@ -296,14 +302,9 @@ void Simulation<D, R>::flag_near_moving_obstacles(double dt) {
     const RigidPose<D>& pose = poses_[k];
     const double reach = h + pose_surface_speed<D>(pose, box.lo, box.hi) * dt;
     parallel_for(particles_.size(), [&](std::size_t i) {
-      // The distance from the particle to the box, in the box's frame.
+      // The distance from the particle to the solid, in its frame.
       const Vec<D, double> X = pose.to_rest(vec_cast<double>(particles_.position[i]));
-      double out2 = 0;
-      for (int d = 0; d < D; ++d) {
-        const double o = std::max({box.lo[d] - X[d], 0.0, X[d] - box.hi[d]});
-        out2 += o * o;
-      }
-      if (out2 < reach * reach) flags[i] = 1;
+      if (obstacle_distance(params_, k, X, reach).distance < reach) flags[i] = 1;
     });
   }
 }
@@ -513,7 +514,7 @@ const StepInfo& Simulation<D, R>::step() {
   if (params_.neighbors == NeighborMode::Adaptive && params_.flag_near_moving) flag_near_moving_obstacles(st.dt);
   const WallContact<D, R> walls(params_.container, params_.obstacles, static_cast<R>(params_.particle_radius),
                                 params_.walls, params_.boundary.handling == BoundaryHandling::Penalty, poses_, moving_,
-                                obstacle_body_);
+                                obstacle_body_, params_.shapes);
   compute_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity), walls,
                         neighbors_->pair_exit_flags(), dt, solid, neighbors_->pair_exit_radius(), !dfsph_);
   info.seconds.forces = watch.lap();

@@ -65,10 +65,11 @@ class WallContact {
  public:
   /// `enabled` false (boundary particles): no wall acceleration at all. `poses`: each obstacle's
   /// pose now (empty: all at rest); `moving[k]` whether obstacle k moves (empty: none);
-  /// `body[k]` obstacle k's floating body (0: none, s + 1: body s; empty: none floats).
+  /// `body[k]` obstacle k's floating body (0: none, s + 1: body s; empty: none floats);
+  /// `shapes[k]` obstacle k's shape when it is not its box (shape.h; empty: all are boxes).
   WallContact(const Box<D>& container, const std::vector<Box<D>>& obstacles, R particle_radius, const WallParams& walls,
               bool enabled = true, std::span<const RigidPose<D>> poses = {}, std::span<const std::uint8_t> moving = {},
-              std::span<const std::uint16_t> body = {})
+              std::span<const std::uint16_t> body = {}, std::span<const ObstacleShape<D>> shapes = {})
       : enabled_(enabled),
         lo_(vec_cast<R>(container.lo)),
         hi_(vec_cast<R>(container.hi)),
@@ -76,6 +77,7 @@ class WallContact {
         poses_(poses),
         moving_(moving),
         body_(body),
+        shapes_(shapes),
         radius_(particle_radius),
         ks_(static_cast<R>(walls.stiffness)),
         kd_(static_cast<R>(walls.damping)) {}
@@ -103,14 +105,14 @@ class WallContact {
         const Vec<D, double> xb = pose.to_rest(xw);
         const Vec<D, double> vb = pose.unrotate(vec_cast<double>(v) - pose.velocity_at(xw));
         Vec<D, R> push{};
-        if (push_out(b, vec_cast<R>(xb), vec_cast<R>(vb), push)) {
+        if (push_out(k, b, vec_cast<R>(xb), vec_cast<R>(vb), push)) {
           const Vec<D, R> turned = vec_cast<R>(pose.rotate(vec_cast<double>(push)));
           a += turned;
           if (body_row && k < body_.size() && body_[k] != 0) body_row[body_[k] - 1] += turned;
         }
         continue;
       }
-      push_out(b, x, v, a);
+      push_out(k, b, x, v, a);
     }
     return a;
   }
@@ -120,9 +122,22 @@ class WallContact {
   R contact(R penetration, R normal_velocity) const {
     return std::max(R(0), ks_ * penetration - kd_ * normal_velocity);
   }
-  /// Adds to `a` the push out of box b (grown by one radius) on a particle at x with velocity v,
-  /// in the box's frame; false (nothing added) if x is outside it.
-  bool push_out(const Box<D>& b, const Vec<D, R>& x, const Vec<D, R>& v, Vec<D, R>& a) const {
+  /// Adds to `a` the push out of obstacle k (its box b, grown by one radius) on a particle at x
+  /// with velocity v, in the obstacle's frame; false (nothing added) if x is outside it. A shape
+  /// (shape.h) pushes along its outward normal at the nearest point of its surface, by the depth
+  /// within one radius of it.
+  bool push_out(std::size_t k, const Box<D>& b, const Vec<D, R>& x, const Vec<D, R>& v, Vec<D, R>& a) const {
+    if (k < shapes_.size() && !shapes_[k].empty()) {
+      const ObstacleShape<D>& shape = shapes_[k];
+      if (!shape.inverted)
+        for (int d = 0; d < D; ++d)
+          if (!(x[d] > static_cast<R>(b.lo[d]) - radius_ && x[d] < static_cast<R>(b.hi[d]) + radius_)) return false;
+      const SurfaceDistance<D> s = shape.solid_distance(vec_cast<double>(x), static_cast<double>(radius_));
+      if (!(s.distance < static_cast<double>(radius_))) return false;
+      const Vec<D, R> n = vec_cast<R>(s.normal);
+      a += n * contact(radius_ - static_cast<R>(s.distance), dot(n, v));
+      return true;
+    }
     R best = std::numeric_limits<R>::max();
     int best_d = -1;
     R best_sign = 0;
@@ -144,6 +159,7 @@ class WallContact {
   std::span<const RigidPose<D>> poses_;
   std::span<const std::uint8_t> moving_;
   std::span<const std::uint16_t> body_;
+  std::span<const ObstacleShape<D>> shapes_;
   R radius_, ks_, kd_;
 };
 

@@ -329,7 +329,11 @@
 
   // The obstacles of a frame as drawn: each box at rest with its placement in that frame (the
   // frame's poses) or at rest. R is null for an upright box (then the point p is at p + t).
-  const AT_REST = OBSTACLES.map((o) => ({ lo: o.lo, hi: o.hi, R: null, c: [0, 0, 0], t: [0, 0, 0] }));
+  // A polygon or mesh obstacle also has its vertices `v` (and 3D `f`, triangles; `inv`: the solid
+  // is outside it): drawn as sph render draws it (2D polygons filled, 3D triangles flat-shaded);
+  // whether a particle is behind it is judged by its bounds.
+  const AT_REST = OBSTACLES.map((o) => ({ lo: o.lo, hi: o.hi, R: null, c: [0, 0, 0], t: [0, 0, 0], v: o.v, f: o.f,
+    inv: o.inv }));
   function solidsOf(ri, fi) {
     const fr = frameOf(RUNS[ri], fi);
     if (!fr.poses) return AT_REST;
@@ -338,7 +342,8 @@
       if (!pose) return AT_REST[k];
       const R = pose.slice(0, 9);
       const upright = R.every((v, j) => v === (j % 4 === 0 ? 1 : 0));
-      return { lo: o.lo, hi: o.hi, R: upright ? null : R, c: pose.slice(9, 12), t: pose.slice(12, 15) };
+      return { lo: o.lo, hi: o.hi, R: upright ? null : R, c: pose.slice(9, 12), t: pose.slice(12, 15), v: o.v, f: o.f,
+        inv: o.inv };
     }));
   }
   // Where the point p of the box at rest is drawn.
@@ -391,6 +396,12 @@
       ctx.fillStyle = solidRgb(1);
       const e = ctx.lineWidth / 2;  // the outline inside the box, as sph render draws it
       for (const o of solids) {
+        if (o.v) {  // a polygon: filled (unless the fluid is inside it) and outlined
+          polygon(ctx, o.v.map((p) => { const w = place(o, [p[0], p[1], 0]); return proj.fn(w[0], w[1], 0); }));
+          if (!o.inv) ctx.fill();
+          ctx.stroke();
+          continue;
+        }
         if (!o.R) {
           const a = proj.fn(o.lo[0] + o.t[0], o.lo[1] + o.t[1], 0), c = proj.fn(o.hi[0] + o.t[0], o.hi[1] + o.t[1], 0);
           const x = Math.min(a[0], c[0]), y = Math.min(a[1], c[1]), w = Math.abs(c[0] - a[0]), h = Math.abs(c[1] - a[1]);
@@ -418,7 +429,35 @@
       return { o, depth: proj.fn(c[0], c[1], c[2])[2] };
     });
     boxes.sort((u, v) => v.depth - u.depth);  // far to near
-    for (const { o } of boxes)
+    for (const { o } of boxes) {
+      if (o.f) {  // a mesh: its triangles turned to the camera (away when inverted), far to near
+        const tris = [];
+        for (const t of o.f) {
+          const w = t.map((k) => place(o, o.v[k]));
+          const e1 = [0, 1, 2].map((k) => w[1][k] - w[0][k]), e2 = [0, 1, 2].map((k) => w[2][k] - w[0][k]);
+          let n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
+          const len = Math.hypot(...n) * (o.inv ? -1 : 1);
+          if (!len) continue;
+          n = n.map((x) => x / len);
+          const facing = persp ? n[0] * (b.eye[0] - w[0][0]) + n[1] * (b.eye[1] - w[0][1]) + n[2] * (b.eye[2] - w[0][2])
+                               : n[0] * b.back[0] + n[1] * b.back[1] + n[2] * b.back[2];
+          if (!(facing > 1e-9)) continue;
+          const pts = w.map((q) => proj.fn(q[0], q[1], q[2]));
+          if (persp && pts.some((q) => q[2] <= 0)) continue;
+          const nc = [b.right, b.up, b.back].map((e) => n[0] * e[0] + n[1] * e[1] + n[2] * e[2]);
+          const shade = 0.55 + 0.45 * Math.max(0, nc[0] * FACE_LIGHT[0] + nc[1] * FACE_LIGHT[1] + nc[2] * FACE_LIGHT[2]);
+          tris.push({ pts, shade, depth: (pts[0][2] + pts[1][2] + pts[2][2]) / 3 });
+        }
+        tris.sort((u, v) => v.depth - u.depth);
+        for (const t of tris) {
+          ctx.fillStyle = ctx.strokeStyle = solidRgb(t.shade);  // (stroked in its own color: no seams)
+          polygon(ctx, t.pts);
+          ctx.fill();
+          ctx.stroke();
+        }
+        ctx.strokeStyle = SOLID_EDGE;
+        continue;
+      }
       for (let a = 0; a < 3; a++) {
         const axis = o.R ? [o.R[a], o.R[3 + a], o.R[6 + a]] : [0, 1, 2].map((k) => (k === a ? 1 : 0));
         for (const side of [0, 1]) {
@@ -446,6 +485,7 @@
           ctx.stroke();
         }
       }
+    }
   }
 
   function drawAxes(ctx, p, dpr) {

@@ -2,7 +2,8 @@
 // flows around them and no particle gets inside them (their signed distance, checked as the run
 // goes), with boundary particles and with penalty springs; a turning polygon stirs without letting
 // fluid in; a closed surface holds the fluid inside it (inverted); fluid blocks lose the particles
-// in a shape, and say so; runs are the same for any thread count and resume bit for bit.
+// in a shape, and say so; a polygon and a mesh float as Archimedes and the box they are say; runs
+// are the same for any thread count and resume bit for bit.
 
 #include <algorithm>
 #include <cmath>
@@ -176,6 +177,89 @@ TEST(MeshObstacle, A3DDamBreakGoesAroundATurnedMeshAndNoParticleGetsInside) {
     const double r = desc.body<3>().sim.particle_radius;
     EXPECT_LT(deepest_over_run<3>(desc), kTolerance * r);
   }
+}
+
+TEST(MeshObstacle, AFloatingDiamondOfHalfTheWatersDensityFloatsHalfIn) {
+  // A square turned 45 degrees (a polygon), density 500, its centre on the water's surface: half
+  // its area under water, as Archimedes has it, and a square log of half the water's density
+  // floats corner down. The water is one block; the particles in the square are left out.
+  const SceneDesc desc = parse_scene(R"({
+    "version": 1, "name": "diamond", "dimension": 2,
+    "Configuration": { "precision": "double", "stopAt": 2.0, "particleRadius": 0.01, "kernelRadius": 0.04,
+      "gravitation": [0, -9.81], "outputFps": 10, "boundaryHandling": "particles", "kernel": "cubic",
+      "simulationMethod": "dfsph", "cflMaxTimeStepSize": 0.005 },
+    "Fluid": { "density0": 1000, "viscosity": 1.0 },
+    "Container": { "start": [0, 0], "end": [1.2, 0.6] },
+    "FluidBlocks": [ { "start": [0, 0], "end": [1.2, 0.3] } ],
+    "Obstacles": [ { "polygon": [[0.6, 0.2], [0.7, 0.3], [0.6, 0.4], [0.5, 0.3]], "dynamic": true,
+                     "density": 500 } ]
+  })",
+                                     "diamond.json");
+  RunDriver<2, double> run(desc, RunSettings{});
+  const Simulation<2, double>& sim = run.simulation();
+  double sum = 0, tilt = 0, mean_tilt = 0, level = 0, deepest = -1e300;
+  int count = 0;
+  RunCallbacks each;
+  each.progress = [&](std::int64_t step, std::size_t) {
+    if (step % 5 == 0) deepest = std::max(deepest, deepest_inside(sim));
+    if (sim.time() < 1.0) return;
+    const RigidBodyState<2>& b = sim.bodies().at(0);
+    sum += b.position[1];
+    const double angle = std::abs(2 * std::asin(b.orientation[3]));
+    tilt = std::max(tilt, angle);
+    mean_tilt += angle;
+    // The free surface away from the body: the highest particle more than 0.3 m from it, plus a radius.
+    double top = 0;
+    for (const auto& x : sim.particles().position)
+      if (std::abs(x[0] - b.position[0]) > 0.3) top = std::max(top, x[1] + 0.01);
+    level += top;
+    ++count;
+  };
+  const RunResult r = run.run(each);
+  ASSERT_EQ(r.status, RunStatus::Completed) << r.message;
+  EXPECT_TRUE(r.warnings.empty()) << (r.warnings.empty() ? "" : r.warnings[0]);
+  ASSERT_GT(count, 0);
+  // Its centre (its centroid, from the polygon) within 5 % of its 0.1 m half-diagonal of the
+  // surface; still corner down, rocking in the waves the start makes (by less than a quarter of
+  // the 45 degrees that would lay it on a face); no particle inside it past the tolerance.
+  EXPECT_NEAR(sum / count, level / count, 0.005);
+  EXPECT_LT(mean_tilt / count, 0.1);
+  EXPECT_LT(tilt, 0.2);
+  EXPECT_LT(deepest, kTolerance * 0.01);
+}
+
+TEST(MeshObstacle, AFloatingMeshBoxMovesAsTheSameBox) {
+  // A box of density 500 dropped from above the water, as a box and as a mesh of a box: the same
+  // mass, centre and inertia (from the mesh) and the same coupling, so the same fall and float.
+  const auto settle = [](const std::string& obstacle) {
+    const SceneDesc desc = parse_scene(fmt::format(R"({{
+      "version": 1, "name": "float3d", "dimension": 3,
+      "Configuration": {{ "precision": "double", "stopAt": 0.8, "particleRadius": 0.02, "kernelRadius": 0.08,
+        "gravitation": [0, -9.81, 0], "outputFps": 10, "boundaryHandling": "particles", "kernel": "cubic",
+        "simulationMethod": "dfsph", "cflMaxTimeStepSize": 0.005 }},
+      "Fluid": {{ "density0": 1000, "viscosity": 1.0 }},
+      "Container": {{ "start": [0, 0, 0], "end": [0.4, 0.4, 0.4] }},
+      "FluidBlocks": [ {{ "start": [0, 0, 0], "end": [0.4, 0.16, 0.4] }} ],
+      "Obstacles": [ {} ]
+    }})",
+                                                   obstacle),
+                                       "float3d.json");
+    RunDriver<3, double> run(desc, RunSettings{});
+    const RunResult r = run.run();
+    EXPECT_EQ(r.status, RunStatus::Completed) << r.message;
+    EXPECT_TRUE(r.warnings.empty()) << (r.warnings.empty() ? "" : r.warnings[0]);
+    return run.simulation().bodies().at(0).position;
+  };
+  const Vec<3, double> box = settle(R"({ "start": [0.1, 0.2, 0.1], "end": [0.3, 0.28, 0.3], "dynamic": true,
+                                         "density": 500 })");
+  const Vec<3, double> mesh = settle(fmt::format(R"({{ "geometryFile": "{}", "scale": [0.2, 0.08, 0.2],
+      "translation": [0.1, 0.2, 0.1], "dynamic": true, "density": 500 }})",
+                                                 SPH_SOURCE_DIR "/tests/data/meshes/cube.stl"));
+  // Fallen onto the water and floating (not at its start, not through the floor)...
+  EXPECT_LT(box[1], 0.2);
+  EXPECT_GT(box[1], 0.1);
+  // ...and the mesh where the box is, within a tenth of a spacing.
+  for (int d = 0; d < 3; ++d) EXPECT_NEAR(mesh[d], box[d], 0.004) << d;
 }
 
 TEST(MeshObstacle, ThreadCountsAgreeAndAResumedRunIsTheSame) {

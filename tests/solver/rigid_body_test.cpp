@@ -12,6 +12,12 @@
 namespace sph {
 namespace {
 
+/// A box's centre (a uniform box's centre of mass).
+template <int D>
+Vec<D, double> center_of(const Box<D>& b) {
+  return (b.lo + b.hi) * 0.5;
+}
+
 TEST(RigidBody, ABoxsMassAndMomentsAreAUniformBoxs) {
   const MassProperties<3> m3 = box_mass_properties<3>(Box<3>{{{0, 0, 0}}, {{1, 2, 3}}}, 500);
   EXPECT_DOUBLE_EQ(m3.mass, 3000);
@@ -47,7 +53,8 @@ TEST(RigidBody, ThePoseMovesTheCentreAndTurnsAboutIt) {
 TEST(RigidBody, FreeFlightFallsAsAStoneAndAPlanarSpinTurnsExactly) {
   const Box<2> box{{{0, 0}}, {{0.4, 0.2}}};
   const MassProperties<2> mp = box_mass_properties<2>(box, 500);
-  RigidBodyState<2> s = initial_body_state(box, BodyParams<2>{true, 500, {{1, 0}}, {{0, 0, std::numbers::pi}}});
+  RigidBodyState<2> s =
+      initial_body_state(center_of(box), BodyParams<2>{true, 500, {{1, 0}}, {{0, 0, std::numbers::pi}}});
   const double dt = 1e-3;
   for (int k = 0; k < 1000; ++k) advance_body(s, mp, BodyLoad<2>{}, Vec<2, double>{{0, -10}}, dt);
   // Symplectic Euler: y = y0 - g dt^2 n (n + 1) / 2 after n steps; x at its constant speed.
@@ -63,7 +70,7 @@ TEST(RigidBody, ATorqueFreeTopKeepsItsAngularMomentumAndEnergy) {
   // and the energy w . L / 2 stay (to the explicit gyroscopic term's first-order error).
   const Box<3> box{{{0, 0, 0}}, {{0.1, 0.2, 0.3}}};
   const MassProperties<3> mp = box_mass_properties<3>(box, 800);
-  RigidBodyState<3> s = initial_body_state(box, BodyParams<3>{true, 800, {}, {{1.0, 2.0, 0.5}}});
+  RigidBodyState<3> s = initial_body_state(center_of(box), BodyParams<3>{true, 800, {}, {{1.0, 2.0, 0.5}}});
   const auto momentum = [&](const RigidBodyState<3>& st) {
     const std::array<double, 9> r = quaternion_matrix(st.orientation);
     Vec<3, double> b{}, l{};
@@ -92,7 +99,7 @@ TEST(RigidBody, TheContainerHoldsARestingBoxAtItsSpringsSag) {
   const Box<2> container{{{0, 0}}, {{1, 1}}};
   const Box<2> box{{{0.3, 0.0}}, {{0.7, 0.2}}};
   const MassProperties<2> mp = box_mass_properties<2>(box, 500);
-  RigidBodyState<2> s = initial_body_state(box, BodyParams<2>{true, 500, {}, {}});
+  RigidBodyState<2> s = initial_body_state(center_of(box), BodyParams<2>{true, 500, {}, {}});
   const double dt = 0.005, w = body_contact_rate(dt);
   for (int k = 0; k < 400; ++k) {
     BodyLoad<2> load;
@@ -103,7 +110,7 @@ TEST(RigidBody, TheContainerHoldsARestingBoxAtItsSpringsSag) {
   EXPECT_NEAR(s.velocity[1], 0, 1e-6);
   EXPECT_NEAR(s.orientation[3], 0, 1e-12);  // pushed evenly: it does not tip
   // And a wall never pulls: a box just off the wall, moving away, gets nothing.
-  s = initial_body_state(Box<2>{{{0.3, 0.01}}, {{0.7, 0.21}}}, BodyParams<2>{true, 500, {{0, 1}}, {}});
+  s = initial_body_state(center_of(Box<2>{{{0.3, 0.01}}, {{0.7, 0.21}}}), BodyParams<2>{true, 500, {{0, 1}}, {}});
   BodyLoad<2> load;
   add_container_contact(container, box, s, mp, w, dt, load);
   EXPECT_EQ(load.impulse, (Vec<2, double>{}));
@@ -113,8 +120,8 @@ TEST(RigidBody, TwoBoxesInContactArePushedApartEquallyAndOppositely) {
   // a's right side overlaps b's left side by 1 cm, b turned a little: each is pushed out of the
   // other, the impulses are opposite, and so are the moments about a common point.
   const Box<2> box_a{{{0, 0}}, {{0.2, 0.1}}}, box_b{{{0.19, 0.02}}, {{0.39, 0.12}}};
-  RigidBodyState<2> sa = initial_body_state(box_a, BodyParams<2>{true, 500, {{0.3, 0}}, {}});
-  RigidBodyState<2> sb = initial_body_state(box_b, BodyParams<2>{true, 800, {{-0.1, 0}}, {}});
+  RigidBodyState<2> sa = initial_body_state(center_of(box_a), BodyParams<2>{true, 500, {{0.3, 0}}, {}});
+  RigidBodyState<2> sb = initial_body_state(center_of(box_b), BodyParams<2>{true, 800, {{-0.1, 0}}, {}});
   const double turn = 0.05;
   sb.orientation = {std::cos(turn / 2), 0, 0, std::sin(turn / 2)};
   const MassProperties<2> ma = box_mass_properties<2>(box_a, 500), mb = box_mass_properties<2>(box_b, 800);

@@ -2,6 +2,7 @@
 // against the box's own, a circle's and a sphere's against their radius), the coarse grid's
 // bound, inverted shapes, and the checks of make_shape and polygon_shape on broken surfaces.
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -13,6 +14,7 @@
 
 #include <sph/core/error.h>
 #include <sph/solver/params.h>
+#include <sph/solver/rigid_body.h>
 #include <sph/solver/shape.h>
 
 namespace sph {
@@ -179,6 +181,89 @@ TEST(Shape, APolygonHasItsExactSignedDistanceEitherWayRound) {
     const V2 x{{u(rng), u(rng)}};
     EXPECT_NEAR(c.field->distance(x).distance, std::sqrt(norm2(x)) - 1, 1e-4);
   }
+}
+
+/// The cube's mesh turned by R (row-major), scaled to a x b x c first: its vertices R (s * X).
+ObstacleShape<3> turned_box(double a, double b, double c, const std::array<double, 9>& r) {
+  const ObstacleShape<3> unit = cube();
+  std::vector<V3> v;
+  for (const V3& x : unit.vertices) {
+    const V3 y{{x[0] * a, x[1] * b, x[2] * c}};
+    v.push_back(V3{{r[0] * y[0] + r[1] * y[1] + r[2] * y[2], r[3] * y[0] + r[4] * y[1] + r[5] * y[2],
+                    r[6] * y[0] + r[7] * y[1] + r[8] * y[2]}});
+  }
+  return make_shape<3>(v, unit.faces, false);
+}
+
+TEST(ShapeMass, AMeshOfABoxHasTheBoxsMassCentreAndInertia) {
+  const MassProperties<3> mesh = shape_mass_properties(turned_box(1, 2, 3, {1, 0, 0, 0, 1, 0, 0, 0, 1}), 500);
+  const MassProperties<3> box = box_mass_properties<3>(Box<3>{V3{}, V3{{1, 2, 3}}}, 500);
+  EXPECT_NEAR(mesh.mass, box.mass, 1e-9);
+  for (int d = 0; d < 3; ++d) EXPECT_NEAR(mesh.center[d], box.center[d], 1e-12);
+  // The same principal moments, in some order, along the box's own axes.
+  std::vector<double> a(mesh.inertia.c.begin(), mesh.inertia.c.end()), b(box.inertia.c.begin(), box.inertia.c.end());
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(a[k], b[k], 1e-9 * b[2]);
+  for (int k = 0; k < 3; ++k) {
+    const V3 axis{{mesh.axes[k], mesh.axes[3 + k], mesh.axes[6 + k]}};
+    EXPECT_NEAR(std::max({std::abs(axis[0]), std::abs(axis[1]), std::abs(axis[2])}), 1.0, 1e-9);
+  }
+}
+
+TEST(ShapeMass, ATurnedBoxsPrincipalAxesAreItsTurnedEdges) {
+  // Turned 30 degrees about z, then 40 about x.
+  const double c1 = std::cos(0.5236), s1 = std::sin(0.5236), c2 = std::cos(0.6981), s2 = std::sin(0.6981);
+  const std::array<double, 9> rz{c1, -s1, 0, s1, c1, 0, 0, 0, 1}, rx{1, 0, 0, 0, c2, -s2, 0, s2, c2};
+  std::array<double, 9> r{};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) r[3 * i + j] += rx[3 * i + k] * rz[3 * k + j];
+  const MassProperties<3> mp = shape_mass_properties(turned_box(1, 2, 3, r), 800);
+  const MassProperties<3> box = box_mass_properties<3>(Box<3>{V3{}, V3{{1, 2, 3}}}, 800);
+  for (int k = 0; k < 3; ++k) {
+    // Each principal axis is one of the turned edges (R e_d, up to sign), with that edge's moment.
+    const V3 axis{{mp.axes[k], mp.axes[3 + k], mp.axes[6 + k]}};
+    int matched = 0;
+    for (int d = 0; d < 3; ++d) {
+      const V3 edge{{r[d], r[3 + d], r[6 + d]}};
+      if (std::abs(std::abs(dot(axis, edge)) - 1) < 1e-9) {
+        EXPECT_NEAR(mp.inertia[k], box.inertia[d], 1e-9 * box.inertia[d]);
+        ++matched;
+      }
+    }
+    EXPECT_EQ(matched, 1) << "axis " << k;
+  }
+  // A rotation: orthonormal, determinant +1.
+  const V3 e0{{mp.axes[0], mp.axes[3], mp.axes[6]}}, e1{{mp.axes[1], mp.axes[4], mp.axes[7]}},
+      e2{{mp.axes[2], mp.axes[5], mp.axes[8]}};
+  EXPECT_NEAR(dot(e0, e1), 0, 1e-12);
+  EXPECT_NEAR(e0[0] * (e1[1] * e2[2] - e1[2] * e2[1]) - e0[1] * (e1[0] * e2[2] - e1[2] * e2[0]) +
+                  e0[2] * (e1[0] * e2[1] - e1[1] * e2[0]),
+              1, 1e-12);
+}
+
+TEST(ShapeMass, AnIcosphereIsASolidBallAndAPolygonAPlate) {
+  const MassProperties<3> ball = shape_mass_properties(sphere(4), 1000);
+  const double m = 1000 * 4 * std::numbers::pi / 3;
+  EXPECT_NEAR(ball.mass, m, 0.01 * m);  // (the faces sag inside the sphere)
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(ball.center[k], 0, 1e-12);
+    EXPECT_NEAR(ball.inertia[k], 0.4 * m, 0.02 * 0.4 * m);
+  }
+  // 2D: a rectangle polygon is the box; a right triangle's centroid is a third of the way in.
+  const MassProperties<2> rect = shape_mass_properties(
+      polygon_shape({V2{{0.2, 0.1}}, V2{{0.6, 0.1}}, V2{{0.6, 0.3}}, V2{{0.2, 0.3}}}, false), 500);
+  const MassProperties<2> box = box_mass_properties<2>(Box<2>{V2{{0.2, 0.1}}, V2{{0.6, 0.3}}}, 500);
+  EXPECT_NEAR(rect.mass, box.mass, 1e-12);
+  EXPECT_NEAR(rect.center[0], box.center[0], 1e-12);
+  EXPECT_NEAR(rect.center[1], box.center[1], 1e-12);
+  EXPECT_NEAR(rect.inertia[2], box.inertia[2], 1e-12);
+  const MassProperties<2> tri = shape_mass_properties(polygon_shape({V2{{0, 0}}, V2{{3, 0}}, V2{{0, 3}}}, false), 2);
+  EXPECT_NEAR(tri.mass, 9, 1e-12);
+  EXPECT_NEAR(tri.center[0], 1, 1e-12);
+  EXPECT_NEAR(tri.center[1], 1, 1e-12);
+  EXPECT_NEAR(tri.inertia[2], 2 * 4.5 * (9 + 9) / 18, 1e-9);  // rho A (a^2 + b^2) / 18 for legs a, b
 }
 
 /// The message make_shape or polygon_shape throws for a broken surface ("" if it accepts it).

@@ -78,8 +78,8 @@ SolidBox placed_obstacle(const SimulationParams<D>& sim, std::size_t k, double t
   RigidBodyState<D> state;
   for (int a = 0; a < D; ++a) state.position[a] = nearest->position[static_cast<std::size_t>(a)];
   state.orientation = nearest->orientation;
-  const Box<D>& box = sim.obstacles[k];
-  return placed_box(sim, k, body_pose(state, (box.lo + box.hi) * 0.5));
+  // (placed about its centre of mass at rest, as the simulation places it)
+  return placed_box(sim, k, body_pose(state, obstacle_mass_properties(sim, k, 1.0).center));
 }
 
 }  // namespace

@@ -77,9 +77,9 @@ void check_obstacles_inside(const ReadContext& ctx, const SimulationParams<D>& s
       inside = inside && o.lo[d] >= c.lo[d] && o.hi[d] <= c.hi[d];
       apart = apart || o.hi[d] <= c.lo[d] || o.lo[d] >= c.hi[d];
     }
-    // (a shape may reach past the walls: its samples and springs there are dropped, so a mesh
-    // floor wider than the container is fine)
-    if (inside || (obstacle_shape(sim, i) && !apart)) continue;
+    // (a shape at rest or on a motion may reach past the walls: its samples and springs there are
+    // dropped, so a mesh floor wider than the container is fine; a floating one starts inside)
+    if (inside || (obstacle_shape(sim, i) && !obstacle_body(sim, i).dynamic && !apart)) continue;
     const std::string where = fmt::format("Obstacles[{}]", i);
     if (apart)
       ctx.fail(where, fmt::format("the obstacle {} lies wholly outside the container {}: it can never touch the "

@@ -714,10 +714,10 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
     sim.obstacles.push_back(box);
     sim.motions.push_back(read_motion<D>(o, sim.obstacles.back()));
     sim.bodies.push_back(read_floating<D>(o, sim.motions.back()));
-    if (sim.bodies.back().dynamic && !sim.shapes.back().empty())
+    if (sim.bodies.back().dynamic && sim.shapes.back().inverted)
       o.ctx().fail(o.child("dynamic"),
-                   "a floating obstacle must be a box (\"start\", \"end\"): floating meshes and "
-                   "polygons are not supported");
+                   "an inverted shape (the fluid inside it) cannot float: its solid is "
+                   "everything outside it; remove \"dynamic\" or \"inverted\"");
   });
   if (!any_shape(sim)) sim.shapes.clear();
   // (none moves, none floats: as a scene without motions or bodies)

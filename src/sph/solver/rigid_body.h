@@ -1,10 +1,11 @@
 #pragma once
-/// \file Floating rigid bodies (Obstacles[].dynamic; docs/physics.md "Floating bodies"): a box
-/// obstacle whose motion the fluid, gravity and the container decide (two-way coupling).
+/// \file Floating rigid bodies (Obstacles[].dynamic; docs/physics.md "Floating bodies"): an
+/// obstacle (a box, a polygon or a mesh) whose motion the fluid, gravity and the container decide
+/// (two-way coupling).
 ///
-/// A body is its box at rest (the scene's `start` .. `end`) and a state: the centre of mass (the
-/// box's centre; the box is uniform), a unit quaternion for its orientation, and its linear and
-/// angular velocities. Its pose (motion.h) places the box at rest where the state puts it:
+/// A body is its solid at rest (the scene's box or shape) and a state: the centre of mass (the
+/// solid is uniform), a unit quaternion for its orientation, and its linear and angular
+/// velocities. Its pose (motion.h) places the box at rest where the state puts it:
 ///   x = c + (position - c) + R(q) (X - c),  c the centre at rest,
 /// so every mechanism of the moving obstacles (wall contact in the body's frame, boundary samples
 /// placed with their velocities, the health checks) serves the bodies unchanged.
@@ -36,21 +37,42 @@ struct RigidBodyState {
   friend bool operator==(const RigidBodyState&, const RigidBodyState&) = default;
 };
 
-/// A uniform box's mass, kg (2D: kg/m), and its principal moments of inertia about its centre
-/// along the box's own axes, kg m^2 (2D: only z counts).
+/// A uniform body's mass, kg (2D: kg/m), its centre of mass at rest, and its principal moments of
+/// inertia about it, kg m^2 (2D: only z counts), along its principal axes: the columns of `axes`
+/// (a rotation, row-major, in the frame at rest; a box's own axes, the identity).
 template <int D>
 struct MassProperties {
   double mass = 0;
   Vec<3, double> inertia{};
-  Vec<D, double> center{};  ///< the centre of mass at rest (the box's centre), m
+  Vec<D, double> center{};  ///< the centre of mass at rest, m
+  std::array<double, 9> axes{1, 0, 0, 0, 1, 0, 0, 0, 1};
 };
 
 template <int D>
 MassProperties<D> box_mass_properties(const Box<D>& box, double density);
 
-/// The state at t = 0: the box where the scene puts it, at its initial velocities.
+/// A uniform solid bounded by a shape's closed surface (shape.h; not inverted): its volume's
+/// mass, centre and inertia, summed exactly over the tetrahedra (3D; triangles in 2D) that its faces
+/// make with the origin (Mirtich 1996's divergence-theorem integrals, in the covariance form), and
+/// the inertia tensor's principal axes (Jacobi rotations).
 template <int D>
-RigidBodyState<D> initial_body_state(const Box<D>& box, const BodyParams<D>& params);
+MassProperties<D> shape_mass_properties(const ObstacleShape<D>& shape, double density);
+
+/// Obstacle k's mass properties at `density`: its shape's, or its box's.
+template <int D>
+MassProperties<D> obstacle_mass_properties(const SimulationParams<D>& p, std::size_t k, double density) {
+  const ObstacleShape<D>* shape = obstacle_shape(p, k);
+  return shape ? shape_mass_properties(*shape, density) : box_mass_properties(p.obstacles[k], density);
+}
+
+/// The rotation from a body's principal axes to the world's: R(q) times `mp.axes`.
+template <int D>
+std::array<double, 9> principal_frame(const RigidBodyState<D>& s, const MassProperties<D>& mp);
+
+/// The state at t = 0: the body where the scene puts it (its centre of mass at `center`), at its
+/// initial velocities.
+template <int D>
+RigidBodyState<D> initial_body_state(const Vec<D, double>& center, const BodyParams<D>& params);
 
 /// The pose (motion.h) the state gives the box whose centre at rest is `center`.
 template <int D>
@@ -64,14 +86,30 @@ struct BodyLoad {
   Vec<3, double> angular_impulse{};
 };
 
-/// The container's contact with a body: each corner of the box past a wall is pushed back by a
-/// damped spring, k pen - c v_n along the wall's normal (never pulling), with k = m w^2 and
-/// c = m w (a damping ratio of 1/2 for one corner, so that four corners at once stay stable):
-/// `omega` (w) is body_contact_rate(). Adds the
-/// impulses of a step of dt to `load`.
+/// Calls f(x) for each point of a body that meets the container, placed by `pose`: its box's
+/// corners, or its shape's vertices.
+template <int D, class F>
+void for_each_contact_point(const Box<D>& box, const ObstacleShape<D>* shape, const RigidPose<D>& pose, F&& f) {
+  if (shape) {
+    for (const Vec<D, double>& v : shape->vertices) f(pose.place(v));
+    return;
+  }
+  for (int c = 0; c < (1 << D); ++c) f(pose.place(box_corner<D>(box.lo, box.hi, c)));
+}
+
+/// The container's contact with a body: each corner of the box (each vertex of its shape) past a
+/// wall is pushed back by a damped spring, k pen - c v_n along the wall's normal (never pulling),
+/// with k = m w^2 and c = m w (a damping ratio of 1/2 for one corner, so that four corners at once
+/// stay stable): `omega` (w) is body_contact_rate(). Adds the impulses of a step of dt to `load`.
 template <int D>
 void add_container_contact(const Box<D>& container, const Box<D>& box, const RigidBodyState<D>& s,
-                           const MassProperties<D>& mp, double omega, double dt, BodyLoad<D>& load);
+                           const MassProperties<D>& mp, double omega, double dt, BodyLoad<D>& load,
+                           const ObstacleShape<D>* shape = nullptr);
+
+/// The energy of those springs, J (2D: J/m): 1/2 k pen^2 summed over the points and walls.
+template <int D>
+double container_contact_energy(const Box<D>& container, const Box<D>& box, const RigidBodyState<D>& s,
+                                const MassProperties<D>& mp, double omega, const ObstacleShape<D>* shape = nullptr);
 
 /// A box another body's corners can meet (add_body_contact): the box at rest, its pose now, and
 /// its mass, kg (0: it does not give way: a resting or prescribed-motion obstacle).
@@ -127,14 +165,24 @@ void add_moment(Vec<3, double>& moment, const Vec<D, double>& x, const Vec<D, do
 
 extern template MassProperties<2> box_mass_properties<2>(const Box<2>&, double);
 extern template MassProperties<3> box_mass_properties<3>(const Box<3>&, double);
-extern template RigidBodyState<2> initial_body_state<2>(const Box<2>&, const BodyParams<2>&);
-extern template RigidBodyState<3> initial_body_state<3>(const Box<3>&, const BodyParams<3>&);
+extern template RigidBodyState<2> initial_body_state<2>(const Vec<2, double>&, const BodyParams<2>&);
+extern template RigidBodyState<3> initial_body_state<3>(const Vec<3, double>&, const BodyParams<3>&);
+extern template MassProperties<2> shape_mass_properties<2>(const ObstacleShape<2>&, double);
+extern template MassProperties<3> shape_mass_properties<3>(const ObstacleShape<3>&, double);
+extern template std::array<double, 9> principal_frame<2>(const RigidBodyState<2>&, const MassProperties<2>&);
+extern template std::array<double, 9> principal_frame<3>(const RigidBodyState<3>&, const MassProperties<3>&);
+extern template double container_contact_energy<2>(const Box<2>&, const Box<2>&, const RigidBodyState<2>&,
+                                                   const MassProperties<2>&, double, const ObstacleShape<2>*);
+extern template double container_contact_energy<3>(const Box<3>&, const Box<3>&, const RigidBodyState<3>&,
+                                                   const MassProperties<3>&, double, const ObstacleShape<3>*);
 extern template RigidPose<2> body_pose<2>(const RigidBodyState<2>&, const Vec<2, double>&);
 extern template RigidPose<3> body_pose<3>(const RigidBodyState<3>&, const Vec<3, double>&);
 extern template void add_container_contact<2>(const Box<2>&, const Box<2>&, const RigidBodyState<2>&,
-                                              const MassProperties<2>&, double, double, BodyLoad<2>&);
+                                              const MassProperties<2>&, double, double, BodyLoad<2>&,
+                                              const ObstacleShape<2>*);
 extern template void add_container_contact<3>(const Box<3>&, const Box<3>&, const RigidBodyState<3>&,
-                                              const MassProperties<3>&, double, double, BodyLoad<3>&);
+                                              const MassProperties<3>&, double, double, BodyLoad<3>&,
+                                              const ObstacleShape<3>*);
 extern template void add_body_contact<2>(const ContactBox<2>&, const ContactBox<2>&, double, double, BodyLoad<2>&,
                                          BodyLoad<2>*);
 extern template void add_body_contact<3>(const ContactBox<3>&, const ContactBox<3>&, double, double, BodyLoad<3>&,

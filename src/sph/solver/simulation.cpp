@@ -182,8 +182,8 @@ void Simulation<D, R>::init_bodies() {
     SPH_CHECK(body_obstacle_.size() < 65535, "too many floating bodies");
     body_obstacle_.push_back(k);
     obstacle_body_[k] = static_cast<std::uint16_t>(body_obstacle_.size());
-    bodies_.push_back(initial_body_state(params_.obstacles[k], b));
-    body_mass_.push_back(box_mass_properties(params_.obstacles[k], b.density));
+    body_mass_.push_back(obstacle_mass_properties(params_, k, b.density));
+    bodies_.push_back(initial_body_state(body_mass_.back().center, b));
   }
   if (body_obstacle_.empty()) {
     obstacle_body_.clear();
@@ -262,7 +262,8 @@ void Simulation<D, R>::advance_bodies(double dt) {
     body_force_[s].impulse = load.impulse * (1.0 / dt);
     body_force_[s].angular_impulse = load.angular_impulse * (1.0 / dt);
     const std::size_t k = body_obstacle_[s];
-    add_container_contact(params_.container, params_.obstacles[k], bodies_[s], body_mass_[s], contact_rate_, dt, load);
+    add_container_contact(params_.container, params_.obstacles[k], bodies_[s], body_mass_[s], contact_rate_, dt, load,
+                          obstacle_shape(params_, k));
   }
   // Contacts between bodies (each pair once, in a fixed order), and with the obstacles that do not
   // float (they do not give way), all from the states at the step's start.
@@ -594,7 +595,7 @@ double Simulation<D, R>::body_energy() const {
     const RigidBodyState<D>& b = bodies_[s];
     const MassProperties<D>& mp = body_mass_[s];
     // Kinetic (w . I_w w, in the body's frame), gravity's, and the container contact's springs.
-    const std::array<double, 9> r = quaternion_matrix(b.orientation);
+    const std::array<double, 9> r = principal_frame(b, mp);
     double spin = 0;
     for (int a = 0; a < 3; ++a) {
       double w = 0;  // (R^T w)_a
@@ -602,15 +603,9 @@ double Simulation<D, R>::body_energy() const {
       spin += mp.inertia[a] * w * w;
     }
     e += 0.5 * mp.mass * norm2(b.velocity) + 0.5 * spin + mp.mass * (low - dot(params_.gravity, b.position));
-    const RigidPose<D> pose = body_pose(b, mp.center);
-    const Box<D>& box = params_.obstacles[body_obstacle_[s]];
-    for (int c = 0; c < (1 << D); ++c) {
-      const Vec<D, double> x = pose.place(box_corner<D>(box.lo, box.hi, c));
-      for (int d = 0; d < D; ++d) {
-        const double pen = std::max({params_.container.lo[d] - x[d], x[d] - params_.container.hi[d], 0.0});
-        e += 0.5 * mp.mass * contact_rate_ * contact_rate_ * pen * pen;
-      }
-    }
+    const std::size_t k = body_obstacle_[s];
+    e += container_contact_energy(params_.container, params_.obstacles[k], b, mp, contact_rate_,
+                                  obstacle_shape(params_, k));
   }
   return e;
 }

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # What an obstacle of any shape costs (docs/performance.md, "Mesh and polygon obstacles"): a 3D dam
-# break (14,400 particles, fixed 1 ms steps, 200 steps, 2 threads) onto an obstacle 0.2 m x 0.3 m x
+# break (14,400 particles, 200 steps, 2 threads) onto an obstacle 0.2 m x 0.3 m x
 # 0.2 m standing on the floor, given as a box and as a mesh of the same box (tests/data/meshes/cube.obj
 # scaled; 12 triangles), and as the boulder of scenes/examples (5,120 triangles, about the same
 # size), with penalty walls (the mesh's signed distance every step, for the particles near it) and
-# with boundary particles (the mesh only when sampling, at the start). RUNS times each (default 3),
+# with boundary particles (DFSPH, fixed 2 ms steps; the mesh only when sampling, at the start).
+# The penalty runs take the scene's "auto" step. RUNS times each (default 3),
 # alternating; prints each run's ms/step and the setup time (wall time less the steps').
 #   bash scripts/shape_cost.sh [SPH] [RUNS]
 set -euo pipefail
@@ -14,8 +15,8 @@ root=$(pwd)
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 scene() {  # boundary handling, obstacle JSON
-  local method='"boundaryHandling": "penalty", "timeStepSize": 0.001'
-  [ "$1" = particles ] && method='"boundaryHandling": "particles", "kernel": "cubic", "simulationMethod": "dfsph", "timeStepSize": 0.001, "cflMethod": "none"'
+  local method='"boundaryHandling": "penalty"'
+  [ "$1" = particles ] && method='"boundaryHandling": "particles", "kernel": "cubic", "simulationMethod": "dfsph", "timeStepSize": 0.002, "cflMethod": "none"'
   cat <<JSON
 { "version": 1, "name": "shape_cost", "dimension": 3,
   "Configuration": { "precision": "float", "numberOfSteps": 200, "particleRadius": 0.01, "kernelRadius": 0.04,
@@ -35,8 +36,9 @@ for k in $(seq "$runs"); do
   for b in penalty particles; do
     for c in box mesh boulder; do
       start=$(date +%s.%N)
-      line=$(OMP_WAIT_POLICY=passive "$sph" run "$dir/${c}_$b.json" -o "$dir/out_${c}_$b" --overwrite --no-progress \
-        --threads 2 2>&1 | grep -o "done.*ms/step)")
+      out=$(OMP_WAIT_POLICY=passive "$sph" run "$dir/${c}_$b.json" -o "$dir/out_${c}_$b" --overwrite --no-progress \
+        --threads 2 2>&1) || { echo "shape_cost: $c ($b) failed: $out" >&2; exit 1; }
+      line=$(grep -o "done.*ms/step)" <<<"$out")
       end=$(date +%s.%N)
       python3 - "$c" "$b" "$k" "$start" "$end" "$line" <<'PY'
 import re, sys

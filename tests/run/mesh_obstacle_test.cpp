@@ -179,6 +179,15 @@ TEST(MeshObstacle, A3DDamBreakGoesAroundATurnedMeshAndNoParticleGetsInside) {
   }
 }
 
+TEST(MeshObstacle, TheBoulderExampleKeepsEveryParticleOutOfTheBoulder) {
+  // scenes/examples/dam_break_boulder_3d.json through the water's impact on the boulder (its first
+  // 0.6 s), every 5 steps: no particle centre deeper in the mesh than the tolerance.
+  const SceneDesc desc =
+      read_scene_file(SPH_SOURCE_DIR "/scenes/examples/dam_break_boulder_3d.json", {"Configuration.stopAt=0.6"});
+  ASSERT_EQ(desc.body<3>().sim.shapes.size(), 1u);
+  EXPECT_LT(deepest_over_run<3>(desc), kTolerance * desc.body<3>().sim.particle_radius);
+}
+
 TEST(MeshObstacle, AFloatingDiamondOfHalfTheWatersDensityFloatsHalfIn) {
   // A square turned 45 degrees (a polygon), density 500, its centre on the water's surface: half
   // its area under water, as Archimedes has it, and a square log of half the water's density

@@ -38,13 +38,18 @@ struct ThreadCount {
 /// (Monaghan's artificial viscosity), which damps its pressure waves.
 constexpr const char* kViscosity[2] = {"", R"(, "viscosity": 1.0)"};
 
+/// The Configuration keys of each way to meet solids: boundary particles with DFSPH and CFL steps,
+/// or penalty springs with WCSPH and the "auto" step.
+std::string boundary_method(bool particles) {
+  return particles ? R"("boundaryHandling": "particles", "kernel": "cubic", "simulationMethod": "dfsph",
+                        "cflMaxTimeStepSize": 0.005)"
+                   : R"("boundaryHandling": "penalty")";
+}
+
 /// A 2D dam break (a column 0.3 m x 0.4 m, spacing 2 cm) onto `obstacle` (an Obstacles entry), with
 /// boundary particles and DFSPH, or penalty springs and WCSPH.
 SceneDesc dam_break_2d(const std::string& obstacle, bool particles, double stop = 1.0) {
-  const std::string method = particles
-                                 ? R"("boundaryHandling": "particles", "kernel": "cubic", "simulationMethod": "dfsph",
-                     "cflMaxTimeStepSize": 0.005)"
-                                 : R"("boundaryHandling": "penalty")";
+  const std::string method = boundary_method(particles);
   return parse_scene(fmt::format(R"({{
     "version": 1, "name": "polygon", "dimension": 2,
     "Configuration": {{ "precision": "double", "stopAt": {}, "particleRadius": 0.01, "kernelRadius": 0.04,
@@ -130,10 +135,7 @@ TEST(MeshObstacle, AClosedPolygonHoldsTheFluidInsideIt) {
   vessel += R"(], "inverted": true })";
   for (const bool particles : {true, false}) {
     SCOPED_TRACE(particles ? "boundary particles" : "penalty springs");
-    const std::string method = particles
-                                   ? R"("boundaryHandling": "particles", "kernel": "cubic", "simulationMethod": "dfsph",
-                       "cflMaxTimeStepSize": 0.005)"
-                                   : R"("boundaryHandling": "penalty")";
+    const std::string method = boundary_method(particles);
     const SceneDesc desc = parse_scene(fmt::format(R"({{
       "version": 1, "name": "vessel", "dimension": 2,
       "Configuration": {{ "precision": "double", "stopAt": 0.8, "particleRadius": 0.01, "kernelRadius": 0.04,
@@ -156,10 +158,7 @@ TEST(MeshObstacle, AClosedPolygonHoldsTheFluidInsideIt) {
 TEST(MeshObstacle, A3DDamBreakGoesAroundATurnedMeshAndNoParticleGetsInside) {
   for (const bool particles : {true, false}) {
     SCOPED_TRACE(particles ? "boundary particles" : "penalty springs");
-    const std::string method = particles
-                                   ? R"("boundaryHandling": "particles", "kernel": "cubic", "simulationMethod": "dfsph",
-                       "cflMaxTimeStepSize": 0.005)"
-                                   : R"("boundaryHandling": "penalty")";
+    const std::string method = boundary_method(particles);
     // The unit cube, scaled to 0.16 m x 0.3 m x 0.16 m and turned 45 degrees about y: an edge meets the flow.
     const SceneDesc desc =
         parse_scene(fmt::format(R"({{

@@ -166,6 +166,19 @@ void fill_face(Image& img, const Face& f, double edge, std::vector<float>* depth
   }
 }
 
+/// Sets the face's depth plane (w0, gx, gy) from the depths `w` of its corners 0, 1 and `other`
+/// (the sides q0 -> q1 and q0 -> q_other); false, leaving it, if those sides are parallel.
+bool set_depth_plane(Face& f, const std::array<double, 4>& w, int other) {
+  const double ax = f.q[1][0] - f.q[0][0], ay = f.q[1][1] - f.q[0][1];
+  const double bx = f.q[other][0] - f.q[0][0], by = f.q[other][1] - f.q[0][1];
+  const double det = ax * by - ay * bx;
+  if (!(std::abs(det) > 1e-12)) return false;
+  f.w0 = w[0];
+  f.gx = ((w[1] - w[0]) * by - (w[other] - w[0]) * ay) / det;
+  f.gy = ((w[other] - w[0]) * ax - (w[1] - w[0]) * bx) / det;
+  return true;
+}
+
 /// The outline width of solids, in pixels: about 1.5 at 800 x 600, wider in larger images.
 double solid_edge_width(const Image& img) { return 0.75 + std::min(img.width(), img.height()) / 800.0; }
 
@@ -192,19 +205,13 @@ std::vector<Face> solid_faces(const SolidBox& box, int dim, const ParticleCamera
       Face f;
       f.n = 3;
       f.outline = false;
-      std::array<double, 3> w{};
+      std::array<double, 4> w{};
       for (int k = 0; k < 3; ++k) {
         const Vec3 s = cam.project(p[k]);
         f.q[k] = {s[0], s[1]};
         w[k] = s[2];
       }
-      const double ax = f.q[1][0] - f.q[0][0], ay = f.q[1][1] - f.q[0][1];
-      const double bx = f.q[2][0] - f.q[0][0], by = f.q[2][1] - f.q[0][1];
-      const double det = ax * by - ay * bx;
-      if (!(std::abs(det) > 1e-12)) continue;
-      f.w0 = w[0];
-      f.gx = ((w[1] - w[0]) * by - (w[2] - w[0]) * ay) / det;
-      f.gy = ((w[2] - w[0]) * ax - (w[1] - w[0]) * bx) / det;
+      if (!set_depth_plane(f, w, 2)) continue;
       f.color = scaled(kSolidColor, kFaceAmbient + kFaceDiffuse * std::max(0.0, dot(n_cam, kFaceLight)));
       faces.push_back(f);
     }
@@ -242,13 +249,7 @@ std::vector<Face> solid_faces(const SolidBox& box, int dim, const ParticleCamera
         w[k] = s[2];
       }
       // Depth gradient from the sides q0 -> q1 and q0 -> q3 (a parallelogram: orthographic).
-      const double ax = f.q[1][0] - f.q[0][0], ay = f.q[1][1] - f.q[0][1];
-      const double bx = f.q[3][0] - f.q[0][0], by = f.q[3][1] - f.q[0][1];
-      const double det = ax * by - ay * bx;
-      if (!(std::abs(det) > 1e-12)) continue;
-      f.w0 = w[0];
-      f.gx = ((w[1] - w[0]) * by - (w[3] - w[0]) * ay) / det;
-      f.gy = ((w[3] - w[0]) * ax - (w[1] - w[0]) * bx) / det;
+      if (!set_depth_plane(f, w, 3)) continue;
       const Vec3 face_n{sign * n_cam[0], sign * n_cam[1], sign * n_cam[2]};
       f.color = scaled(kSolidColor, kFaceAmbient + kFaceDiffuse * std::max(0.0, dot(face_n, kFaceLight)));
       faces.push_back(f);

@@ -34,8 +34,8 @@ struct SolidBox {
   /// A solid of another shape (its surface at rest, placed as the box is; [lo, hi] its bounds):
   /// 2D, a polygon's vertices in order around it; 3D, a mesh's vertices and `triangles`, turned
   /// outwards. Empty: the box.
-  std::vector<std::array<double, 3>> vertices;
-  std::vector<std::array<std::uint32_t, 3>> triangles;
+  std::vector<std::array<double, 3>> vertices{};
+  std::vector<std::array<std::uint32_t, 3>> triangles{};
   /// The solid is outside the surface (the fluid inside it): in 2D only its outline is drawn, in
   /// 3D only the faces turned away from the camera (the far side of the vessel, cut open).
   bool inverted = false;

@@ -17,6 +17,7 @@
 #include <sph/scene/scene_reader.h>
 
 #include "support/temp_dir.h"
+#include "support/thread_count.h"
 
 namespace sph {
 namespace {
@@ -27,10 +28,7 @@ using test::TempDir;
 const std::string kTank = SPH_SOURCE_DIR "/scenes/paper/tank_fill_3d.json";
 const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
 
-struct ThreadCount {
-  int saved = num_threads();
-  ~ThreadCount() { set_num_threads(saved); }
-};
+using test::ThreadCount;
 
 SceneDesc scene(const std::string& file, const std::string& mode, const std::string& precision, int steps) {
   return read_scene_file(file,

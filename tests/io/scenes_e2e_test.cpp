@@ -14,6 +14,8 @@
 #include <sph/scene/builders.h>
 #include <sph/scene/scene_reader.h>
 
+#include "support/thread_count.h"
+
 namespace sph {
 namespace {
 
@@ -24,10 +26,7 @@ struct Expect {
 };
 
 /// Restores the thread count at scope exit.
-struct ThreadCount {
-  int saved = num_threads();
-  ~ThreadCount() { set_num_threads(saved); }
-};
+using test::ThreadCount;
 
 template <int D, class R>
 void check_state(const Simulation<D, R>& sim, const Expect& ex, const std::string& what) {

@@ -13,6 +13,8 @@
 #include <sph/neighbors/standard.h>
 #include <sph/neighbors/verlet.h>
 
+#include "support/thread_count.h"
+
 namespace sph {
 namespace {
 
@@ -38,10 +40,7 @@ void jitter(ParticleSet<3, double>& ps, double amount, unsigned seed) {
   for (auto& x : ps.position) x += V3{u(rng), u(rng), u(rng)};
 }
 
-struct ThreadCount {
-  int saved = num_threads();
-  ~ThreadCount() { set_num_threads(saved); }
-};
+using test::ThreadCount;
 
 constexpr double kH = 0.1;
 

@@ -14,6 +14,8 @@
 #include <sph/neighbors/standard.h>
 #include <sph/neighbors/tracked.h>
 
+#include "support/thread_count.h"
+
 namespace sph {
 namespace {
 
@@ -23,10 +25,7 @@ using V2 = Vec<2, double>;
 constexpr double kH = 0.1;
 constexpr double kSkin = 0.02;
 
-struct ThreadCount {
-  int saved = num_threads();
-  ~ThreadCount() { set_num_threads(saved); }
-};
+using test::ThreadCount;
 
 template <int D>
 ParticleSet<D, double> random_particles(std::size_t n, double extent, unsigned seed) {

@@ -17,6 +17,7 @@
 
 #include "support/resume.h"
 #include "support/temp_dir.h"
+#include "support/thread_count.h"
 
 namespace sph {
 namespace {
@@ -32,10 +33,7 @@ SceneDesc dam_break_cfl(double stop, double fps, const std::string& mode = "stan
                           "Configuration.neighbors=\"" + mode + "\""});
 }
 
-struct ThreadCount {
-  int saved = num_threads();
-  ~ThreadCount() { set_num_threads(saved); }
-};
+using test::ThreadCount;
 
 TEST(CflSteps, EachStepKeepsToTheLimitsOfTheStateItStartsFrom) {
   const SceneDesc desc = dam_break_cfl(0.15, 40);

@@ -17,6 +17,7 @@
 
 #include "support/resume.h"
 #include "support/temp_dir.h"
+#include "support/thread_count.h"
 
 namespace sph {
 namespace {
@@ -31,10 +32,7 @@ SceneDesc coarse_tank(double stop, const std::vector<std::string>& more = {}) {
   return read_scene_file(SPH_SOURCE_DIR "/scenes/validation/hydrostatic_2d_dfsph.json", sets);
 }
 
-struct ThreadCount {
-  int saved = num_threads();
-  ~ThreadCount() { set_num_threads(saved); }
-};
+using test::ThreadCount;
 
 struct TankRun {
   double rho_max = 0;       // the largest density / rho0 of any step

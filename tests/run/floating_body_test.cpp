@@ -20,6 +20,7 @@
 #include "support/resume.h"
 #include "support/solids.h"
 #include "support/temp_dir.h"
+#include "support/thread_count.h"
 
 namespace sph {
 namespace {
@@ -296,10 +297,7 @@ TEST(FloatingBody, BodiesMeetEachOtherAndTheRestingObstacles) {
   EXPECT_LT(std::sqrt(norm2(b.velocity)), 0.01);
 }
 
-struct ThreadCount {
-  int saved = num_threads();
-  ~ThreadCount() { set_num_threads(saved); }
-};
+using test::ThreadCount;
 
 TEST(FloatingBody, TheThreadCountChangesNothingAndAStoppedRunResumesBitForBit) {
   ThreadCount restore;

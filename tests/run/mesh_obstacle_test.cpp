@@ -22,6 +22,7 @@
 #include "support/resume.h"
 #include "support/solids.h"
 #include "support/temp_dir.h"
+#include "support/thread_count.h"
 
 namespace sph {
 namespace {
@@ -29,10 +30,7 @@ namespace {
 using test::deepest_inside;
 using test::TempDir;
 
-struct ThreadCount {
-  int saved = num_threads();
-  ~ThreadCount() { set_num_threads(saved); }
-};
+using test::ThreadCount;
 
 /// The fluid's viscosity: DFSPH's scenes' 1 Pa s (Eq. 6); WCSPH with penalty walls keeps the default
 /// (Monaghan's artificial viscosity), which damps its pressure waves.

@@ -18,6 +18,7 @@
 #include "support/resume.h"
 #include "support/solids.h"
 #include "support/temp_dir.h"
+#include "support/thread_count.h"
 
 namespace sph {
 namespace {
@@ -25,10 +26,7 @@ namespace {
 using test::deepest_inside;
 using test::TempDir;
 
-struct ThreadCount {
-  int saved = num_threads();
-  ~ThreadCount() { set_num_threads(saved); }
-};
+using test::ThreadCount;
 
 /// Whether the time is on the scene's frame schedule (CFL steps land on it exactly).
 bool on_frame(double t, double fps) { return std::abs(t * fps - std::round(t * fps)) < 1e-6; }

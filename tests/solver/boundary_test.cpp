@@ -20,16 +20,15 @@
 #include <sph/solver/smoothing.h>
 #include <sph/solver/wcsph.h>
 
+#include "support/thread_count.h"
+
 namespace sph {
 namespace {
 
 using V2 = Vec<2, double>;
 using V3 = Vec<3, double>;
 
-struct ThreadCount {
-  int saved = num_threads();
-  ~ThreadCount() { set_num_threads(saved); }
-};
+using test::ThreadCount;
 
 TEST(BoundarySampling, ShellCoversFacesEdgesAndCornersOutsideTheBox) {
   Box<2> box{V2{0, 0}, V2{0.4, 0.3}};

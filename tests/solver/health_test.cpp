@@ -14,13 +14,12 @@
 #include <sph/solver/simulation.h>
 #include <sph/solver/wcsph.h>
 
+#include "support/thread_count.h"
+
 namespace sph {
 namespace {
 
-struct ThreadCount {
-  int saved = num_threads();
-  ~ThreadCount() { set_num_threads(saved); }
-};
+using test::ThreadCount;
 
 /// A 2D tank, 0.4 m x 0.4 m, with an nx x ny block of water at rest in its corner (spacing 0.02 m).
 SimulationParams<2> tank_params() {

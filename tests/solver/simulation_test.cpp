@@ -14,6 +14,8 @@
 #include <sph/solver/simulation.h>
 #include <sph/solver/wcsph.h>
 
+#include "support/thread_count.h"
+
 // Counts every allocation in this test program (forwarding to malloc).
 namespace {
 std::atomic<std::uint64_t> g_allocations{0};
@@ -34,10 +36,7 @@ void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 namespace sph {
 namespace {
 
-struct ThreadCount {
-  int saved = num_threads();
-  ~ThreadCount() { set_num_threads(saved); }
-};
+using test::ThreadCount;
 
 /// A 3D column of water collapsing in a box (dam break), n^3 particles.
 template <class R>

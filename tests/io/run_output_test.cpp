@@ -139,7 +139,8 @@ TEST(RunOutput, WritesFramesStatsAndSummary) {
             "missed_pairs,particles_missing,max_missed_penetration,t_grid,t_lists,t_density,t_forces,t_integrate,"
             "t_output,outside,outside_depth,inside_solid,inside_depth,max_mach,rho_min,rho_max,energy,"
             "boundary_pairs_stored,boundary_missed_pairs,entries_rebuilt,list_insertions,list_removals,list_overflows,"
-            "skin,dt,solver_iterations,density_error,divergence_iterations,divergence_error,t_solve");
+            "skin,dt,solver_iterations,density_error,divergence_iterations,divergence_error,t_solve,"
+            "viscosity_iterations,viscosity_error");
   EXPECT_EQ(rows[0], stats_header());
   // step: the steps done after the row's step (1 to 5), as summary.json's steps counts them
   for (int i = 0; i < 5; ++i)

@@ -32,7 +32,7 @@ STATS_COLUMNS = ("step,time,particles,kinetic_energy,max_speed,mean_neighbors,li
                  "outside,outside_depth,inside_solid,inside_depth,max_mach,rho_min,rho_max,energy,"
                  "boundary_pairs_stored,boundary_missed_pairs,"
                  "entries_rebuilt,list_insertions,list_removals,list_overflows,skin,dt,solver_iterations,density_error,"
-                 "divergence_iterations,divergence_error,t_solve")
+                 "divergence_iterations,divergence_error,t_solve,viscosity_iterations,viscosity_error")
 PHASES = ("grid", "lists", "density", "forces", "integrate", "solve", "output")
 POINT_FIELDS = {"velocity": 3, "density": 1, "pressure": 1, "id": 1, "initial_position": 3}
 

@@ -79,7 +79,8 @@ json every_key_2d() {
       "enableDivergenceSolver": false, "maxIterationsV": 33, "maxErrorV": 2.5
     },
     "Fluid": { "density0": 1001, "stiffness": 2000, "viscosity": 0.01, "negativePressure": "clamp",
-               "pressureForce": "symmetric", "gradientCorrection": "none", "particleMass": 0.1 },
+               "pressureForce": "symmetric", "gradientCorrection": "none", "particleMass": 0.1,
+               "viscositySolver": "implicit", "viscosityMaxIterations": 17, "viscosityMaxError": 0.07 },
     "Container": { "start": [0, 0], "end": [1, 1], "wallStiffness": 1e5, "wallDamping": 0.5 },
     "FluidBlocks": [ { "start": [0, 0], "end": [0.2, 0.2], "velocity": [-0.3, 0.7] } ],
     "Obstacles": [ { "start": [0.5, 0], "end": [0.6, 0.1],

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <utility>
+#include <vector>
 
 namespace sph {
 
@@ -47,6 +48,22 @@ void parallel_chunks(std::size_t n, F&& f) {
     const std::size_t end = begin + kChunkSize < n ? begin + kChunkSize : n;
     f(static_cast<std::size_t>(c), begin, end);
   }
+}
+
+/// The sum of term(i) over [0, n), the same for any thread count: each fixed chunk of
+/// parallel_chunks sums its terms in index order into `partial` (kept by the caller, so that a
+/// step allocates nothing), and the chunks' sums are added in chunk order.
+template <class F>
+double chunked_sum(std::size_t n, std::vector<double>& partial, F&& term) {
+  partial.assign(chunk_count(n), 0.0);
+  parallel_chunks(n, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    double s = 0;
+    for (std::size_t i = begin; i < end; ++i) s += term(i);
+    partial[c] = s;
+  });
+  double s = 0;
+  for (const double p : partial) s += p;
+  return s;
 }
 
 }  // namespace sph

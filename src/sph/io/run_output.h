@@ -76,8 +76,10 @@ constexpr StatsColumn real_column(std::string_view name, StatsFormat format, dou
 /// insertions into and removals from other particles' lists and lists that outgrew their room,
 /// and the lists' skin (m; 0 in the modes without one). Then the step's time step (s), and DFSPH's
 /// solves: the constant-density solve's iterations and final average compression (%), the
-/// divergence solve's iterations and final average divergence error (% per second), and the
-/// wall seconds of the two solves (t_solve); 0 with WCSPH.
+/// divergence solve's iterations and final average divergence error (% per second), the wall
+/// seconds of the solves (t_solve: DFSPH's two and the implicit viscosity's); 0 with WCSPH.
+/// Last, the implicit viscosity solve's iterations and final residual (% of its starting one);
+/// 0 with the explicit viscosity.
 inline constexpr StatsColumn kStatsColumns[] = {
     detail::count_column("step", [](const StepStats& s) { return static_cast<std::uint64_t>(s.info.step + 1); }),
     detail::real_column("time", StatsFormat::Real9, [](const StepStats& s) { return s.info.time; }),
@@ -137,6 +139,11 @@ inline constexpr StatsColumn kStatsColumns[] = {
     detail::real_column("divergence_error", StatsFormat::Real6,
                         [](const StepStats& s) { return s.info.divergence_solve.error; }),
     detail::real_column("t_solve", StatsFormat::Real6, [](const StepStats& s) { return s.info.seconds.solve; }),
+    detail::count_column(
+        "viscosity_iterations",
+        [](const StepStats& s) { return static_cast<std::uint64_t>(s.info.viscosity_solve.iterations); }),
+    detail::real_column("viscosity_error", StatsFormat::Real6,
+                        [](const StepStats& s) { return s.info.viscosity_solve.error; }),
 };
 
 /// The header line of stats.csv: the column names, comma-separated.

@@ -41,9 +41,18 @@ inline const std::vector<std::string> kConfigurationKeys{"precision",          "
                                                          "minIterations",      "maxIterations",
                                                          "maxError",           "enableDivergenceSolver",
                                                          "maxIterationsV",     "maxErrorV"};
-inline const std::vector<std::string> kFluidKeys{
-    "density0",         "stiffness",     "viscosity",          "viscosityModel", "artificialViscosityAlpha",
-    "negativePressure", "pressureForce", "gradientCorrection", "particleMass"};
+inline const std::vector<std::string> kFluidKeys{"density0",
+                                                 "stiffness",
+                                                 "viscosity",
+                                                 "viscosityModel",
+                                                 "artificialViscosityAlpha",
+                                                 "viscositySolver",
+                                                 "viscosityMaxIterations",
+                                                 "viscosityMaxError",
+                                                 "negativePressure",
+                                                 "pressureForce",
+                                                 "gradientCorrection",
+                                                 "particleMass"};
 inline const std::vector<std::string> kContainerKeys{"start", "end", "wallStiffness", "wallDamping"};
 inline const std::vector<std::string> kFluidBlockKeys{"start", "end", "velocity"};
 inline const std::vector<std::string> kObstacleKeys{
@@ -113,6 +122,8 @@ inline constexpr Named<MotionType> kMotionTypeNames[] = {{MotionType::None, "non
                                                          {MotionType::Keyframes, "keyframes"}};
 inline constexpr Named<ViscosityModel> kViscosityModelNames[] = {{ViscosityModel::Paper, "paper"},
                                                                  {ViscosityModel::Artificial, "artificial"}};
+inline constexpr Named<ViscositySolve> kViscositySolverNames[] = {{ViscositySolve::Explicit, "explicit"},
+                                                                  {ViscositySolve::Implicit, "implicit"}};
 
 /// The names of a table, in its order (the order messages list them in).
 template <class E, std::size_t N>

@@ -510,6 +510,22 @@ void read_fluid(ObjectReader& f, SimulationParams<D>& sim, Derived& derived) {
   sim.fluid.alpha = f.positive("artificialViscosityAlpha",
                                "Monaghan's artificial viscosity coefficient alpha >= 0 (typical: 0.01 to 0.1)",
                                kArtificialViscosityAlpha, true);
+  sim.fluid.viscosity_solve = value_named(
+      detail::kViscositySolverNames, f.choice("viscositySolver", names_of(detail::kViscositySolverNames), "explicit"));
+  if (sim.fluid.viscosity_solve == ViscositySolve::Implicit && sim.fluid.viscosity_model != ViscosityModel::Paper)
+    f.ctx().fail(f.child("viscositySolver"), kImplicitViscosityNeedsPaperModel);
+  sim.fluid.viscosity_max_iterations = static_cast<int>(
+      f.integer("viscosityMaxIterations", "the implicit viscosity solve's most iterations per step, 1 to 10000", 1,
+                10000, sim.fluid.viscosity_max_iterations));
+  sim.fluid.viscosity_max_error =
+      f.positive("viscosityMaxError",
+                 "the implicit viscosity solve's tolerance: a positive % (at most 100) of its starting residual",
+                 sim.fluid.viscosity_max_error);
+  if (sim.fluid.viscosity_max_error > 100)
+    f.ctx().fail(f.child("viscosityMaxError"),
+                 fmt::format("viscosityMaxError = {:g} % is above 100 %: the tolerance is a % of the solve's starting "
+                             "residual, at most 100 (typical: 0.01 to 1)",
+                             sim.fluid.viscosity_max_error));
   sim.fluid.negative_pressure = value_named(
       detail::kNegativePressureNames, f.choice("negativePressure", names_of(detail::kNegativePressureNames), "clamp"));
   sim.fluid.pressure_force = value_named(detail::kPressureForceNames,

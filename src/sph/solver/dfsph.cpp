@@ -142,20 +142,6 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
 }
 
 template <int D, std::floating_point R>
-template <class F>
-double DfsphSolver<D, R>::chunked_sum(std::size_t n, F&& f) {
-  partial_.assign(chunk_count(n), 0.0);
-  parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
-    double sum = 0;
-    for (std::size_t i = b; i < e; ++i) sum += f(i);
-    partial_[c] = sum;
-  });
-  double total = 0;
-  for (const double p : partial_) total += p;
-  return total;
-}
-
-template <int D, std::floating_point R>
 template <class V>
 R DfsphSolver<D, R>::density_rate(std::size_t i, V&& v) const {
   const Vec<D, R> vi = v(i);
@@ -223,11 +209,12 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
 
   // The error of the current s: the average compression (as the papers measure it).
   const auto error_sum = [&] {
-    return chunked_sum(n, [&](std::size_t i) { return static_cast<double>(std::max(scale * (b_[i] - as_[i]), R(0))); });
+    return sph::chunked_sum(
+        n, partial_, [&](std::size_t i) { return static_cast<double>(std::max(scale * (b_[i] - as_[i]), R(0))); });
   };
   // Sums over the active set.
   const auto active_sum = [&](auto&& f) {
-    return chunked_sum(n, [&](std::size_t i) { return active_[i] ? f(i) : 0.0; });
+    return sph::chunked_sum(n, partial_, [&](std::size_t i) { return active_[i] ? f(i) : 0.0; });
   };
   apply(s_, acc_s_, as_);
   double error = error_sum();

@@ -46,16 +46,10 @@
 #include <sph/neighbors/neighbor_lists.h>
 #include <sph/solver/params.h>
 #include <sph/solver/smoothing.h>
+#include <sph/solver/solve_stats.h>
 #include <sph/solver/wcsph.h>
 
 namespace sph {
-
-/// What one solve did.
-struct SolveStats {
-  int iterations = 0;     ///< iterations (each one applies A once: two passes over the neighbours)
-  double error = 0;       ///< the average error after them: % (density), % per second (divergence)
-  bool converged = true;  ///< the error reached the tolerance
-};
 
 /// The DFSPH solves of one run. Its warm-start values are particle fields (added to the
 /// ParticleSet by the constructor): they follow reordering, emission and checkpoints.
@@ -95,9 +89,6 @@ class DfsphSolver {
   /// (J v)_i: the density rate of particle i under the velocities v(j), on the step's pairs.
   template <class V>
   R density_rate(std::size_t i, V&& v) const;
-  /// sum over the particles of f(i), in fixed chunks (the same for any thread count).
-  template <class F>
-  double chunked_sum(std::size_t n, F&& f);
 
   DfsphParams params_;
   R spacing_;

@@ -67,6 +67,18 @@ enum class ViscosityModel {
   Artificial,
 };
 
+/// How the fluid's viscosity term (ViscosityModel::Paper: Eq. 6, or Morris et al.'s with the
+/// cubic spline and Wendland C2) is integrated in time.
+enum class ViscositySolve {
+  /// In the force pass, with the step's velocities (forward Euler); the step is held below the
+  /// viscous diffusion limit 0.125 h^2 rho0 / mu (default).
+  Explicit,
+  /// Backward Euler, solved by conjugate gradients on the step's pairs within h (viscosity.h): the
+  /// velocities after the step satisfy m_i v_i = m_i v*_i + dt sum_j m_i k_ij (v_j - v_i). Stable
+  /// at any step, so the viscous limit no longer bounds the step.
+  Implicit,
+};
+
 /// Weakly compressible fluid: EOS p = k (rho - rho0).
 struct FluidParams {
   double rest_density = 1000;  ///< rho0, kg/m^D
@@ -78,6 +90,11 @@ struct FluidParams {
   KernelKind kernel = KernelKind::Paper;  ///< the smoothing kernels of density, gradient and viscosity
   ViscosityModel viscosity_model = ViscosityModel::Paper;
   double alpha = 0.1;  ///< ViscosityModel::Artificial's coefficient (Monaghan 1992)
+  ViscositySolve viscosity_solve = ViscositySolve::Explicit;
+  /// ViscositySolve::Implicit: the solve's most iterations per step, and its tolerance: the
+  /// residual as a % of the starting one (the explicit step's viscous impulse).
+  int viscosity_max_iterations = 100;
+  double viscosity_max_error = 0.1;  ///< %
 
   friend bool operator==(const FluidParams&, const FluidParams&) = default;
 };
@@ -168,6 +185,12 @@ enum class SimulationMethod {
 inline constexpr const char* kDfsphNeedsBoundaryParticles =
     "DFSPH needs boundary particles: penalty springs push with forces the pressure solve does not see, and at "
     "DFSPH's large time steps they are unstable; set Configuration.boundaryHandling to \"particles\"";
+
+/// Why the implicit viscosity refuses Monaghan's artificial viscosity (the reader and Simulation).
+inline constexpr const char* kImplicitViscosityNeedsPaperModel =
+    "the implicit viscosity solves the viscosity term of viscosityModel \"paper\" (Eq. 6, or Morris's with the cubic "
+    "spline and Wendland C2); Monaghan's artificial viscosity acts only on approaching pairs, which no linear solve "
+    "can take: set viscosityModel to \"paper\" or viscositySolver to \"explicit\"";
 
 /// DFSPH's two solves (Configuration keys of SPlisHSPlasH's names; docs/scene-format.md).
 struct DfsphParams {

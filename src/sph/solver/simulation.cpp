@@ -19,20 +19,6 @@ namespace sph {
 
 namespace {
 
-/// Deterministic sum over particles: fixed chunks, partial sums added in chunk order.
-template <class F>
-double chunked_sum(std::size_t n, std::vector<double>& partial, F&& term) {
-  partial.assign(chunk_count(n), 0.0);
-  parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
-    double s = 0;
-    for (std::size_t i = b; i < e; ++i) s += term(i);
-    partial[c] = s;
-  });
-  double s = 0;
-  for (double p : partial) s += p;
-  return s;
-}
-
 /// Measures one particle for the health statistics (after its motion): containment, speed,
 /// density ratio, and its energy, kinetic + gravity (from the container's lowest point along g)
 /// + the wall springs it compresses (the penetrations of WallContact, ks pen^2 / 2 per kg); and,
@@ -142,6 +128,11 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
       throw Error(kDfsphNeedsBoundaryParticles, "Configuration.simulationMethod");
     dfsph_ =
         std::make_unique<DfsphSolver<D, R>>(params_.dfsph, particles_, static_cast<R>(2.0 * params_.particle_radius));
+  }
+  if (params_.fluid.viscosity_solve == ViscositySolve::Implicit) {
+    if (params_.fluid.viscosity_model != ViscosityModel::Paper)
+      throw Error(kImplicitViscosityNeedsPaperModel, "Fluid.viscositySolver");
+    viscosity_ = std::make_unique<ImplicitViscosity<D, R>>();
   }
   if (any_obstacle_moves(params_)) {
     SPH_CHECK(params_.motions.size() <= params_.obstacles.size() && params_.bodies.size() <= params_.obstacles.size(),
@@ -519,6 +510,12 @@ const StepInfo& Simulation<D, R>::step() {
   compute_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity), walls,
                         neighbors_->pair_exit_flags(), dt, solid, neighbors_->pair_exit_radius(), !dfsph_);
   info.seconds.forces = watch.lap();
+  // The viscosity backward in time, after every other acceleration of the step (DFSPH's density
+  // solve then sees the velocities it leaves).
+  if (viscosity_) {
+    info.viscosity_solve = viscosity_->solve(particles_, lists, h, params_.fluid, dt);
+    info.seconds.solve += watch.lap();
+  }
   if (dfsph_) {
     info.density_solve = last_density_solve_ = dfsph_->density_solve(particles_, rho0, dt);
     info.seconds.solve += watch.lap();

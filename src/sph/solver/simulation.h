@@ -13,6 +13,7 @@
 #include <sph/solver/health.h>
 #include <sph/solver/params.h>
 #include <sph/solver/rigid_body.h>
+#include <sph/solver/viscosity.h>
 #include <sph/solver/wcsph.h>
 
 namespace sph {
@@ -46,6 +47,7 @@ struct StepInfo {
   HealthStats health;                ///< measured in the integrate pass, judged by the health monitor
   SolveStats density_solve;          ///< DFSPH: the constant-density solve (0 iterations with WCSPH)
   SolveStats divergence_solve;       ///< DFSPH: the divergence solve
+  SolveStats viscosity_solve;        ///< Fluid.viscositySolver "implicit": the viscosity solve
 };
 
 namespace detail {
@@ -225,9 +227,10 @@ class Simulation {
   double time_ = 0;         // TimeStepping::Cfl: simulated time, s
   double last_cfl_dt_ = 0;  // the last step's CFL step before barriers shortened it (its growth limit), s
   double barrier_ = kNoLimit;
-  double cfl_limit_ = kNoLimit;               // TimeStepping::Cfl: the scene's limits but the acoustic one, s
-  std::unique_ptr<DfsphSolver<D, R>> dfsph_;  // SimulationMethod::Dfsph
-  SolveStats last_density_solve_;             // its last constant-density solve (the CFL step's feedback)
+  double cfl_limit_ = kNoLimit;                         // TimeStepping::Cfl: the scene's limits but the acoustic one, s
+  std::unique_ptr<DfsphSolver<D, R>> dfsph_;            // SimulationMethod::Dfsph
+  std::unique_ptr<ImplicitViscosity<D, R>> viscosity_;  // ViscositySolve::Implicit
+  SolveStats last_density_solve_;                       // its last constant-density solve (the CFL step's feedback)
   HealthMonitor monitor_;
   StepInfo info_;
 };

@@ -23,7 +23,8 @@ std::vector<TimeStepLimit> time_step_limits(const SimulationParams<D>& p) {
     out.back().acoustic = true;
   }
   const double nu = p.fluid.viscosity / p.fluid.rest_density;
-  if (p.fluid.viscosity_model == ViscosityModel::Paper && nu > 0)
+  // (integrated implicitly, the viscosity has no step limit)
+  if (p.fluid.viscosity_model == ViscosityModel::Paper && p.fluid.viscosity_solve == ViscositySolve::Explicit && nu > 0)
     add("viscous diffusion (dt <= 0.125 h^2 rho0 / viscosity)", 0.125 * h * h / nu, 0.5 * h * h / nu);
   // Artificial viscosity's diffusion, nu = alpha h c / (2 (D + 2)) (Monaghan 2005), is below the
   // acoustic limit's for alpha < 1; it is checked the same way.

@@ -182,7 +182,8 @@ template <int D, std::floating_point R>
 struct ForceConstants {
   ForceConstants(R h, const FluidParams& fluid, const BoundaryView<D, R>& boundary)
       : h(h),
-        mu(static_cast<R>(fluid.viscosity)),
+        // (ViscositySolve::Implicit: the viscosity solve adds it after this pass, viscosity.h)
+        mu(fluid.viscosity_solve == ViscositySolve::Implicit ? R(0) : static_cast<R>(fluid.viscosity)),
         c0(static_cast<R>(std::sqrt(std::max(fluid.stiffness, 0.0)))),
         artificial(fluid.viscosity_model == ViscosityModel::Artificial),
         alpha(static_cast<R>(fluid.alpha)),

@@ -1,7 +1,8 @@
 // The implicit viscosity (Fluid.viscositySolver "implicit") in a run: a very viscous column
 // (mu = 100 Pa s) collapses with DFSPH at the flow's CFL steps, over 20 times the explicit
 // term's, and ends where the explicit run at small steps ends; the explicit run at those steps
-// is what the viscous limit exists to prevent.
+// is what the viscous limit exists to prevent, and its CFL steps keep below the term's
+// stability bound.
 
 #include <algorithm>
 #include <string>
@@ -9,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <sph/core/error.h>
 #include <sph/run/driver.h>
 #include <sph/scene/scene_reader.h>
 
@@ -76,11 +78,25 @@ TEST(ImplicitViscosity, AViscousColumnAtTheFlowsStepsEndsWhereTheExplicitRunAtSm
 }
 
 TEST(ImplicitViscosity, TheViscousLimitNoLongerBoundsTheStep) {
-  // The scene's explicit limit is 0.125 h^2 rho0 / mu = 5e-4 s: refused above it by 4x with the
-  // explicit term, accepted with the implicit one.
+  // The scene's explicit limit is 0.0625 h^2 rho0 / mu = 2.5e-4 s (the cubic spline): refused
+  // above 4 times it with the explicit term, accepted with the implicit one.
   const std::vector<std::string> fixed{R"(Configuration.cflMethod="none")", "Configuration.timeStepSize=0.004"};
   EXPECT_THROW(viscous_column("explicit", fixed), Error);
   EXPECT_NO_THROW(viscous_column("implicit", fixed));
+}
+
+TEST(ExplicitViscosity, CflStepsStayBelowTheTermsStabilityBound) {
+  // Forward Euler on Morris's term is stable up to about 0.095 h^2 rho0 / mu on this lattice
+  // (scripts/viscous_limit.py). The CFL steps take 0.8 of the warning level 0.0625: the column
+  // runs 0.1 s without a health warning. At 0.8 of the level before 2026-12-05 (0.125), 4e-4 s,
+  // forced, it gains energy and fails (at step 88 when measured).
+  const std::vector<std::string> short_run{"Configuration.stopAt=0.1"};
+  const ColumnRun cfl = run_column(viscous_column("explicit", short_run));
+  EXPECT_EQ(cfl.warnings, 0u);
+  EXPECT_GT(cfl.steps, 400);  // (the viscous level holds the step: 2e-4 s at most)
+  std::vector<std::string> old_step = short_run;
+  old_step.insert(old_step.end(), {"Configuration.cflMinTimeStepSize=4e-4", "Configuration.cflMaxTimeStepSize=4e-4"});
+  EXPECT_THROW(run_column(viscous_column("explicit", old_step)), Error);
 }
 
 }  // namespace

@@ -23,9 +23,19 @@ std::vector<TimeStepLimit> time_step_limits(const SimulationParams<D>& p) {
     out.back().acoustic = true;
   }
   const double nu = p.fluid.viscosity / p.fluid.rest_density;
-  // (integrated implicitly, the viscosity has no step limit)
-  if (p.fluid.viscosity_model == ViscosityModel::Paper && p.fluid.viscosity_solve == ViscositySolve::Explicit && nu > 0)
-    add("viscous diffusion (dt <= 0.125 h^2 rho0 / viscosity)", 0.125 * h * h / nu, 0.5 * h * h / nu);
+  // Forward Euler is stable while dt lambda_max <= 2, lambda_max the viscosity operator's largest
+  // eigenvalue; on a lattice (scripts/viscous_limit.py) that is dt <= 0.127-0.147 h^2 / nu for Eq. 6's
+  // Laplacian and 0.078-0.095 h^2 / nu for Morris's (the cubic spline and Wendland C2 at 2 to 3
+  // spacings). The warning levels stay below: 0.125 and 0.0625. (Integrated implicitly, the
+  // viscosity has no step limit.)
+  if (p.fluid.viscosity_model == ViscosityModel::Paper && p.fluid.viscosity_solve == ViscositySolve::Explicit &&
+      nu > 0) {
+    if (p.fluid.kernel == KernelKind::Paper)
+      add("viscous diffusion (dt <= 0.125 h^2 rho0 / viscosity)", 0.125 * h * h / nu, 0.5 * h * h / nu);
+    else
+      add("viscous diffusion (dt <= 0.0625 h^2 rho0 / viscosity with the cubic spline and Wendland C2)",
+          0.0625 * h * h / nu, 0.25 * h * h / nu);
+  }
   // Artificial viscosity's diffusion, nu = alpha h c / (2 (D + 2)) (Monaghan 2005), is below the
   // acoustic limit's for alpha < 1; it is checked the same way.
   const double nu_art = p.fluid.alpha * h * c / (2.0 * (D + 2));

@@ -193,6 +193,24 @@ TEST(Health, ANonFiniteVelocityStillBlowsUp) {
   EXPECT_NE(e.find("is not finite"), std::string::npos) << e;
 }
 
+TEST(Health, AVeryViscousFluidGainingEnergyIsToldOfTheImplicitViscosityNotToRaiseIt) {
+  HealthScene scene;
+  scene.sound_speed = 10, scene.kernel_radius = 0.04, scene.time_step = 1e-3;
+  scene.viscosity = 100;  // Monaghan's alpha = 0.1 is 2.5 Pa s here
+  HealthMonitor monitor(scene);
+  monitor.set_initial(100.0, 1.0);
+  HealthStats s;
+  s.energy = 250.0;
+  const std::string e = error_of([&] { monitor.check(s, 2, 3e-3, 10); });
+  EXPECT_NE(e.find("Fluid.viscositySolver \"implicit\""), std::string::npos) << e;
+  EXPECT_EQ(e.find("raise Fluid.viscosity"), std::string::npos) << e;
+  scene.implicit_viscosity = true;  // (already implicit: the usual advice)
+  HealthMonitor implicit(scene);
+  implicit.set_initial(100.0, 1.0);
+  const std::string f = error_of([&] { implicit.check(s, 2, 3e-3, 10); });
+  EXPECT_EQ(f.find("viscositySolver"), std::string::npos) << f;
+}
+
 TEST(Health, EnergyGrowthInAClosedSceneWarns) {
   HealthScene scene;
   scene.sound_speed = 10, scene.kernel_radius = 0.04, scene.time_step = 1e-3;
@@ -206,6 +224,7 @@ TEST(Health, EnergyGrowthInAClosedSceneWarns) {
   monitor.check(s, 1, 2e-3, 10);
   EXPECT_EQ(s.new_warnings, 1u << static_cast<int>(HealthKind::Energy));
   EXPECT_NE(monitor.warning(HealthKind::Energy).find("lower Configuration.timeStepSize"), std::string::npos);
+  EXPECT_NE(monitor.warning(HealthKind::Energy).find("raise Fluid.viscosity"), std::string::npos);
   s.new_warnings = 0, s.energy = 250.0;
   const std::string e = error_of([&] { monitor.check(s, 2, 3e-3, 10); });
   EXPECT_NE(e.find("simulation gained energy at step 2"), std::string::npos) << e;

@@ -80,6 +80,7 @@ HealthScene health_scene(const SimulationParams<D>& p) {
   s.incompressible = p.method == SimulationMethod::Dfsph;
   s.boundary_particles = p.boundary.handling == BoundaryHandling::Particles;
   s.misses_pairs = p.neighbors == NeighborMode::Adaptive;
+  s.implicit_viscosity = p.fluid.viscosity_solve == ViscositySolve::Implicit;
   if (p.time_stepping == TimeStepping::Cfl) s.time_step = p.cfl.max_dt;
   return s;
 }
@@ -180,6 +181,14 @@ void HealthMonitor::check(HealthStats& st, std::int64_t step, double time, std::
   if (s.closed) {
     const double growth = (st.energy - initial_energy_) / energy_scale();
     const auto advice = [&] {
+      // A fluid far more viscous than the damping needs: its explicit viscous term is what a long
+      // step makes unstable, and more viscosity would make it worse.
+      if (!s.implicit_viscosity && s.viscosity > 10 * suggested_viscosity(s))
+        return fmt::format(
+            "a closed, damped scene cannot gain energy: lower Configuration.timeStepSize (now {:.3g} s, e.g. to "
+            "{:.3g} s), or, the fluid being this viscous (Fluid.viscosity {:.3g}, {:.0f} times Monaghan's alpha = "
+            "0.1), integrate its viscosity backward in time: Fluid.viscositySolver \"implicit\" (stable at any step)",
+            s.time_step, 0.5 * s.time_step, s.viscosity, s.viscosity / suggested_viscosity(s));
       return fmt::format(
           "a closed, damped scene cannot gain energy: lower Configuration.timeStepSize (now {:.3g} s, e.g. to "
           "{:.3g} s) or raise Fluid.viscosity (now {:.3g}; Monaghan's alpha = 0.1 is about {:.3g})",

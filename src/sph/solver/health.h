@@ -89,6 +89,7 @@ struct HealthScene {
   bool incompressible = false;      ///< SimulationMethod::Dfsph: the Mach number is not judged
   bool boundary_particles = false;  ///< BoundaryHandling::Particles (no wall springs to advise on)
   bool misses_pairs = false;        ///< NeighborMode::Adaptive: the lists can miss pairs coming into range
+  bool implicit_viscosity = false;  ///< ViscositySolve::Implicit (no viscous step limit to advise on)
 };
 
 template <int D>

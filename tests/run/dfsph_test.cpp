@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <sph/core/error.h>
 #include <sph/core/parallel.h>
 #include <sph/run/driver.h>
 #include <sph/scene/scene_reader.h>
@@ -103,6 +104,24 @@ TEST(Dfsph, PenaltyWallsAreRefused) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("DFSPH needs boundary particles"), std::string::npos) << e.what();
   }
+}
+
+TEST(Dfsph, ASupportAboveTwoAndAHalfSpacingsIsWarnedOfAndTheWarningIsTrue) {
+  const auto warned = [](const SceneDesc& d) {
+    return std::any_of(d.warnings.begin(), d.warnings.end(),
+                       [](const std::string& w) { return w.find("above 2.5 spacings") != std::string::npos; });
+  };
+  const std::string tank = SPH_SOURCE_DIR "/scenes/validation/hydrostatic_2d_dfsph.json";
+  EXPECT_FALSE(warned(read_scene_file(tank)));                                         // (2.5 spacings)
+  const SceneDesc wide = read_scene_file(tank, {"Configuration.kernelRadius=0.015"});  // 3 spacings
+  EXPECT_TRUE(warned(wide));
+  // The resting tank on 3 spacings gains energy from rest and fails (at step 22 when measured).
+  RunDriver<2, double> run(wide, RunSettings{});
+  EXPECT_THROW(
+      {
+        for (int k = 0; k < 60; ++k) run.step();
+      },
+      Error);
 }
 
 TEST(Dfsph, TheThreadCountChangesNothing) {

@@ -181,18 +181,20 @@ void HealthMonitor::check(HealthStats& st, std::int64_t step, double time, std::
   if (s.closed) {
     const double growth = (st.energy - initial_energy_) / energy_scale();
     const auto advice = [&] {
+      const std::string smaller_step = fmt::format(
+          "a closed, damped scene cannot gain energy: lower Configuration.timeStepSize (now {:.3g} s, "
+          "e.g. to {:.3g} s)",
+          s.time_step, 0.5 * s.time_step);
+      const double viscous = s.viscosity / suggested_viscosity(s);
       // A fluid far more viscous than the damping needs: its explicit viscous term is what a long
       // step makes unstable, and more viscosity would make it worse.
-      if (!s.implicit_viscosity && s.viscosity > 10 * suggested_viscosity(s))
+      if (!s.implicit_viscosity && viscous > 10)
         return fmt::format(
-            "a closed, damped scene cannot gain energy: lower Configuration.timeStepSize (now {:.3g} s, e.g. to "
-            "{:.3g} s), or, the fluid being this viscous (Fluid.viscosity {:.3g}, {:.0f} times Monaghan's alpha = "
-            "0.1), integrate its viscosity backward in time: Fluid.viscositySolver \"implicit\" (stable at any step)",
-            s.time_step, 0.5 * s.time_step, s.viscosity, s.viscosity / suggested_viscosity(s));
-      return fmt::format(
-          "a closed, damped scene cannot gain energy: lower Configuration.timeStepSize (now {:.3g} s, e.g. to "
-          "{:.3g} s) or raise Fluid.viscosity (now {:.3g}; Monaghan's alpha = 0.1 is about {:.3g})",
-          s.time_step, 0.5 * s.time_step, s.viscosity, suggested_viscosity(s));
+            "{}, or, the fluid being this viscous (Fluid.viscosity {:.3g}, {:.0f} times Monaghan's alpha = 0.1), "
+            "integrate its viscosity backward in time: Fluid.viscositySolver \"implicit\" (stable at any step)",
+            smaller_step, s.viscosity, viscous);
+      return fmt::format("{} or raise Fluid.viscosity (now {:.3g}; Monaghan's alpha = 0.1 is about {:.3g})",
+                         smaller_step, s.viscosity, suggested_viscosity(s));
     };
     if (growth > watch(HealthKind::Energy).fail)
       fail(

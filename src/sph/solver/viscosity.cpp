@@ -1,47 +1,12 @@
 #include <sph/solver/viscosity.h>
 
-#include <algorithm>
 #include <cmath>
 
 #include <sph/core/error.h>
-#include <sph/core/kernels.h>
 #include <sph/core/parallel.h>
+#include <sph/solver/smoothing.h>
 
 namespace sph {
-
-namespace {
-
-/// The pair's viscosity coefficient without the masses and densities, c(r) with
-/// k_ij = c(r) m_j / (rho_i rho_j) (viscosity.h), the force pass's formulas (wcsph.cpp): mu lap
-/// W_visc(r) with the paper's kernels, -2 mu (x_ij . grad W_ij) / (r^2 + 0.01 h^2) with Morris's.
-template <int D, std::floating_point R>
-class PairCoefficient {
- public:
-  PairCoefficient(const FluidParams& fluid, R h)
-      : kind_(fluid.kernel), h_(h), mu_(static_cast<R>(fluid.viscosity)), lap_(h), cubic_(h), wendland_(h) {}
-  /// c for a pair at squared distance r2 < h^2.
-  R operator()(R r2) const {
-    const R r = std::sqrt(r2);
-    switch (kind_) {
-      case KernelKind::Cubic:
-        return R(-2) * mu_ * (cubic_.gradient_factor(r) * r2) / (r2 + R(0.01) * h_ * h_);
-      case KernelKind::Wendland:
-        return R(-2) * mu_ * (wendland_.gradient_factor(r) * r2) / (r2 + R(0.01) * h_ * h_);
-      case KernelKind::Paper:
-        break;
-    }
-    return mu_ * lap_.laplacian(r);
-  }
-
- private:
-  KernelKind kind_;
-  R h_, mu_;
-  ViscosityKernel<D, R> lap_;
-  CubicSplineKernel<D, R> cubic_;
-  WendlandC2Kernel<D, R> wendland_;
-};
-
-}  // namespace
 
 template <int D, std::floating_point R>
 void ImplicitViscosity<D, R>::apply(const std::vector<Vec<D, R>>& x, std::vector<Vec<D, R>>& y) const {
@@ -70,9 +35,11 @@ SolveStats ImplicitViscosity<D, R>::solve(ParticleSet<D, R>& ps, const NeighborL
   SPH_CHECK(lists.particle_count() == n, "implicit viscosity: neighbor lists do not cover the particles");
   if (n == 0 || !(dt > R(0)) || !(fluid.viscosity > 0)) return stats;
   const R h2 = h * h;
-  const PairCoefficient<D, R> coefficient(fluid, h);
-  // The step's pairs within h, and w_ij = dt m_i k_ij = dt c(r) (m_i m_j) / (rho_i rho_j): the
-  // same number for (i, j) and (j, i), so the matrix is exactly symmetric.
+  const SmoothingKernels<D, R> kernels(fluid, h);
+  const R mu = static_cast<R>(fluid.viscosity);
+  // The step's pairs within h, and w_ij = dt m_i k_ij = dt mu L(r) (m_i m_j) / (rho_i rho_j)
+  // (SmoothingKernels::viscosity_laplacian): the same number for (i, j) and (j, i), so the matrix
+  // is exactly symmetric.
   begin_.resize(n + 1);
   begin_[0] = 0;
   parallel_for(n, [&](std::size_t i) {
@@ -95,7 +62,7 @@ SolveStats ImplicitViscosity<D, R>::solve(ParticleSet<D, R>& ps, const NeighborL
     for (const std::uint32_t j : lists.of(i)) {
       const R r2 = norm2(xi - ps.position[j]);
       if (!(r2 < h2)) continue;
-      const R w = dt * coefficient(r2) * ((mi * ps.mass[j]) * (inv_rhoi * (R(1) / ps.density[j])));
+      const R w = dt * mu * kernels.viscosity_laplacian(r2) * ((mi * ps.mass[j]) * (inv_rhoi * (R(1) / ps.density[j])));
       pair_j_[k] = j, pair_w_[k] = w, ++k;
       diag += w;
     }

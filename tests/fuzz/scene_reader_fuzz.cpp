@@ -129,13 +129,11 @@ void check_preflight_promises(const sph::SceneDesc& desc) {
   const sph::SimulationParams<D>& p = body.sim;
   const double dx = 2 * p.particle_radius;
   const auto ps = sph::build_particles<D, double>(body);
+  // Each block's kept particles, in block order (a block cut by obstacle shapes keeps fewer
+  // particles than its lattice has sites).
   std::vector<std::size_t> block_of;
-  for (std::size_t b = 0; b < body.blocks.size(); ++b) {
-    sph::SceneBody<D> one;
-    one.sim.particle_radius = p.particle_radius;
-    one.blocks.push_back(body.blocks[b]);
-    block_of.insert(block_of.end(), sph::count_block_particles<D>(one), b);
-  }
+  const std::vector<sph::BlockCount> counts = sph::count_block_particles_kept<D>(body);
+  for (std::size_t b = 0; b < counts.size(); ++b) block_of.insert(block_of.end(), counts[b].kept, b);
   promise(block_of.size() == ps.size(), "one block per built particle");
   for (std::size_t i = 0; i < ps.size(); ++i)
     for (std::size_t j = i + 1; j < ps.size(); ++j)

@@ -96,6 +96,18 @@ TEST(Dfsph, HoldsARestingTankAtRestDensityWithLongSteps) {
   EXPECT_GT(wcsph.bottom_error, 3 * dfsph.bottom_error);
 }
 
+TEST(Dfsph, TheGradientCorrectionReachesTheSolvesAndHoldsTheTank) {
+  // (Fluid.gradientCorrection was once read and then ignored by DFSPH.)
+  const TankRun plain = run_tank(coarse_tank(0.3));
+  const TankRun corrected = run_tank(coarse_tank(0.3, {"Fluid.gradientCorrection=\"renormalize\""}));
+  EXPECT_NE(plain.bottom_ratio, corrected.bottom_ratio);
+  EXPECT_EQ(corrected.unconverged, 0);
+  EXPECT_LT(corrected.rho_max, 1.01);
+  EXPECT_LT(corrected.bottom_error, 5e-4);
+  EXPECT_GE(corrected.min_pressure, 0.0);
+  EXPECT_NEAR(corrected.bottom_ratio, 1.0, 0.25);
+}
+
 TEST(Dfsph, PenaltyWallsAreRefused) {
   try {
     (void)read_scene_file(SPH_SOURCE_DIR "/scenes/validation/hydrostatic_2d_dfsph.json",

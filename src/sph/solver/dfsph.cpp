@@ -5,6 +5,7 @@
 
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
+#include <sph/solver/gradient_correction.h>
 
 namespace sph {
 
@@ -64,8 +65,10 @@ DfsphSolver<D, R>::DfsphSolver(const DfsphParams& params, ParticleSet<D, R>& ps,
 
 template <int D, std::floating_point R>
 void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const NeighborLists& lists,
-                                        const SmoothingKernels<D, R>& kernels, const BoundaryView<D, R>& boundary) {
+                                        const SmoothingKernels<D, R>& kernels, const BoundaryView<D, R>& boundary,
+                                        std::span<const R> correction) {
   const std::size_t n = ps.size();
+  SPH_CHECK(correction.empty() || correction.size() == n * D * D, "DFSPH: one gradient correction per particle");
   beta_.resize(n);
   const R h = kernels.radius(), h2 = h * h;
   // Once (the first call with particles: an emitter scene may start empty): the floor of beta,
@@ -118,16 +121,19 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
     R squares = 0;
     int count = 0;
     std::size_t k = begin_[i];
+    const R* li = correction.empty() ? nullptr : &correction[i * D * D];
     for_neighbours(
         ps, i, lists, kernels, boundary, h2,
-        [&](std::uint32_t j, const Vec<D, R>& g) {
+        [&](std::uint32_t j, const Vec<D, R>& plain) {
+          const Vec<D, R> g = li ? corrected_gradient<D, R>(li, &correction[std::size_t{j} * D * D], plain) : plain;
           const Vec<D, R> mg = g * ps.mass[j];
           pair_j_[k] = j, pair_g_[k] = mg, ++k;
           sum += mg;
           squares += ps.mass[j] * norm2(g);
           ++count;
         },
-        [&](std::uint32_t b, const Vec<D, R>& g) {
+        [&](std::uint32_t b, const Vec<D, R>& plain) {
+          const Vec<D, R> g = li ? corrected_gradient<D, R>(li, li, plain) : plain;
           solid += g * boundary.psi[b];
           if (!boundary.velocity.empty()) solid_rate_[i] += boundary.psi[b] * dot(boundary.velocity[b], g);
           if (bodies_ > 0 && boundary.body[b] != 0)

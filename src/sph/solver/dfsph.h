@@ -40,6 +40,7 @@
 /// count.
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <sph/core/particle_set.h>
@@ -65,9 +66,13 @@ class DfsphSolver {
   DfsphSolver(const DfsphParams& params, ParticleSet<D, R>& ps, R spacing);
 
   /// Computes beta_i of the particles' positions, and keeps the step's pairs within h (with
-  /// m_j grad W_ij) for the solves.
+  /// m_j grad W_ij) for the solves. `correction`: the kernel-gradient correction's L
+  /// (gradient_corrections, D x D per particle; empty: none). With it every gradient of the
+  /// solves, the constraint's as the force's, is corrected as in the WCSPH pressure force:
+  /// (L_i + L_j) / 2 grad W_ij for a pair, L_i grad W_ib for a boundary sample, so A stays
+  /// symmetric and a linear pressure gets its exact gradient in the interior.
   void compute_factors(const ParticleSet<D, R>& ps, const NeighborLists& lists, const SmoothingKernels<D, R>& kernels,
-                       const BoundaryView<D, R>& boundary);
+                       const BoundaryView<D, R>& boundary, std::span<const R> correction = {});
   /// The divergence solve: changes ps.velocity. Needs compute_factors of this state.
   SolveStats divergence_solve(ParticleSet<D, R>& ps, R rho0, R dt);
   /// The constant-density solve: adds the pressure accelerations to ps.acceleration (which holds

@@ -10,6 +10,7 @@
 #include <sph/core/parallel.h>
 #include <sph/core/state_stream.h>
 #include <sph/core/timer.h>
+#include <sph/solver/gradient_correction.h>
 #include <sph/solver/nozzle.h>
 #include <sph/solver/smoothing.h>
 #include <sph/solver/time_step.h>
@@ -488,7 +489,13 @@ const StepInfo& Simulation<D, R>::step() {
   info.pairs_within_h = compute_density_pressure(particles_, lists, h, params_.fluid, solid);
   const R rho0 = static_cast<R>(params_.fluid.rest_density);
   if (dfsph_) {
-    dfsph_->compute_factors(particles_, lists, SmoothingKernels<D, R>(params_.fluid, h), solid);
+    const SmoothingKernels<D, R> kernels(params_.fluid, h);
+    std::span<const R> correction;
+    if (params_.fluid.gradient_correction == GradientCorrection::Renormalize) {
+      gradient_corrections(particles_, lists, kernels, solid, rho0, gradient_correction_);
+      correction = gradient_correction_;
+    }
+    dfsph_->compute_factors(particles_, lists, kernels, solid, correction);
     info.seconds.density = watch.lap();
     // (its velocity change does not depend on dt: the last step's is as good as any)
     if (params_.dfsph.divergence_solver)

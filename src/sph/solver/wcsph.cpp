@@ -9,6 +9,7 @@
 #include <sph/core/kernels.h>
 #include <sph/core/parallel.h>
 #include <sph/core/simd.h>
+#include <sph/solver/gradient_correction.h>
 #include <sph/solver/smoothing.h>
 
 namespace sph {
@@ -407,52 +408,6 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
   });
 }
 
-/// L_i = A_i^-1 with A_i = sum_j V_j grad_i W_ij (x_j - x_i)^T (row-major D x D per particle;
-/// the boundary samples' V_b = psi_b / rho0 included), or the identity where det A_i < 1/2
-/// (see GradientCorrection::Renormalize).
-template <int D, std::floating_point R>
-std::vector<R> gradient_corrections(const ParticleSet<D, R>& ps, const NeighborLists& lists,
-                                    const SmoothingKernels<D, R>& kernels, const BoundaryView<D, R>& boundary,
-                                    R rest_density) {
-  std::vector<R> L(ps.size() * D * D);
-  const bool solid = boundary.active();
-  parallel_for(ps.size(), [&](std::size_t i) {
-    R a[D][D] = {};
-    const auto add = [&](const Vec<D, R>& rij, R v) {
-      const Vec<D, R> g = kernels.gradient(rij);
-      for (int r = 0; r < D; ++r)
-        for (int c = 0; c < D; ++c) a[r][c] -= v * g[r] * rij[c];  // x_j - x_i = -rij
-    };
-    for (const std::uint32_t j : lists.of(i)) add(ps.position[i] - ps.position[j], ps.mass[j] / ps.density[j]);
-    if (solid)
-      for (const std::uint32_t b : boundary.lists->of(i))
-        add(ps.position[i] - boundary.position[b], boundary.psi[b] / rest_density);
-    R* out = &L[i * D * D];
-    R det;
-    if constexpr (D == 2)
-      det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
-    else
-      det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-            a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-    if (!(det >= R(0.5))) {  // also NaN
-      for (int r = 0; r < D; ++r)
-        for (int c = 0; c < D; ++c) out[r * D + c] = r == c ? R(1) : R(0);
-      return;
-    }
-    if constexpr (D == 2) {
-      out[0] = a[1][1] / det, out[1] = -a[0][1] / det, out[2] = -a[1][0] / det, out[3] = a[0][0] / det;
-    } else {
-      // The adjugate's transpose over the determinant.
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) {
-          const int r1 = (c + 1) % 3, r2 = (c + 2) % 3, c1 = (r + 1) % 3, c2 = (r + 2) % 3;
-          out[r * 3 + c] = (a[r1][c1] * a[r2][c2] - a[r1][c2] * a[r2][c1]) / det;
-        }
-    }
-  });
-  return L;
-}
-
 /// Adds the pressure accelerations with corrected gradients: each pair's term of the plain
 /// force (in its form) with grad W_ij replaced by (L_i + L_j) / 2 grad W_ij; a boundary sample's
 /// (its pressure extrapolated or mirrored, as in the force pass) by L_i grad W_ib.
@@ -461,7 +416,8 @@ void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, 
                              const BoundaryView<D, R>& boundary) {
   const SmoothingKernels<D, R> kernels(fluid, h);
   const R rho0 = static_cast<R>(fluid.rest_density);
-  const std::vector<R> L = gradient_corrections(ps, lists, kernels, boundary, rho0);
+  std::vector<R> L;
+  gradient_corrections(ps, lists, kernels, boundary, rho0, L);
   const bool paper = fluid.pressure_force == PressureForce::Paper;
   const bool solid = boundary.active();
   parallel_for(ps.size(), [&](std::size_t i) {
@@ -473,12 +429,7 @@ void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, 
       const R inv_rhoj = R(1) / ps.density[j];
       const R pij = paper ? (R(0.5) * ps.pressure[i] + R(0.5) * ps.pressure[j]) * inv_rhoi * inv_rhoj
                           : ps.pressure[i] * inv_rhoi * inv_rhoi + ps.pressure[j] * inv_rhoj * inv_rhoj;
-      const R* lj = &L[std::size_t{j} * D * D];
-      for (int r = 0; r < D; ++r) {
-        R gc = 0;
-        for (int c = 0; c < D; ++c) gc += R(0.5) * (li[r * D + c] + lj[r * D + c]) * g[c];
-        acc[r] -= ps.mass[j] * pij * gc;
-      }
+      acc -= corrected_gradient<D, R>(li, &L[std::size_t{j} * D * D], g) * (ps.mass[j] * pij);
     }
     if (solid) {
       const R pii = (paper ? R(1) : R(2)) * ps.pressure[i] * inv_rhoi * inv_rhoi;
@@ -492,17 +443,10 @@ void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, 
           if (boundary.clamp) pb = std::max(pb, R(0));
           pib = w * (pi_sym + pb);
         }
-        for (int r = 0; r < D; ++r) {
-          R gc = 0;
-          for (int c = 0; c < D; ++c) gc += li[r * D + c] * g[c];
-          acc[r] -= boundary.psi[b] * pib * gc;
-        }
+        const Vec<D, R> gc = corrected_gradient<D, R>(li, li, g);  // L_i grad W_ib
+        acc -= gc * (boundary.psi[b] * pib);
         if (!boundary.body.empty() && boundary.body_acceleration && boundary.body[b] != 0)
-          for (int r = 0; r < D; ++r) {
-            R gc = 0;
-            for (int c = 0; c < D; ++c) gc += li[r * D + c] * g[c];
-            boundary.body_row(i)[boundary.body[b] - 1][r] -= boundary.psi[b] * pib * gc;
-          }
+          boundary.body_row(i)[boundary.body[b] - 1] -= gc * (boundary.psi[b] * pib);
       }
     }
     ps.acceleration[i] += acc;

@@ -1,0 +1,70 @@
+#!/usr/bin/env python3
+"""A resting tank's pressure profile, bin by bin, through the Python module (docs/validation.md,
+"DFSPH": where the pressure misses rho0 g d).
+
+    PYTHONPATH=build/python python3 scripts/tank_bins.py SCENE [KEY=VALUE ...]
+
+Runs the scene (KEY=VALUE as --set) and averages each particle's pressure, density and position
+over the steps of the run's last tenth, as sph validate does. The free surface is the mean of each
+column's top particle plus half a spacing. Prints, for each 2-spacing depth bin below the second
+layer, the mean p / (rho0 g d) of the whole bin and of its interior (the particles at least 3
+spacings from the side walls), with their counts.
+"""
+import json
+import sys
+
+import numpy as np
+import sph
+
+
+def main():
+    overrides = {}
+    for arg in sys.argv[2:]:
+        key, value = arg.split("=", 1)
+        try:
+            overrides[key] = json.loads(value)
+        except ValueError:
+            overrides[key] = value
+    scene = sph.load_scene(sys.argv[1], overrides=overrides)
+    d = scene.to_dict()
+    dim = d["dimension"]
+    dx = 2 * d["Configuration"]["particleRadius"]
+    g = -d["Configuration"]["gravitation"][1]
+    rho0 = d["Fluid"]["density0"]
+    lo, hi = d["Container"]["start"], d["Container"]["end"]
+    end = d["Configuration"]["stopAt"]
+    sim = sph.Simulation(scene)
+    while sim.time < 0.9 * end:
+        sim.step(1)
+    sums, n = None, 0
+    while sim.time < end * (1 - 1e-12):  # the last tenth, by particle id
+        sim.step(1)
+        order = np.argsort(np.asarray(sim.ids))
+        now = [np.asarray(a)[order] for a in (sim.pressures, sim.positions, sim.densities)]
+        sums = now if sums is None else [s + a for s, a in zip(sums, now)]
+        n += 1
+    p, x, rho = (s / n for s in sums)
+    tops = {}
+    for xx in x:
+        key = (int(np.floor(xx[0] / dx)), int(np.floor(xx[2] / dx)) if dim == 3 else 0)
+        tops[key] = max(tops.get(key, -np.inf), xx[1])
+    surface = float(np.mean(list(tops.values()))) + dx / 2
+    depth = surface - x[:, 1]
+    wall = np.full(len(x), np.inf)
+    for a in [0] + ([2] if dim == 3 else []):
+        wall = np.minimum(wall, np.minimum(x[:, a] - lo[a], hi[a] - x[:, a]))
+    print(f"{n} steps averaged, surface {surface:.4f} m, mean |rho - rho0| / rho0 "
+          f"{np.mean(np.abs(rho - rho0)) / rho0:.2e}")
+    deep = depth > 2 * dx
+    bins = np.floor((depth - 2 * dx) / (2 * dx)).astype(int)
+    for k in np.unique(bins[deep]):
+        whole = deep & (bins == k)
+        inner = whole & (wall > 3 * dx)
+        ratio = p[whole].mean() / (rho0 * g * depth[whole].mean())
+        inside = p[inner].mean() / (rho0 * g * depth[inner].mean()) if inner.any() else float("nan")
+        print(f"bin {k:2d}  depth {depth[whole].mean():.4f} m  whole {ratio:.3f} ({whole.sum()})  "
+              f"interior {inside:.3f} ({inner.sum()})")
+
+
+if __name__ == "__main__":
+    main()

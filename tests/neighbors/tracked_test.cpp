@@ -43,7 +43,8 @@ ParticleSet<D, double> random_particles(std::size_t n, double extent, unsigned s
 /// Every pair within h is listed both ways, the lists are symmetric, without self or
 /// duplicates, and hold only pairs within h + skin + the motion allowed since (3 triggers).
 template <int D>
-void expect_exact(const TrackedNeighbors<D, double>& t, const ParticleSet<D, double>& ps, const std::string& when) {
+void expect_exact(const TrackedNeighbors<D, double>& t, const ParticleSet<D, double>& ps, const std::string& when,
+                  double reach = 0) {
   SCOPED_TRACE(when);
   const NeighborLists& l = t.lists();
   ASSERT_EQ(l.particle_count(), ps.size());
@@ -60,7 +61,7 @@ void expect_exact(const TrackedNeighbors<D, double>& t, const ParticleSet<D, dou
     ASSERT_FALSE(std::binary_search(sorted[i].begin(), sorted[i].end(), static_cast<std::uint32_t>(i)));
   }
   EXPECT_EQ(entries, l.entry_count());
-  const double reach = kH + t.skin() + 3 * t.trigger();
+  if (reach == 0) reach = kH + t.skin() + 3 * t.trigger();
   for (std::size_t i = 0; i < ps.size(); ++i) {
     for (const std::uint32_t j : exact.of(i))
       ASSERT_TRUE(std::binary_search(sorted[i].begin(), sorted[i].end(), j)) << "pair " << i << "-" << j << " missed";
@@ -243,18 +244,23 @@ TEST(Tracked, SameListsInTheSameOrderForAnyThreadCount) {
   }
 }
 
+/// Saves `from`'s state and loads it into `to` (a fresh strategy of the same settings).
+void save_and_load(const TrackedNeighbors<3, double>& from, TrackedNeighbors<3, double>& to, std::size_t particles) {
+  std::stringstream buf;
+  StateWriter w(buf);
+  from.save_state(w);
+  StateReader r(buf, 1u << 30, "a test");
+  to.load_state(r, particles);
+}
+
 TEST(Tracked, SavedAndLoadedStateContinuesIdentically) {
   for (const bool exit_test : {false, true}) {
     SCOPED_TRACE(exit_test ? "adaptive_exact" : "tracked");
     auto ps = random_particles<3>(3000, 1.0, 6);
     TrackedNeighbors<3, double> a(kH, 0, 25, 1e-3, exit_test);
     run_sequence(a, ps, 0, 20);
-    std::stringstream buf;
-    StateWriter w(buf);
-    a.save_state(w);
     TrackedNeighbors<3, double> b(kH, 0, 25, 1e-3, exit_test);
-    StateReader r(buf, 1u << 30, "a test");
-    b.load_state(r, ps.size());
+    save_and_load(a, b, ps.size());
     auto ps_b = ps;
     const auto ca = run_sequence(a, ps, 20, 45);
     const auto cb = run_sequence(b, ps_b, 20, 45);
@@ -264,12 +270,154 @@ TEST(Tracked, SavedAndLoadedStateContinuesIdentically) {
   }
 }
 
+// The path rule (set_time): particles followed along their velocity at their build.
+
+/// How far apart a listed pair can be: its paths met within h + s in the windows, each path
+/// runs kTrackedReach h, and each particle is up to a trigger off its path.
+double path_reach(const TrackedNeighbors<3, double>& t) {
+  return kH + t.skin() + 4 * kTrackedReach * kH + 3 * t.trigger() + 1e-9;
+}
+
+/// One step of a flow: v += a dt, x += v dt, then the lists at the new time.
+void flow_step(TrackedNeighbors<3, double>& t, ParticleSet<3, double>& ps, const std::vector<V3>& a, double dt,
+               double& time) {
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    ps.velocity[i] += a[i] * dt;
+    ps.position[i] += ps.velocity[i] * dt;
+  }
+  time += dt;
+  t.set_time(time);
+  t.update(ps);
+}
+
+TEST(TrackedPaths, ABlockMovingAsOneIsRebuiltOnlyWhenItsPathsRunOut) {
+  ParticleSet<3, double> ps;
+  const V3 v{3, -2, 1};  // 3.7 mm per step: the displacement rule would rebuild every other step
+  for (int a = 0; a < 10; ++a)
+    for (int b = 0; b < 10; ++b)
+      for (int c = 0; c < 10; ++c) ps.add(V3{0.04 * a, 0.04 * b, 0.04 * c}, v, 1.0);
+  TrackedNeighbors<3, double> t(kH, kSkin, 1000, 1e-3, false);
+  double time = 0;
+  t.set_time(time);
+  t.update(ps);
+  const std::vector<V3> still(ps.size());
+  std::size_t rebuilt = 0;
+  int rebuild_steps = 0;
+  for (int s = 0; s < 60; ++s) {
+    flow_step(t, ps, still, 1e-3, time);
+    rebuilt += t.counters().lists_rebuilt;
+    rebuild_steps += t.counters().lists_rebuilt > 0;
+    expect_exact(t, ps, "step " + std::to_string(s), path_reach(t));
+    if (HasFatalFailure()) return;
+  }
+  // A path runs kTrackedReach h in |v| / (kTrackedReach h) steps; the lists are rebuilt on the
+  // first step past it.
+  EXPECT_EQ(rebuilt, static_cast<std::size_t>(rebuild_steps) * ps.size());  // all at once, when the paths run out
+  const double window_steps = kTrackedReach * kH / std::sqrt(norm2(v)) / 1e-3;
+  EXPECT_NEAR(rebuild_steps, 60 / (std::floor(window_steps) + 1), 1.0);
+  EXPECT_LT(rebuild_steps, 30);  // the displacement rule: every other step
+}
+
+// Two particles closing head-on at 12 m/s through a resting lattice: they follow their paths
+// exactly (never off them), so only the path test can list them before they meet.
+TEST(TrackedPaths, FastParticlesClosingHeadOnAreNeverMissed) {
+  ParticleSet<3, double> ps;
+  for (int a = 0; a < 12; ++a)
+    for (int b = 0; b < 12; ++b)
+      for (int c = 0; c < 12; ++c) ps.add(V3{0.05 * a, 0.05 * b, 0.05 * c} + V3::filled(0.0123), V3{}, 1.0);
+  const std::size_t p = ps.size(), q = p + 1;
+  ps.add(V3{0.03, 0.301, 0.302}, V3{6, 0, 0}, 1.0);
+  ps.add(V3{0.58, 0.302, 0.301}, V3{-6, 0, 0}, 1.0);
+  TrackedNeighbors<3, double> t(kH, kSkin, 1000, 1e-3, false);
+  double time = 0;
+  t.set_time(time);
+  t.update(ps);
+  const std::vector<V3> still(ps.size());
+  bool met = false;
+  for (int s = 0; s < 100 && ps.position[p][0] < 0.58; ++s) {
+    flow_step(t, ps, still, 1e-3, time);
+    met = met || norm2(ps.position[p] - ps.position[q]) < kH * kH;
+    expect_exact(t, ps, "step " + std::to_string(s), path_reach(t));
+    if (HasFatalFailure()) return;
+  }
+  EXPECT_TRUE(met);
+}
+
+/// A gas of particles with random velocities (up to 4 m/s) and random accelerations (up to
+/// 200 m/s^2, redrawn every step), at random steps of 0.5 to 1.5 ms; some emitted on the way.
+std::vector<NeighborCounters> random_flow(TrackedNeighbors<3, double>& t, ParticleSet<3, double>& ps, double& time,
+                                          int from, int to, bool check) {
+  std::vector<NeighborCounters> out;
+  for (int s = from; s < to; ++s) {
+    std::mt19937 rng(300 + static_cast<unsigned>(s));
+    std::uniform_real_distribution<double> u(-1, 1);
+    if (s % 9 == 4)
+      for (int k = 0; k < 20; ++k) ps.add(V3{0.3 + 0.012 * k, 0.2, 0.25}, V3{0, 2, 0}, 1.0);
+    std::vector<V3> a(ps.size());
+    for (auto& ai : a) ai = V3{u(rng), u(rng), u(rng)} * 115.0;
+    if (!t.pair_exit_flags().empty())
+      for (std::size_t i = static_cast<std::size_t>(s); i < t.pair_exit_flags().size(); i += 97)
+        t.pair_exit_flags()[i] = 1;
+    flow_step(t, ps, a, 1e-3 * (1 + 0.5 * u(rng)), time);
+    out.push_back(t.counters());
+    if (check) expect_exact(t, ps, "step " + std::to_string(s), path_reach(t));
+  }
+  return out;
+}
+
+ParticleSet<3, double> moving_gas(std::size_t n, unsigned seed) {
+  auto ps = random_particles<3>(n, 0.5, seed);
+  std::mt19937 rng(seed + 1);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (auto& v : ps.velocity) v = V3{u(rng), u(rng), u(rng)} * 2.3;
+  return ps;
+}
+
+TEST(TrackedPaths, AnAcceleratingGasAtRandomStepsIsNeverMissed) {
+  for (const bool exit_test : {false, true}) {
+    SCOPED_TRACE(exit_test ? "adaptive_exact" : "tracked");
+    auto ps = moving_gas(1500, 8);
+    TrackedNeighbors<3, double> t(kH, kSkin, 1000, 1e-3, exit_test);
+    double time = 0.37;
+    t.set_time(time);
+    t.update(ps);
+    const auto counts = random_flow(t, ps, time, 0, 50, true);
+    std::size_t rebuilt = 0, particles = 0;
+    for (const auto& c : counts) rebuilt += c.lists_rebuilt;
+    for (int s = 0; s < 50; ++s) particles += 1500 + 20 * static_cast<std::size_t>((s + 5) / 9);
+    EXPECT_LT(rebuilt, particles) << "not every list every step";
+  }
+}
+
+TEST(TrackedPaths, SameListsForAnyThreadCountAndAfterASaveAndLoad) {
+  ThreadCount keep;
+  auto ps1 = moving_gas(3000, 9);
+  auto ps3 = ps1;
+  TrackedNeighbors<3, double> one(kH, 0, 25, 1e-3, false), three(kH, 0, 25, 1e-3, false);
+  double t1 = 0, t3 = 0;
+  set_num_threads(1);
+  const auto c1 = random_flow(one, ps1, t1, 0, 30, false);
+  set_num_threads(3);
+  const auto c3 = random_flow(three, ps3, t3, 0, 30, false);
+  EXPECT_TRUE(one.lists() == three.lists());
+  EXPECT_TRUE(same_counts(c1, c3));
+  // Saved after 30 steps and loaded into a fresh strategy: the next 20 steps are the same.
+  TrackedNeighbors<3, double> loaded(kH, 0, 25, 1e-3, false);
+  save_and_load(three, loaded, ps3.size());
+  auto ps_loaded = ps3;
+  double t_loaded = t3;
+  const auto ca = random_flow(three, ps3, t3, 30, 50, false);
+  const auto cb = random_flow(loaded, ps_loaded, t_loaded, 30, 50, false);
+  EXPECT_TRUE(three.lists() == loaded.lists());
+  EXPECT_TRUE(same_counts(ca, cb));
+}
+
 TEST(AdaptiveExact, Eq7FlagsRebuildTheFlaggedParticles) {
   auto ps = random_particles<3>(2000, 1.0, 7);
   TrackedNeighbors<3, double> t(kH, kSkin, 200, 1e-3, true);
   t.update(ps);
   ASSERT_EQ(t.pair_exit_flags().size(), ps.size());
-  EXPECT_EQ(t.pair_exit_radius(), kH + kSkin);
+  EXPECT_EQ(t.pair_exit_radius(), (kH + kSkin + t.trigger() + 2 * kTrackedReach * kH) * 1.0001);
   t.pair_exit_flags()[5] = 1;
   t.pair_exit_flags()[700] = 1;
   t.update(ps);

@@ -39,7 +39,7 @@ namespace sph {
 /// name and kind, in kParticleFields order, then the fields a run added (ParticleSet::save);
 /// version 2 kept the frames' times and the schedule's next tick instead of version 1's .vtu
 /// file list.
-inline constexpr std::uint32_t kCheckpointVersion = 10;
+inline constexpr std::uint32_t kCheckpointVersion = 11;
 /// The checkpoint's file name in a run's output directory.
 inline constexpr const char* kCheckpointFile = "checkpoint.sphc";
 

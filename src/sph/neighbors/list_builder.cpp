@@ -209,7 +209,8 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
     for (std::size_t i = b; i < e; ++i) {
       st.update(grid, query.cell(i));
       ensure_room(buf, used + st.candidates + kRoom);
-      const std::uint32_t m = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + used);
+      std::uint32_t m = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + used);
+      if (filter_) m = filter_->keep(i, buf.data() + used, m);
       out.begin_[i] = static_cast<std::uint32_t>(used);
       out.end_[i] = static_cast<std::uint32_t>(used + m);
       entries += m;
@@ -293,6 +294,7 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
         st.update(grid, query.cell(i));
         ensure_room(buf, at + st.candidates + kRoom);
         len = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at);
+        if (filter_) len = filter_->keep(i, buf.data() + at, len);
         written += len;
         cap = room_ ? list_capacity(len) : len;
         ensure_room(buf, at + cap + kRoom);
@@ -349,7 +351,8 @@ void ListBuilder<D, R>::rebuild_in_place(const UniformGrid<D, R>& grid, std::siz
       if (i >= old_n) {  // appended: its list goes after the chunk's last one
         const std::size_t at = i == b ? 0 : lists.begin_[i - 1] + lists.cap_[i - 1];
         ensure_room(buf, at + st.candidates + kRoom);
-        const std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at);
+        std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at);
+        if (filter_) len = filter_->keep(i, buf.data() + at, len);
         const std::uint32_t cap = list_capacity(len);
         ensure_room(buf, at + cap + kRoom);
         std::fill_n(buf.data() + at + len, cap - len + kRoom, 0u);
@@ -362,7 +365,8 @@ void ListBuilder<D, R>::rebuild_in_place(const UniformGrid<D, R>& grid, std::siz
         continue;
       }
       ensure_room(scratch, st.candidates + kRoom);
-      const std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, scratch.data());
+      std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, scratch.data());
+      if (filter_) len = filter_->keep(i, scratch.data(), len);
       written += len;
       if (len > lists.cap_[i]) {
         const std::uint32_t want = list_capacity(len);

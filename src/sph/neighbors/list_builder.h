@@ -27,6 +27,16 @@ struct RebuildVisitor {
                        std::span<const std::uint32_t> after) = 0;
 };
 
+/// Sees each list a ListBuilder gathers (set_filter), before it is stored, and keeps the entries
+/// it wants: the tracked modes keep, of the candidates within the builder's radius, the pairs
+/// whose paths come close (tracked.h). Called from the thread that builds the list.
+struct ListFilter {
+  virtual ~ListFilter() = default;
+  /// Keeps some of the `len` entries of point i's list, in place and in their order; returns how
+  /// many it kept.
+  virtual std::uint32_t keep(std::size_t i, std::uint32_t* list, std::uint32_t len) const = 0;
+};
+
 template <int D, std::floating_point R>
 class ListBuilder {
  public:
@@ -61,6 +71,9 @@ class ListBuilder {
   /// slots for a list of that size, so that other lists' particles can be inserted (the tracked
   /// modes); rebuild_some() keeps a kept list's capacity. Off by default (compact lists).
   void keep_room(bool on) { room_ = on; }
+  /// Every list built from now on is passed through `filter` (null: none) before it is stored;
+  /// capacities and counts are those of the filtered lists.
+  void set_filter(const ListFilter* filter) { filter_ = filter; }
   /// The capacity a list of `size` entries is built with when lists keep room: a quarter more and 4.
   static std::uint32_t list_capacity(std::uint32_t size) { return size + size / 4 + 4; }
 
@@ -78,6 +91,7 @@ class ListBuilder {
 
   bool vector_ = true;
   bool room_ = false;
+  const ListFilter* filter_ = nullptr;
   std::vector<std::size_t> chunk_entries_;
   std::vector<std::int64_t> chunk_delta_;
   std::vector<std::size_t> chunk_written_;

@@ -32,12 +32,13 @@ inline constexpr NeighborModeInfo kNeighborModes[] = {
     {NeighborMode::Verlet, "verlet", "exact lists of radius h + skin, all rebuilt once a particle moved half the skin",
      true},
     {NeighborMode::Tracked, "tracked",
-     "exact per-particle lists of radius h + skin: a list is rebuilt once its particle moved a third of the skin, "
-     "and inserted into its new neighbors' lists (docs/neighbor-modes.md)",
+     "exact per-particle lists of the pairs whose paths (positions and velocities at their builds) come within h + "
+     "skin: a list is rebuilt once its particle is a third of the skin off its path or its path has run 0.1 h, and "
+     "inserted into its new neighbors' lists (docs/neighbor-modes.md)",
      true, true},
     {NeighborMode::AdaptiveExact, "adaptive_exact",
-     "the paper's Eq. 7 test on tracked lists (a pair predicted to leave h + skin flags both): Algorithm 2 without "
-     "missed pairs",
+     "the paper's Eq. 7 test on tracked lists (a pair predicted to leave the lists' reach flags both): Algorithm 2 "
+     "without missed pairs",
      true, true},
     {NeighborMode::BruteForce, "brute_force", "compares every pair, O(N^2): the tests' oracle, for tiny scenes", false},
 };

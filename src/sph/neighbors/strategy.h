@@ -53,6 +53,9 @@ class NeighborStrategy {
   /// since the last call (emitters); none are removed.
   virtual void update(const ParticleSet<D, R>& particles) = 0;
   virtual const NeighborLists& lists() const = 0;
+  /// The simulated time (s) of the state the next update() sees. The tracked modes follow each
+  /// particle along a path in time; the others ignore it.
+  virtual void set_time(double t) { (void)t; }
 
   /// Static boundary samples (boundary particles): from now on every update() also keeps
   /// boundary_lists(), each fluid particle's samples closer than h, by the strategy's own rule:
@@ -60,7 +63,7 @@ class NeighborStrategy {
   /// fluid list, and the Eq. 7 test flags a particle for its fluid-boundary pairs too; verlet
   /// lists the samples within h + skin and rebuilds them with the fluid lists. Called before
   /// the first update; the samples never move.
-  void set_boundary(std::span<const Vec<D, R>> samples) { boundary_.set_samples(samples, list_radius()); }
+  void set_boundary(std::span<const Vec<D, R>> samples) { boundary_.set_samples(samples, boundary_radius()); }
   /// The samples moved (moving obstacles; as many as were set): the next update() rebuilds
   /// every boundary list, whatever the strategy's rule, so that no fluid-boundary pair is missed.
   void move_boundary(std::span<const Vec<D, R>> samples) { boundary_.move_samples(samples); }
@@ -105,6 +108,8 @@ class NeighborStrategy {
  protected:
   /// The radius the lists hold pairs within (h; verlet: h + skin).
   virtual R list_radius() const = 0;
+  /// The radius of the boundary lists (list_radius(); the tracked modes reach further).
+  virtual R boundary_radius() const { return list_radius(); }
   BoundaryLists<D, R> boundary_;
 };
 

@@ -6,6 +6,7 @@
 
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
+#include <sph/core/simd.h>
 #include <sph/core/state_stream.h>
 #include <sph/core/timer.h>
 
@@ -32,6 +33,72 @@ TrackedNeighbors<D, R>::TrackedNeighbors(R radius, R skin, int full_rebuild_peri
 }
 
 template <int D, std::floating_point R>
+R TrackedNeighbors<D, R>::window(const Vec<D, R>& v) const {
+  const double speed = std::sqrt(static_cast<double>(norm2(v)));
+  return speed > 0 ? static_cast<R>(kTrackedReach * static_cast<double>(radius_) / speed)
+                   : std::numeric_limits<R>::infinity();
+}
+
+template <int D, std::floating_point R>
+void TrackedNeighbors<D, R>::start_path(const ParticleSet<D, R>& ps, std::size_t i) {
+  built_at_[i] = path_now_[i] = ps.position[i];
+  built_velocity_[i] = ps.velocity[i];
+  built_time_[i] = time_;
+  left_[i] = window(ps.velocity[i]);
+  window_end_[i] = time_ + static_cast<double>(left_[i]);
+}
+
+template <int D, std::floating_point R>
+std::uint32_t TrackedNeighbors<D, R>::PathFilter::keep(std::size_t i, std::uint32_t* list, std::uint32_t len) const {
+  // The closest approach of the two paths over [now, the first window's end]: the relative path
+  // r0 + dw t, 0 <= t <= min(left_i, left_j); receding or parallel paths are closest now. Lanes
+  // of simd::Pack (the portable Pack where AVX-512 is missing: the same operations in the same
+  // order, so the same lists), and symmetric bit for bit when both particles are rebuilt now:
+  // r0 and dw change sign, and j's path is where j is.
+  using P = simd::Pack<R>;
+  constexpr int kW = simd::kLanes<R>;
+  static_assert(sizeof(Vec<D, R>) == D * sizeof(R));
+  const TrackedNeighbors& t = *self;
+  const R* path = reinterpret_cast<const R*>(t.path_now_.data());
+  const R* w = reinterpret_cast<const R*>(t.built_velocity_.data());
+  const R* left = t.left_.data();
+  const R reach = t.radius_ + t.skin_;
+  const P reach2 = P::set1(reach * reach), zero = P::set1(R(0)), li = P::set1(t.left_[i]);
+  P xi[D], wi[D];
+  for (int d = 0; d < D; ++d) xi[d] = P::set1(t.built_at_[i][d]), wi[d] = P::set1(t.built_velocity_[i][d]);
+  std::uint32_t kept = 0;
+  alignas(64) std::uint32_t idx[kW];
+  for (std::uint32_t k = 0; k < len; k += kW) {
+    const std::uint32_t lanes = std::min<std::uint32_t>(kW, len - k);
+    for (int l = 0; l < kW; ++l) idx[l] = list[k + std::min<std::uint32_t>(static_cast<std::uint32_t>(l), lanes - 1)];
+    P r0[D], dw[D];
+    for (int d = 0; d < D; ++d) {
+      r0[d] = xi[d] - P::template gather<D>(path, idx, d);
+      dw[d] = wi[d] - P::template gather<D>(w, idx, d);
+    }
+    P d2 = r0[0] * r0[0], b = r0[0] * dw[0], a = dw[0] * dw[0];
+    for (int d = 1; d < D; ++d) d2 = d2 + r0[d] * r0[d], b = b + r0[d] * dw[d], a = a + dw[d] * dw[d];
+    // (only lanes with b < 0 use t; there a > 0)
+    const simd::Mask approach = (b < zero) & (d2 > reach2);
+    if (approach != 0) {
+      const P lj = P::template gather<1>(left, idx, 0);
+      const P span = select(lj < li, lj, li);
+      P tm = (zero - b) / select(approach, a, P::set1(R(1)));
+      tm = select(span < tm, span, tm);
+      P e2 = zero;
+      for (int d = 0; d < D; ++d) {
+        const P e = r0[d] + dw[d] * tm;
+        e2 = e2 + e * e;
+      }
+      d2 = select(approach, e2, d2);
+    }
+    simd::Mask meet = ~(d2 > reach2) & simd::first_lanes<R>(lanes);
+    for (; meet != 0; meet &= meet - 1) list[kept++] = idx[__builtin_ctz(meet)];
+  }
+  return kept;
+}
+
+template <int D, std::floating_point R>
 void TrackedNeighbors<D, R>::choose_skin(const ParticleSet<D, R>& particles) {
   if (fixed_skin_ > R(0)) return;
   const std::size_t n = particles.size();
@@ -54,19 +121,26 @@ void TrackedNeighbors<D, R>::set_skin(R skin) {
   skin_ = skin;
   // The samples' grid is indexed for the lists' radius.
   samples_copy_.assign(this->boundary_.samples().begin(), this->boundary_.samples().end());
-  if (!samples_copy_.empty()) this->boundary_.set_samples(samples_copy_, radius_ + skin_);
+  if (!samples_copy_.empty()) this->boundary_.set_samples(samples_copy_, boundary_radius());
 }
 
 template <int D, std::floating_point R>
 void TrackedNeighbors<D, R>::full_build(const ParticleSet<D, R>& particles) {
   Stopwatch watch;
   choose_skin(particles);
-  const R r = radius_ + skin_;
+  const R r = candidate_radius();
   grid_.build(particles.position, r);
   counters_.grid_seconds = watch.lap();
+  const std::size_t n = particles.size();
+  for (auto* v : {&built_at_, &built_velocity_, &path_now_}) v->resize(n);
+  built_time_.resize(n);
+  window_end_.resize(n);
+  left_.resize(n);
+  parallel_for(n, [&](std::size_t i) { start_path(particles, i); });
+  filter_.self = this;  // (set at each build: the strategy may have been moved)
+  builder_.set_filter(&filter_);
   builder_.build(grid_, particles.position, r, lists_);
   this->boundary_.build(particles.position);
-  built_at_.assign(particles.position.begin(), particles.position.end());
   // Room for the changes a step's rebuilds make to other lists: two per particle of a chunk
   // covers steady flows many times over (a vector grows past it only in a violent step).
   changes_.resize(chunk_count(particles.size()));
@@ -81,7 +155,8 @@ void TrackedNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
   const std::size_t n = particles.size();
   const std::size_t old_n = lists_.particle_count();
   SPH_CHECK(n < kRemove, "too many particles for the tracked lists");
-  const bool full = invalid_ || old_n == 0 || built_at_.size() != old_n || updates_ % period_ == 0;
+  const bool full = invalid_ || old_n == 0 || built_at_.size() != old_n || built_velocity_.size() != old_n ||
+                    built_time_.size() != old_n || window_end_.size() != old_n || updates_ % period_ == 0;
   invalid_ = false;
   ++updates_;
   counters_ = {};
@@ -89,17 +164,28 @@ void TrackedNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
   if (full) {
     full_build(particles);
   } else {
-    // 1. Marks: moved more than the trigger since its own build, emitted since the last update, or
-    // (exit test) flagged by Eq. 7.
+    // 1. Marks: more than the trigger off its path, its path's window closed, emitted since the
+    // last update, or (exit test) flagged by Eq. 7.
     const R t2 = trigger() * trigger();
     marks_.assign(n, 0);
+    for (auto* v : {&built_at_, &built_velocity_, &path_now_}) v->resize(n);
+    built_time_.resize(n);
+    window_end_.resize(n);
+    left_.resize(n);
     const std::size_t chunks = chunk_count(n);
     chunk_counts_.assign(chunks, 0);
     parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
       std::uint32_t count = 0;
       for (std::size_t i = b; i < e; ++i) {
-        const bool mark = i >= old_n || !(norm2(particles.position[i] - built_at_[i]) <= t2) ||  // NaN: rebuilt
-                          (exit_test_ && flags_[i] != 0);
+        bool mark = i >= old_n || (exit_test_ && flags_[i] != 0) || time_ > window_end_[i];
+        if (!mark) {
+          path_now_[i] = built_at_[i] + built_velocity_[i] * static_cast<R>(time_ - built_time_[i]);
+          left_[i] = static_cast<R>(window_end_[i] - time_);
+          mark = !(norm2(particles.position[i] - path_now_[i]) <= t2);  // NaN: rebuilt
+        }
+        // A marked particle's path starts again here, before any list is built (the path test
+        // reads the new paths of the particles rebuilt with it).
+        if (mark) start_path(particles, i);
         marks_[i] = mark ? 1 : 0;
         count += mark ? 1 : 0;
       }
@@ -114,10 +200,11 @@ void TrackedNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
       // or in neither: the distance test is symmetric, bit for bit). Old and new lists are
       // compared through per-thread stamps, one per particle: the old entries get one value, the
       // new ones the next.
-      const R r = radius_ + skin_;
+      const R r = candidate_radius();
       grid_.build(particles.position, r);
       counters_.grid_seconds = watch.lap();
-      built_at_.resize(n);
+      filter_.self = this;  // (set at each build: the strategy may have been moved)
+      builder_.set_filter(&filter_);
       changes_.resize(chunks);
       for (std::size_t c = 0; c < chunks; ++c) changes_[c].clear();
       stamps_.resize(static_cast<std::size_t>(num_threads()));
@@ -140,7 +227,6 @@ void TrackedNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
         Diff(TrackedNeighbors& s, const ParticleSet<D, R>& p) : self(s), ps(p) {}
         void rebuilt(std::size_t c, std::size_t i, std::span<const std::uint32_t> before,
                      std::span<const std::uint32_t> after) override {
-          self.built_at_[i] = ps.position[i];
           std::vector<Change>& out = self.changes_[c];
           const auto me = static_cast<std::uint32_t>(i);
           const std::uint8_t* marks = self.marks_.data();
@@ -215,6 +301,9 @@ void TrackedNeighbors<D, R>::save_state(StateWriter& out) const {
   out.put(skin_);
   out.put(flags_);
   out.put(built_at_);
+  out.put(built_velocity_);
+  out.put(built_time_);
+  out.put(window_end_);
   lists_.save(out);
   this->boundary_.save(out);
 }
@@ -229,10 +318,15 @@ void TrackedNeighbors<D, R>::load_state(StateReader& in, std::size_t particles) 
   if (skin != skin_) set_skin(skin);
   in.get(flags_);
   in.get(built_at_);
+  in.get(built_velocity_);
+  in.get(built_time_);
+  in.get(window_end_);
   lists_.load(in);
   this->boundary_.load(in, particles);
   in.expect(updates_ >= 0 && built_at_.size() == lists_.particle_count() && built_at_.size() <= particles &&
-                flags_.size() <= particles && (lists_.particle_count() == 0 || lists_.has_room()),
+                built_velocity_.size() == built_at_.size() && built_time_.size() == built_at_.size() &&
+                window_end_.size() == built_at_.size() && flags_.size() <= particles &&
+                (lists_.particle_count() == 0 || lists_.has_room()),
             "tracked neighbor state does not match the particles");
 }
 

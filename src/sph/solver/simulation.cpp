@@ -455,6 +455,7 @@ const StepInfo& Simulation<D, R>::step() {
   // Moving obstacles: where they are at the step's start; their samples' lists are all rebuilt.
   place_obstacles();
   if (boundary_.moving()) neighbors_->move_boundary(boundary_.position);
+  neighbors_->set_time(time());
   neighbors_->update(particles_);
   info.neighbors = neighbors_->counters();
   if (boundary_.moving()) {  // (for strategies that rebuild lists on their own schedule)

@@ -416,7 +416,10 @@ void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, 
                              const BoundaryView<D, R>& boundary) {
   const SmoothingKernels<D, R> kernels(fluid, h);
   const R rho0 = static_cast<R>(fluid.rest_density);
-  std::vector<R> L;
+  // Kept between steps (no allocation in steady state); a reference, so that the pass's worker
+  // threads see the calling thread's buffer, not thread_local ones of their own.
+  thread_local std::vector<R> kept;
+  std::vector<R>& L = kept;
   gradient_corrections(ps, lists, kernels, boundary, rho0, L);
   const bool paper = fluid.pressure_force == PressureForce::Paper;
   const bool solid = boundary.active();

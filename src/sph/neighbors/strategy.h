@@ -85,8 +85,8 @@ class NeighborStrategy {
   /// Eq. 7). The strategy reads and clears them in its next update(). Empty for strategies
   /// that do not ask for the test (the solver then skips it).
   virtual std::span<std::uint8_t> pair_exit_flags() { return {}; }
-  /// The radius of the Eq. 7 test: h for the paper's lists, h + skin for adaptive_exact's (a pair
-  /// is flagged when it is predicted to leave the lists' reach).
+  /// The radius of the Eq. 7 test: h for the paper's lists, the candidates' radius for
+  /// adaptive_exact's (a pair is flagged when it is predicted to leave the lists' reach).
   R pair_exit_radius() const { return list_radius(); }
 
   /// The particles were reordered in memory: the lists refer to old indices, so the next

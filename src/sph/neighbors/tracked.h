@@ -67,8 +67,8 @@ class TrackedNeighbors final : public NeighborStrategy<D, R> {
   void load_state(StateReader& in, std::size_t particles) override;
 
   R skin() const { return skin_; }
-  /// A list is rebuilt once its particle moved farther than this since its own build (a hair
-  /// under a third of the skin, so that rounding can never let a pair within h slip).
+  /// A list is rebuilt once its particle is farther than this off its path (a hair under a
+  /// third of the skin, so that rounding can never let a pair within h slip).
   R trigger() const { return skin_ / R(3) * R(0.999); }
 
  private:

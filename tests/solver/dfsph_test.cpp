@@ -14,6 +14,7 @@
 #include <sph/core/parallel.h>
 #include <sph/core/particle_set.h>
 #include <sph/neighbors/neighbor_lists.h>
+#include <sph/neighbors/standard.h>
 #include <sph/solver/dfsph.h>
 #include <sph/solver/gradient_correction.h>
 #include <sph/solver/params.h>
@@ -63,12 +64,15 @@ ParticleSet<D, double> block(int n, double scale, double jitter, unsigned seed, 
 /// Every pair closer than 1.2 h, both ways (lists hold some pairs beyond h, as verlet's do).
 template <int D>
 NeighborLists all_pairs(const ParticleSet<D, double>& ps) {
-  std::vector<std::vector<std::uint32_t>> lists(ps.size());
-  for (std::size_t i = 0; i < ps.size(); ++i)
-    for (std::size_t j = 0; j < ps.size(); ++j)
-      if (i != j && norm2(ps.position[i] - ps.position[j]) < 1.44 * kH * kH)
-        lists[i].push_back(static_cast<std::uint32_t>(j));
-  return NeighborLists::from(lists);
+  return brute_force_lists<D, double>(ps.position, 1.2 * kH);
+}
+
+/// Whether x is more than `margin` spacings inside a block of side n spacings (from the origin).
+template <int D>
+bool inside(const Vec<D, double>& x, int n, double margin) {
+  for (int d = 0; d < D; ++d)
+    if (!(x[d] > margin * kSpacing && x[d] < (n - margin) * kSpacing)) return false;
+  return true;
 }
 
 /// m_j grad W_ij as DFSPH's pairs should take it: corrected by (L_i + L_j) / 2, written out here
@@ -100,10 +104,7 @@ void check_factors(bool corrected) {
   solver.compute_factors(ps, lists, k, {}, L);
   int checked = 0;
   for (std::size_t i = 0; i < ps.size(); ++i) {
-    bool inner = true;
-    for (int d = 0; d < D; ++d)
-      inner = inner && ps.position[i][d] > 2.4 * kSpacing && ps.position[i][d] < (n - 2.4) * kSpacing;
-    if (!inner) continue;
+    if (!inside(ps.position[i], n, 2.4)) continue;
     Vec<D, double> sum{};
     double squares = 0;
     for (const std::uint32_t j : lists.of(i)) {
@@ -209,10 +210,7 @@ void check_divergence_solve(bool corrected) {
   const auto inner_rate = [&] {
     double sum = 0;
     for (std::size_t i = 0; i < ps.size(); ++i) {
-      bool inner = true;
-      for (int d = 0; d < D; ++d)
-        inner = inner && ps.position[i][d] > 2.6 * kSpacing && ps.position[i][d] < (n - 2.6) * kSpacing;
-      if (!inner) continue;
+      if (!inside(ps.position[i], n, 2.6)) continue;
       for (const std::uint32_t j : lists.of(i))
         if (norm2(ps.position[i] - ps.position[j]) < kH * kH)
           sum += dot(ps.velocity[i] - ps.velocity[j], pair_gradient(ps, L, k, i, j));

@@ -13,6 +13,7 @@
 #include <sph/core/parallel.h>
 #include <sph/core/particle_set.h>
 #include <sph/neighbors/neighbor_lists.h>
+#include <sph/neighbors/standard.h>
 #include <sph/solver/params.h>
 #include <sph/solver/viscosity.h>
 #include <sph/solver/wcsph.h>
@@ -57,12 +58,7 @@ ParticleSet<D, double> sheared_block(int n, unsigned seed) {
 /// Every pair closer than 1.2 h, both ways (lists hold some pairs beyond h, as verlet's do).
 template <int D>
 NeighborLists all_pairs(const ParticleSet<D, double>& ps) {
-  std::vector<std::vector<std::uint32_t>> lists(ps.size());
-  for (std::size_t i = 0; i < ps.size(); ++i)
-    for (std::size_t j = 0; j < ps.size(); ++j)
-      if (i != j && norm2(ps.position[i] - ps.position[j]) < 1.44 * kH * kH)
-        lists[i].push_back(static_cast<std::uint32_t>(j));
-  return NeighborLists::from(lists);
+  return brute_force_lists<D, double>(ps.position, 1.2 * kH);
 }
 
 /// `tolerance`: the solve's, as a fraction of its starting residual.

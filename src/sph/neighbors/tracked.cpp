@@ -40,6 +40,16 @@ R TrackedNeighbors<D, R>::window(const Vec<D, R>& v) const {
 }
 
 template <int D, std::floating_point R>
+void TrackedNeighbors<D, R>::size_paths(std::size_t n) {
+  for (auto* v : {&built_at_, &built_velocity_, &path_now_}) v->resize(n);
+  built_time_.resize(n);
+  window_end_.resize(n);
+  left_.resize(n);
+  filter_.self = this;  // (set before each build: the strategy may have been moved)
+  builder_.set_filter(&filter_);
+}
+
+template <int D, std::floating_point R>
 void TrackedNeighbors<D, R>::start_path(const ParticleSet<D, R>& ps, std::size_t i) {
   built_at_[i] = path_now_[i] = ps.position[i];
   built_velocity_[i] = ps.velocity[i];
@@ -132,13 +142,8 @@ void TrackedNeighbors<D, R>::full_build(const ParticleSet<D, R>& particles) {
   grid_.build(particles.position, r);
   counters_.grid_seconds = watch.lap();
   const std::size_t n = particles.size();
-  for (auto* v : {&built_at_, &built_velocity_, &path_now_}) v->resize(n);
-  built_time_.resize(n);
-  window_end_.resize(n);
-  left_.resize(n);
+  size_paths(n);
   parallel_for(n, [&](std::size_t i) { start_path(particles, i); });
-  filter_.self = this;  // (set at each build: the strategy may have been moved)
-  builder_.set_filter(&filter_);
   builder_.build(grid_, particles.position, r, lists_);
   this->boundary_.build(particles.position);
   // Room for the changes a step's rebuilds make to other lists: two per particle of a chunk
@@ -168,10 +173,7 @@ void TrackedNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
     // last update, or (exit test) flagged by Eq. 7.
     const R t2 = trigger() * trigger();
     marks_.assign(n, 0);
-    for (auto* v : {&built_at_, &built_velocity_, &path_now_}) v->resize(n);
-    built_time_.resize(n);
-    window_end_.resize(n);
-    left_.resize(n);
+    size_paths(n);
     const std::size_t chunks = chunk_count(n);
     chunk_counts_.assign(chunks, 0);
     parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
@@ -203,8 +205,6 @@ void TrackedNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
       const R r = candidate_radius();
       grid_.build(particles.position, r);
       counters_.grid_seconds = watch.lap();
-      filter_.self = this;  // (set at each build: the strategy may have been moved)
-      builder_.set_filter(&filter_);
       changes_.resize(chunks);
       for (std::size_t c = 0; c < chunks; ++c) changes_[c].clear();
       stamps_.resize(static_cast<std::size_t>(num_threads()));

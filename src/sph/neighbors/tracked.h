@@ -86,6 +86,8 @@ class TrackedNeighbors final : public NeighborStrategy<D, R> {
   R boundary_radius() const override { return (radius_ + skin_ + R(kTrackedReach) * radius_) * R(1.0001); }
   /// How long a path at velocity v takes to run kTrackedReach h (infinite at rest).
   R window(const Vec<D, R>& v) const;
+  /// Sizes the paths' arrays for n particles and points the builder at the path test.
+  void size_paths(std::size_t n);
   /// Particle i's path starts now, where it is, at its velocity.
   void start_path(const ParticleSet<D, R>& ps, std::size_t i);
   /// The path test, as ListFilter: of the candidates of particle i (rebuilt now), keeps those

@@ -66,13 +66,14 @@ TEST_F(Compare, WritesEveryPromisedFileWithContent) {
   opt.samples = 20;
   opt.frames = 2;
   const CompareResult res = run_comparison(small_dam(120), opt);
-  ASSERT_EQ(res.runs.size(), 6u);
+  ASSERT_EQ(res.runs.size(), 7u);
   EXPECT_EQ(res.runs[0].label, "standard");
   EXPECT_EQ(res.runs[1].label, "adaptive");
   EXPECT_EQ(res.runs[2].label, "verlet");
   EXPECT_EQ(res.runs[3].label, "tracked");
   EXPECT_EQ(res.runs[4].label, "adaptive_exact");
-  EXPECT_TRUE(res.runs[5].perturbed);
+  EXPECT_EQ(res.runs[5].label, "verlet_clusters");
+  EXPECT_TRUE(res.runs[6].perturbed);
   for (const auto& r : res.runs) {
     EXPECT_TRUE(r.failure.empty()) << r.label << ": " << r.failure;
     EXPECT_EQ(r.steps.size(), 120u) << r.label;
@@ -101,7 +102,7 @@ TEST_F(Compare, WritesEveryPromisedFileWithContent) {
   // One row per step (plus the header) in the per-step files; one per sample in divergence.csv.
   for (const char* f : {"timing.csv", "energy.csv", "neighbors.csv"})
     EXPECT_EQ(line_count(read_file(dir_ / f)), 121u) << f;
-  EXPECT_EQ(line_count(read_file(dir_ / "phases.csv")), 7u);  // header and one row per run
+  EXPECT_EQ(line_count(read_file(dir_ / "phases.csv")), 8u);  // header and one row per run
   EXPECT_EQ(line_count(read_file(dir_ / "divergence.csv")), 1u + res.runs[0].samples.size());
   EXPECT_NE(report.find("| adaptive |"), std::string::npos);
   EXPECT_NE(report.find("chaos floor"), std::string::npos);
@@ -115,19 +116,19 @@ TEST_F(Compare, DivergencesAreMeasuredAgainstTheStandardRun) {
   opt.samples = 10;
   opt.frames = 1;
   const CompareResult res = run_comparison(small_dam(40), opt);
-  ASSERT_EQ(res.divergence.size(), 6u);
+  ASSERT_EQ(res.divergence.size(), 7u);
   EXPECT_TRUE(res.divergence[0].empty());
-  // Verlet and the tracked modes compute the same sums over the same pairs, in another order:
-  // round-off apart, and the audit finds no missed pair.
-  for (const std::size_t k : {2u, 3u, 4u}) {
+  // Verlet, the tracked modes and verlet's cluster pairs compute the same sums over the same
+  // pairs, in another order: round-off apart, and the audit finds no missed pair.
+  for (const std::size_t k : {2u, 3u, 4u, 5u}) {
     SCOPED_TRACE(res.runs[k].label);
     for (const auto& d : res.divergence[k]) EXPECT_LT(d.max, 1e-6) << "step " << d.step;
     for (const auto& st : res.runs[k].steps) EXPECT_EQ(st.missed_pairs, 0u);
   }
   // The perturbed run starts displaced by exactly the perturbation (every particle).
-  ASSERT_FALSE(res.divergence[5].empty());
-  EXPECT_EQ(res.divergence[5][0].step, 0);
-  EXPECT_NEAR(res.divergence[5][0].rms, opt.perturbation, 1e-3 * opt.perturbation);
+  ASSERT_FALSE(res.divergence[6].empty());
+  EXPECT_EQ(res.divergence[6][0].step, 0);
+  EXPECT_NEAR(res.divergence[6][0].rms, opt.perturbation, 1e-3 * opt.perturbation);
   // Adaptive misses pairs coming into range, the audit says so, and it drifts further than verlet.
   std::uint64_t missed = 0;
   for (const auto& s : res.runs[1].steps) missed += s.missed_pairs;

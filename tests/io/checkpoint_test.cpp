@@ -103,7 +103,8 @@ TEST_P(ResumeMode, DamBreakResumesBitwise2d) {
   expect_resume_is_bitwise<2, double>(scene(kDamBreak, GetParam(), "double", 150), 61, 150);
 }
 
-INSTANTIATE_TEST_SUITE_P(Modes, ResumeMode, testing::Values("standard", "adaptive", "verlet", "brute_force"));
+INSTANTIATE_TEST_SUITE_P(Modes, ResumeMode,
+                         testing::Values("standard", "adaptive", "verlet", "verlet_clusters", "brute_force"));
 
 TEST(Checkpoint, ResumingBeforeTheFirstStepAndAfterAnEmissionStepWorks) {
   // Step 0 (nothing updated yet) and step 16 (the emitter's second batch just added).

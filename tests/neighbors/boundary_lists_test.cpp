@@ -116,7 +116,7 @@ TEST(BoundaryLists, EveryStrategyListsThePairsWithinH) {
   auto ps = random_particles<double>(3000, 0.0, 1.0, 11);
   const NeighborLists exact = brute_force_query_lists<3, double>(ps.position, samples, kH);
   for (NeighborMode mode : {NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet, NeighborMode::Tracked,
-                            NeighborMode::AdaptiveExact, NeighborMode::BruteForce}) {
+                            NeighborMode::AdaptiveExact, NeighborMode::VerletClusters, NeighborMode::BruteForce}) {
     NeighborOptions opt;
     opt.radius = kH;
     auto s = make_neighbor_strategy<3, double>(mode, opt);

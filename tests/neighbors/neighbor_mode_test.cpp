@@ -28,7 +28,7 @@ TEST(NeighborModeTable, EveryNameParsesBackToItsModeAndItsStrategy) {
     EXPECT_EQ((make_neighbor_strategy<2, double>(info.mode, options)->mode()), info.mode);
     EXPECT_EQ((make_neighbor_strategy<3, float>(info.mode, options)->mode()), info.mode);
   }
-  EXPECT_EQ(names.size(), 6u);
+  EXPECT_EQ(names.size(), 7u);
 }
 
 TEST(NeighborModeTable, UnknownNameIsRefusedNamingEveryMode) {
@@ -39,31 +39,35 @@ TEST(NeighborModeTable, UnknownNameIsRefusedNamingEveryMode) {
     EXPECT_EQ(e.where(), "--neighbors");
     EXPECT_EQ(e.message(),
               "unknown neighbor mode \"fast\"; expected one of \"standard\", \"adaptive\", \"verlet\", \"tracked\", "
-              "\"adaptive_exact\", \"brute_force\"");
+              "\"adaptive_exact\", \"verlet_clusters\", \"brute_force\"");
   }
   EXPECT_THROW(parse_neighbor_mode(""), Error);
   EXPECT_THROW(parse_neighbor_mode("Standard"), Error) << "names are case-sensitive";
 }
 
 TEST(NeighborModeTable, ListsDerivedFromTheTable) {
-  EXPECT_EQ(neighbor_mode_names(),
-            (std::vector<std::string>{"standard", "adaptive", "verlet", "tracked", "adaptive_exact", "brute_force"}));
-  EXPECT_EQ(neighbor_mode_names(NeighborModeSet::Compared),
-            (std::vector<std::string>{"standard", "adaptive", "verlet", "tracked", "adaptive_exact"}));
-  EXPECT_EQ(neighbor_modes(NeighborModeSet::Compared),
-            (std::vector<NeighborMode>{NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet,
-                                       NeighborMode::Tracked, NeighborMode::AdaptiveExact}));
+  EXPECT_EQ(neighbor_mode_names(), (std::vector<std::string>{"standard", "adaptive", "verlet", "tracked",
+                                                             "adaptive_exact", "verlet_clusters", "brute_force"}));
+  EXPECT_EQ(
+      neighbor_mode_names(NeighborModeSet::Compared),
+      (std::vector<std::string>{"standard", "adaptive", "verlet", "tracked", "adaptive_exact", "verlet_clusters"}));
+  EXPECT_EQ(
+      neighbor_modes(NeighborModeSet::Compared),
+      (std::vector<NeighborMode>{NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet,
+                                 NeighborMode::Tracked, NeighborMode::AdaptiveExact, NeighborMode::VerletClusters}));
   EXPECT_EQ(neighbor_modes(NeighborModeSet::All).size(), std::size(kNeighborModes));
   EXPECT_FALSE(neighbor_mode_info(NeighborMode::BruteForce).compared) << "the oracle is too slow to time";
   for (const NeighborModeInfo& info : kNeighborModes)  // the modes that read Configuration.trackedSkin
     EXPECT_EQ(info.tracked, info.mode == NeighborMode::Tracked || info.mode == NeighborMode::AdaptiveExact)
         << info.name;
+  for (const NeighborModeInfo& info : kNeighborModes)  // the modes that read Configuration.verletSkin
+    EXPECT_EQ(info.verlet, info.mode == NeighborMode::Verlet || info.mode == NeighborMode::VerletClusters) << info.name;
   EXPECT_EQ(join_neighbor_mode_names(NeighborModeSet::Compared, ",", ","),
-            "standard,adaptive,verlet,tracked,adaptive_exact");
+            "standard,adaptive,verlet,tracked,adaptive_exact,verlet_clusters");
   EXPECT_EQ(join_neighbor_mode_names(NeighborModeSet::Compared, ", ", " or "),
-            "standard, adaptive, verlet, tracked or adaptive_exact");
+            "standard, adaptive, verlet, tracked, adaptive_exact or verlet_clusters");
   EXPECT_EQ(join_neighbor_mode_names(NeighborModeSet::All, ", ", " and "),
-            "standard, adaptive, verlet, tracked, adaptive_exact and brute_force");
+            "standard, adaptive, verlet, tracked, adaptive_exact, verlet_clusters and brute_force");
 }
 
 }  // namespace

@@ -123,7 +123,8 @@ TEST_P(StopAndResume, GivesTheFilesOfARunNeverStopped) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Modes, StopAndResume, testing::Values("standard", "adaptive", "tracked", "adaptive_exact"));
+INSTANTIATE_TEST_SUITE_P(Modes, StopAndResume,
+                         testing::Values("standard", "adaptive", "tracked", "adaptive_exact", "verlet_clusters"));
 
 TEST(RunDriver, StopsTwiceAndResumesTwiceBitwise) {
   TempDir tmp;

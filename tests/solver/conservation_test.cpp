@@ -108,6 +108,12 @@ TEST(Conservation, MomentumWithVerletLists2D) {
 TEST(Conservation, MomentumWithVerletLists3D) {
   check_momentum_conserved<3, double>(10, 100, 1e-12, NeighborMode::Verlet);
 }
+TEST(Conservation, MomentumWithVerletClusterPairs2D) {
+  check_momentum_conserved<2, double>(20, 200, 1e-12, NeighborMode::VerletClusters);
+}
+TEST(Conservation, MomentumWithVerletClusterPairs3D) {
+  check_momentum_conserved<3, double>(10, 100, 1e-12, NeighborMode::VerletClusters);
+}
 
 /// The largest change of the total energy (kinetic + the EOS's internal energy of the summed
 /// densities) of an inviscid free blob over `steps` steps, relative to the largest kinetic

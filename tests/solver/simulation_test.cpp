@@ -87,7 +87,8 @@ TEST_P(NoAllocation, SteadyStateStepsAllocateNothing) {
 
 INSTANTIATE_TEST_SUITE_P(Modes, NoAllocation,
                          ::testing::Values(NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet,
-                                           NeighborMode::Tracked, NeighborMode::AdaptiveExact),
+                                           NeighborMode::Tracked, NeighborMode::AdaptiveExact,
+                                           NeighborMode::VerletClusters),
                          [](const auto& info) { return std::string(to_string(info.param)); });
 
 TEST(Reorder, KeepsEveryParticleAndOrdersThemAlongTheCurve) {
@@ -214,7 +215,7 @@ void expect_thread_independent(NeighborMode mode, int n, int steps, std::vector<
 // 1,728 particles: two chunks of the parallel loops.
 TEST(Determinism, EveryModeIsBitwiseIdenticalFor1To4ThreadsDouble) {
   for (NeighborMode m : {NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet, NeighborMode::Tracked,
-                         NeighborMode::AdaptiveExact}) {
+                         NeighborMode::AdaptiveExact, NeighborMode::VerletClusters}) {
     SCOPED_TRACE(std::string(to_string(m)));
     expect_thread_independent<double>(m, 12, 120, {2, 3, 4});
   }
@@ -222,7 +223,7 @@ TEST(Determinism, EveryModeIsBitwiseIdenticalFor1To4ThreadsDouble) {
 
 TEST(Determinism, EveryModeIsBitwiseIdenticalFor1To4ThreadsFloat) {
   for (NeighborMode m : {NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet, NeighborMode::Tracked,
-                         NeighborMode::AdaptiveExact}) {
+                         NeighborMode::AdaptiveExact, NeighborMode::VerletClusters}) {
     SCOPED_TRACE(std::string(to_string(m)));
     expect_thread_independent<float>(m, 12, 120, {2, 3, 4});
   }
@@ -233,7 +234,7 @@ TEST(Determinism, EveryModeIsBitwiseIdenticalFor1To4ThreadsFloat) {
 // tests/neighbors/list_builder_test.cpp.)
 TEST(Determinism, EveryModeIsBitwiseIdenticalFor1And3ThreadsOn8Chunks) {
   for (NeighborMode m : {NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet, NeighborMode::Tracked,
-                         NeighborMode::AdaptiveExact}) {
+                         NeighborMode::AdaptiveExact, NeighborMode::VerletClusters}) {
     SCOPED_TRACE(std::string(to_string(m)));
     expect_thread_independent<double>(m, 20, 40, {3});
   }

@@ -60,6 +60,16 @@ struct Pack<float> {
   /// Lanes in m from a, the others from b.
   friend Pack select(Mask m, Pack a, Pack b) { return {_mm512_mask_blend_ps(static_cast<__mmask16>(m), b.v, a.v)}; }
   void store(float* out) const { _mm512_storeu_ps(out, v); }
+  /// Lane l = p[pattern[l]] for the lane pattern of lane_pattern(); reads p[0..16).
+  static Pack permuted(const float* p, __m512i pattern) {  // (maskz: no warning)
+    return {_mm512_maskz_permutexvar_ps(0xffff, pattern, _mm512_loadu_ps(p))};
+  }
+  template <class F>
+  static __m512i lane_pattern(F f) {
+    alignas(64) std::int32_t idx[16];
+    for (int l = 0; l < 16; ++l) idx[l] = f(l);
+    return _mm512_load_si512(idx);
+  }
 };
 
 template <>
@@ -82,6 +92,15 @@ struct Pack<double> {
   friend Mask operator>(Pack a, Pack b) { return _mm512_cmp_pd_mask(a.v, b.v, _CMP_GT_OQ); }
   friend Pack select(Mask m, Pack a, Pack b) { return {_mm512_mask_blend_pd(static_cast<__mmask8>(m), b.v, a.v)}; }
   void store(double* out) const { _mm512_storeu_pd(out, v); }
+  static Pack permuted(const double* p, __m512i pattern) {
+    return {_mm512_maskz_permutexvar_pd(0xff, pattern, _mm512_loadu_pd(p))};
+  }
+  template <class F>
+  static __m512i lane_pattern(F f) {
+    alignas(64) std::int64_t idx[8];
+    for (int l = 0; l < 8; ++l) idx[l] = f(l);
+    return _mm512_load_si512(idx);
+  }
 };
 #else
 template <class R>
@@ -133,8 +152,28 @@ struct Pack {
     return p;
   }
   void store(R* out) const { std::memcpy(out, v, sizeof(v)); }
+  struct Pattern {
+    int lane[W];
+  };
+  static Pack permuted(const R* src, const Pattern& pattern) {
+    Pack p;
+    for (int l = 0; l < W; ++l) p.v[l] = src[pattern.lane[l]];
+    return p;
+  }
+  template <class F>
+  static Pattern lane_pattern(F f) {
+    Pattern pattern;
+    for (int l = 0; l < W; ++l) pattern.lane[l] = f(l);
+    return pattern;
+  }
 };
 #endif
+
+/// A fixed lane pattern: with pattern = Pack<R>::lane_pattern(f), Pack<R>::permuted(src, pattern)
+/// gives lane l the value src[f(l)], f(l) in [0, kLanes<R>) (src holds kLanes<R> readable
+/// values). The cluster-pair loops lay a register out as a small grid of (i, j) pairs this way.
+template <class R>
+using LanePattern = decltype(Pack<R>::lane_pattern([](int l) { return l; }));
 
 /// Sum of the lanes, added in lane order (the same in both implementations).
 template <class R>
@@ -144,6 +183,20 @@ inline R sum_lanes(const Pack<R>& p) {
   R s = 0;
   for (int l = 0; l < kLanes<R>; ++l) s += lanes[l];
   return s;
+}
+
+/// Sums of groups of G consecutive lanes, each added in lane order (the same in both
+/// implementations): out[g] = lane G g + lane G g + 1 + ... + lane G g + G - 1.
+template <int G, class R>
+inline void sum_lane_groups(const Pack<R>& p, R* out) {
+  static_assert(kLanes<R> % G == 0);
+  R lanes[kLanes<R>];
+  p.store(lanes);
+  for (int g = 0; g < kLanes<R> / G; ++g) {
+    R s = 0;
+    for (int l = 0; l < G; ++l) s += lanes[G * g + l];
+    out[g] = s;
+  }
 }
 
 }  // namespace sph::simd

@@ -16,7 +16,21 @@ ListAudit ListAuditor<D, R>::audit(std::span<const Vec<D, R>> positions, const N
   if (n == 0) return total;
   grid_.build(positions, h);
   builder_.build(grid_, positions, h, exact_);
-  return compare(positions, positions, lists, h);
+  return compare(
+      positions, positions, [&](std::size_t i) { return lists.of(i); }, [](std::uint32_t j) { return j; }, h);
+}
+
+template <int D, std::floating_point R>
+ListAudit ListAuditor<D, R>::audit_clusters(std::span<const Vec<D, R>> positions, const ClusterPairs<D, R>& pairs,
+                                            R h) {
+  const std::size_t n = positions.size();
+  SPH_CHECK(pairs.particle_count() == n, "audited cluster pairs must cover every particle");
+  if (n == 0) return {};
+  grid_.build(positions, h);
+  builder_.build(grid_, positions, h, exact_);
+  return compare(
+      positions, positions, [&](std::size_t i) { return pairs.of(pairs.cluster_of(i)); },
+      [&](std::uint32_t j) { return pairs.cluster_of(j); }, h);
 }
 
 template <int D, std::floating_point R>
@@ -27,12 +41,14 @@ ListAudit ListAuditor<D, R>::audit_boundary(std::span<const Vec<D, R>> positions
   SPH_CHECK(lists.particle_count() == n, "audited boundary lists must cover every particle");
   sample_grid_.build(samples, h);
   builder_.build_queries(sample_grid_, positions, h, exact_);
-  return compare(positions, samples, lists, h);
+  return compare(
+      positions, samples, [&](std::size_t i) { return lists.of(i); }, [](std::uint32_t j) { return j; }, h);
 }
 
 template <int D, std::floating_point R>
+template <class Listed, class Key>
 ListAudit ListAuditor<D, R>::compare(std::span<const Vec<D, R>> positions, std::span<const Vec<D, R>> others,
-                                     const NeighborLists& lists, R h) {
+                                     const Listed& listed_of, const Key& key, R h) {
   const std::size_t n = positions.size();
   ListAudit total;
   const std::size_t chunks = chunk_count(n);
@@ -44,12 +60,12 @@ ListAudit ListAuditor<D, R>::compare(std::span<const Vec<D, R>> positions, std::
     for (std::size_t i = b; i < e; ++i) {
       const auto want = exact_.of(i);
       if (want.empty()) continue;
-      const auto listed = lists.of(i);
+      const std::span<const std::uint32_t> listed = listed_of(i);
       have.assign(listed.begin(), listed.end());
       std::sort(have.begin(), have.end());
       std::uint64_t missed = 0;
       for (std::uint32_t j : want) {
-        if (std::binary_search(have.begin(), have.end(), j)) continue;
+        if (std::binary_search(have.begin(), have.end(), key(j))) continue;
         ++missed;
         const double r = std::sqrt(static_cast<double>(norm2(positions[i] - others[j])));
         a.max_penetration = std::max(a.max_penetration, (static_cast<double>(h) - r) / static_cast<double>(h));

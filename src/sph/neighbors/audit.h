@@ -5,6 +5,7 @@
 #include <span>
 #include <vector>
 
+#include <sph/neighbors/cluster_pairs.h>
 #include <sph/neighbors/list_builder.h>
 #include <sph/neighbors/neighbor_lists.h>
 #include <sph/neighbors/uniform_grid.h>
@@ -29,6 +30,9 @@ template <int D, std::floating_point R>
 class ListAuditor {
  public:
   ListAudit audit(std::span<const Vec<D, R>> positions, const NeighborLists& lists, R h);
+  /// The same for cluster pairs (verlet_clusters): the pairs (i, j) closer than h whose clusters
+  /// are not listed, i's cluster missing j's.
+  ListAudit audit_clusters(std::span<const Vec<D, R>> positions, const ClusterPairs<D, R>& pairs, R h);
   /// The same for boundary lists: the fluid-boundary pairs (particle i, sample b) closer than h
   /// that i's boundary list misses (missed_pairs counts each once: the solver visits the pair
   /// from the fluid side only).
@@ -36,9 +40,11 @@ class ListAuditor {
                            const NeighborLists& lists, R h);
 
  private:
-  /// Counts what `lists` misses of exact_, the pairs of positions[i] and others[j] closer than h.
-  ListAudit compare(std::span<const Vec<D, R>> positions, std::span<const Vec<D, R>> others, const NeighborLists& lists,
-                    R h);
+  /// Counts what the lists miss of exact_, the pairs of positions[i] and others[j] closer than h:
+  /// pair (i, j) is listed when listed(i) holds key(j) (both given as index -> value functions).
+  template <class Listed, class Key>
+  ListAudit compare(std::span<const Vec<D, R>> positions, std::span<const Vec<D, R>> others, const Listed& listed,
+                    const Key& key, R h);
 
   UniformGrid<D, R> grid_, sample_grid_;
   ListBuilder<D, R> builder_;

@@ -9,7 +9,7 @@
 namespace sph {
 
 /// Neighbor strategies (kNeighborModes describes each).
-enum class NeighborMode { Standard, Adaptive, Verlet, Tracked, AdaptiveExact, BruteForce };
+enum class NeighborMode { Standard, Adaptive, Verlet, Tracked, AdaptiveExact, VerletClusters, BruteForce };
 
 /// One neighbor mode as users name and select it.
 struct NeighborModeInfo {
@@ -21,6 +21,8 @@ struct NeighborModeInfo {
   bool compared;
   /// Keeps tracked lists (TrackedNeighbors: h + Configuration.trackedSkin, rebuilt per particle).
   bool tracked = false;
+  /// Keeps verlet lists (h + Configuration.verletSkin, all rebuilt once a particle moved half the skin).
+  bool verlet = false;
 };
 
 /// Every mode, in the enum's order.
@@ -30,7 +32,7 @@ inline constexpr NeighborModeInfo kNeighborModes[] = {
      "the paper's Algorithm 2: rebuilds the lists flagged by the Eq. 7 test, all of them every full-rebuild period",
      true},
     {NeighborMode::Verlet, "verlet", "exact lists of radius h + skin, all rebuilt once a particle moved half the skin",
-     true},
+     true, false, true},
     {NeighborMode::Tracked, "tracked",
      "exact per-particle lists of the pairs whose paths (positions and velocities at their builds) come within h + "
      "skin: a list is rebuilt once its particle is a third of the skin off its path or its path has run 0.1 h, and "
@@ -40,6 +42,11 @@ inline constexpr NeighborModeInfo kNeighborModes[] = {
      "the paper's Eq. 7 test on tracked lists (a pair predicted to leave the lists' reach flags both): Algorithm 2 "
      "without missed pairs",
      true, true},
+    {NeighborMode::VerletClusters, "verlet_clusters",
+     "verlet's exact lists (h + skin, all rebuilt once a particle moved half the skin) held as pairs of clusters of 4 "
+     "particles, so that the density and force passes load a neighbor cluster instead of gathering each neighbor "
+     "(docs/neighbor-modes.md)",
+     true, false, true},
     {NeighborMode::BruteForce, "brute_force", "compares every pair, O(N^2): the tests' oracle, for tiny scenes", false},
 };
 

@@ -18,10 +18,11 @@ std::unique_ptr<NeighborStrategy<D, R>> make_neighbor_strategy(NeighborMode mode
       return std::make_unique<BruteForceNeighbors<D, R>>(radius);
     case NeighborMode::Adaptive:
       return std::make_unique<AdaptiveNeighbors<D, R>>(radius, options.full_rebuild_period);
-    case NeighborMode::Verlet: {
+    case NeighborMode::Verlet:
+    case NeighborMode::VerletClusters: {
       const R skin =
           static_cast<R>(options.verlet_skin > 0 ? options.verlet_skin : kDefaultSkinFraction * options.radius);
-      return std::make_unique<VerletNeighbors<D, R>>(radius, skin);
+      return std::make_unique<VerletNeighbors<D, R>>(radius, skin, mode == NeighborMode::VerletClusters);
     }
     case NeighborMode::Tracked:
     case NeighborMode::AdaptiveExact:

@@ -6,6 +6,7 @@
 
 #include <sph/core/particle_set.h>
 #include <sph/neighbors/boundary_lists.h>
+#include <sph/neighbors/cluster_pairs.h>
 #include <sph/neighbors/neighbor_lists.h>
 #include <sph/neighbors/neighbor_mode.h>
 
@@ -53,6 +54,10 @@ class NeighborStrategy {
   /// since the last call (emitters); none are removed.
   virtual void update(const ParticleSet<D, R>& particles) = 0;
   virtual const NeighborLists& lists() const = 0;
+  /// The same pairs as cluster pairs (verlet_clusters: every pair within h lies in a listed pair
+  /// of clusters), which the WCSPH density and force passes then loop over instead of lists();
+  /// null for the strategies that keep per-particle lists only.
+  virtual const ClusterPairs<D, R>* cluster_pairs() const { return nullptr; }
   /// The simulated time (s) of the state the next update() sees. The tracked modes follow each
   /// particle along a path in time; the others ignore it.
   virtual void set_time(double t) { (void)t; }

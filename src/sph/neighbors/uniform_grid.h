@@ -86,6 +86,14 @@ class UniformGrid {
     return k;
   }
 
+  /// The cells' side (at least the radius).
+  R cell_size() const { return R(1) / inv_cell_; }
+  /// Cells holding at least one point.
+  std::size_t occupied_cells() const {
+    std::size_t k = 0;
+    for (std::size_t c = 0; c + 1 < cell_start_.size(); ++c) k += cell_start_[c + 1] > cell_start_[c] ? 1 : 0;
+    return k;
+  }
   /// Maximum number of dense cells, relative to the point count (plus a constant).
   static constexpr std::size_t kMaxCellsPerPoint = 8;
 

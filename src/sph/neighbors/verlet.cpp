@@ -11,7 +11,8 @@
 namespace sph {
 
 template <int D, std::floating_point R>
-VerletNeighbors<D, R>::VerletNeighbors(R radius, R skin) : radius_(radius), skin_(skin) {
+VerletNeighbors<D, R>::VerletNeighbors(R radius, R skin, bool clusters)
+    : radius_(radius), skin_(skin), clusters_(clusters) {
   SPH_CHECK(radius > R(0), "neighbor radius must be positive");
   SPH_CHECK(skin > R(0), "verlet skin must be positive");
 }
@@ -20,7 +21,7 @@ template <int D, std::floating_point R>
 void VerletNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
   Stopwatch watch;
   const std::size_t n = particles.size();
-  bool rebuild = n != built_at_.size() || lists_.particle_count() != n;
+  bool rebuild = n != built_at_.size() || (clusters_ ? pairs_.particle_count() : lists_.particle_count()) != n;
   if (!rebuild) {
     // Largest squared displacement since the last build (a max: the same for any thread count).
     chunk_max_.assign(chunk_count(n), R(0));
@@ -42,26 +43,48 @@ void VerletNeighbors<D, R>::update(const ParticleSet<D, R>& particles) {
     const R r = radius_ + skin_;
     grid_.build(particles.position, r);
     counters_.grid_seconds = watch.lap();
-    builder_.build(grid_, particles.position, r, lists_);
+    if (clusters_) {
+      pairs_.build(grid_, particles.position, r);
+      lists_built_ = false;
+    } else {
+      builder_.build(grid_, particles.position, r, lists_);
+    }
     // The samples do not move: a fluid particle that moved less than the skin since this build
     // still lists every sample within h.
     this->boundary_.build(particles.position);
     built_at_.assign(particles.position.begin(), particles.position.end());
     max_disp_ = 0;
     counters_.lists_rebuilt = n;
-    counters_.entries_rebuilt = builder_.entries_written();
+    counters_.entries_rebuilt = clusters_ ? cluster_lanes() : builder_.entries_written();
   }
   counters_.skin = static_cast<double>(skin_);
   counters_.lists_seconds = watch.lap();
-  counters_.pairs_stored = lists_.entry_count();
+  counters_.pairs_stored = clusters_ ? cluster_lanes() : lists_.entry_count();
   counters_.boundary_pairs_stored = this->boundary_.lists().entry_count();
+}
+
+template <int D, std::floating_point R>
+const NeighborLists& VerletNeighbors<D, R>::lists() const {
+  if (clusters_ && !lists_built_) build_lists();
+  return lists_;
+}
+
+template <int D, std::floating_point R>
+void VerletNeighbors<D, R>::build_lists() const {
+  if (built_at_.empty()) {
+    lists_.clear();
+  } else {
+    builder_.build(grid_, built_at_, radius_ + skin_, lists_);
+  }
+  lists_built_ = true;
 }
 
 template <int D, std::floating_point R>
 void VerletNeighbors<D, R>::save_state(StateWriter& out) const {
   out.put(max_disp_);
   out.put(built_at_);
-  lists_.save(out);
+  // (clusters: the build is a function of its positions, and is made again on load)
+  if (!clusters_) lists_.save(out);
   this->boundary_.save(out);
 }
 
@@ -69,10 +92,19 @@ template <int D, std::floating_point R>
 void VerletNeighbors<D, R>::load_state(StateReader& in, std::size_t particles) {
   in.get(max_disp_);
   in.get(built_at_);
-  lists_.load(in);
+  if (!clusters_) lists_.load(in);
   this->boundary_.load(in, particles);
   in.expect(built_at_.size() <= particles && lists_.particle_count() <= particles,
             "verlet neighbor state does not match the particles");
+  if (clusters_) {
+    pairs_.clear();
+    lists_.clear();
+    lists_built_ = false;
+    if (!built_at_.empty()) {
+      grid_.build(built_at_, radius_ + skin_);
+      pairs_.build(grid_, built_at_, radius_ + skin_);
+    }
+  }
 }
 
 template class VerletNeighbors<2, float>;

@@ -126,7 +126,7 @@ double estimated_bytes_of(const SceneBody<D>& body, std::size_t real_bytes) {
   const SimulationParams<D>& p = body.sim;
   const double n = static_cast<double>(max_particles_of<D>(body));
   double radius = p.kernel_radius;
-  if (p.neighbors == NeighborMode::Verlet)
+  if (neighbor_mode_info(p.neighbors).verlet)
     radius += p.verlet_skin > 0 ? p.verlet_skin : kDefaultSkinFraction * p.kernel_radius;
   // The tracked modes: their largest skin (automatic: at most h / 2), and the room of each list.
   const bool tracked = neighbor_mode_info(p.neighbors).tracked;

@@ -451,7 +451,7 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
   };
   if (neighbor_mode_info(sim.neighbors).tracked)
     refuse_huge_skin("trackedSkin", sim.tracked_skin, "0 (automatic) or a skin of", "0.02 h to 0.5 h");
-  if (sim.neighbors == NeighborMode::Verlet)
+  if (neighbor_mode_info(sim.neighbors).verlet)
     refuse_huge_skin("verletSkin", sim.verlet_skin, "a skin above 0 and", "0.05 h to 0.5 h");
 }
 

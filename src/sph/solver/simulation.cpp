@@ -467,7 +467,12 @@ const StepInfo& Simulation<D, R>::step() {
   }
   info.seconds.grid = info.neighbors.grid_seconds + reorder_seconds;
   info.seconds.lists = info.neighbors.lists_seconds;
-  const NeighborLists& lists = neighbors_->lists();
+  // verlet_clusters: the passes run on cluster pairs, and the per-particle lists are built only
+  // for what needs them.
+  const ClusterPairs<D, R>* clusters = neighbors_->cluster_pairs();
+  const bool per_particle =
+      !clusters || dfsph_ || viscosity_ || params_.fluid.gradient_correction == GradientCorrection::Renormalize;
+  const NeighborLists& lists = per_particle ? neighbors_->lists() : no_lists_;
   BoundaryView<D, R> solid = boundary_view(neighbors_->boundary_lists());
   if (!bodies_.empty()) {  // (what each floating body gives each particle in this step)
     const std::size_t entries = particles_.size() * bodies_.size();
@@ -480,14 +485,15 @@ const StepInfo& Simulation<D, R>::step() {
   }
   if (auditor_) {
     info.audited = true;
-    info.audit = auditor_->audit(particles_.position, lists, h);
+    info.audit = clusters ? auditor_->audit_clusters(particles_.position, *clusters, h)
+                          : auditor_->audit(particles_.position, lists, h);
     info.boundary_audit =
         auditor_->audit_boundary(particles_.position, boundary_.position, neighbors_->boundary_lists(), h);
   }
 
   Stopwatch watch;
   // (DFSPH: the EOS pressure this pass computes is replaced by the density solve's)
-  info.pairs_within_h = compute_density_pressure(particles_, lists, h, params_.fluid, solid);
+  info.pairs_within_h = compute_density_pressure(particles_, lists, h, params_.fluid, solid, clusters);
   const R rho0 = static_cast<R>(params_.fluid.rest_density);
   if (dfsph_) {
     const SmoothingKernels<D, R> kernels(params_.fluid, h);
@@ -516,7 +522,7 @@ const StepInfo& Simulation<D, R>::step() {
                                 params_.walls, params_.boundary.handling == BoundaryHandling::Penalty, poses_, moving_,
                                 obstacle_body_, params_.shapes);
   compute_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity), walls,
-                        neighbors_->pair_exit_flags(), dt, solid, neighbors_->pair_exit_radius(), !dfsph_);
+                        neighbors_->pair_exit_flags(), dt, solid, neighbors_->pair_exit_radius(), !dfsph_, clusters);
   info.seconds.forces = watch.lap();
   // The viscosity backward in time, after every other acceleration of the step (DFSPH's density
   // solve then sees the velocities it leaves).

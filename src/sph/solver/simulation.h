@@ -230,6 +230,7 @@ class Simulation {
   double cfl_limit_ = kNoLimit;                         // TimeStepping::Cfl: the scene's limits but the acoustic one, s
   std::unique_ptr<DfsphSolver<D, R>> dfsph_;            // SimulationMethod::Dfsph
   std::vector<R> gradient_correction_;                  // DFSPH with GradientCorrection::Renormalize: L
+  NeighborLists no_lists_;                              // the lists the passes get when they run on cluster pairs
   std::unique_ptr<ImplicitViscosity<D, R>> viscosity_;  // ViscositySolve::Implicit
   SolveStats last_density_solve_;                       // its last constant-density solve (the CFL step's feedback)
   HealthMonitor monitor_;

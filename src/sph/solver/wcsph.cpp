@@ -1,6 +1,7 @@
 #include <sph/solver/wcsph.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <type_traits>
@@ -9,6 +10,7 @@
 #include <sph/core/kernels.h>
 #include <sph/core/parallel.h>
 #include <sph/core/simd.h>
+#include <sph/core/storage.h>
 #include <sph/solver/gradient_correction.h>
 #include <sph/solver/smoothing.h>
 
@@ -35,6 +37,14 @@ template <int D, std::floating_point R>
 void check_pass_inputs(const ParticleSet<D, R>& ps, const NeighborLists& lists) {
   SPH_CHECK(lists.particle_count() == ps.size(), "neighbor lists do not cover the particles");
   SPH_CHECK(ps.size() * D < (std::size_t{1} << 31), "too many particles for 32-bit gather offsets");
+}
+
+/// What the cluster-pair passes assume: clusters of exactly these particles, and slot offsets
+/// that fit 32 bits.
+template <int D, std::floating_point R>
+void check_cluster_inputs(const ParticleSet<D, R>& ps, const ClusterPairs<D, R>& clusters) {
+  SPH_CHECK(clusters.particle_count() == ps.size(), "cluster pairs do not cover the particles");
+  SPH_CHECK(clusters.slots().size() < (std::size_t{1} << 31), "too many particles for 32-bit cluster slots");
 }
 
 /// What the boundary terms assume: a boundary list per particle, indices below the samples
@@ -114,6 +124,24 @@ class PackKernel<KernelKind::Paper, D, R> {
   explicit PackKernel(R) {}
 };
 
+/// m_j W(|x_ij|) on the lanes in `in` (pairs closer than h), zero on the others.
+template <KernelKind K, int D, std::floating_point R>
+simd::Pack<R> density_term(const simd::Pack<R>& r2, Mask in, const simd::Pack<R>& mj, const simd::Pack<R>& h2v,
+                           const simd::Pack<R>& normv, const PackKernel<K, D, R>& kernel) {
+  using P = simd::Pack<R>;
+  const P zero = P::set1(R(0));
+  if constexpr (K == KernelKind::Paper) {
+    (void)kernel;
+    const P dd = h2v - r2;
+    // Paper Eq. 4: m_j W_poly6 = m_j C (h^2 - r^2)^3 inside the support.
+    return select(in, mj * (normv * dd * dd * dd), zero);
+  } else {
+    (void)normv;
+    const P r = sqrt(select(in, r2, zero));
+    return select(in, mj * kernel.w(r), zero);
+  }
+}
+
 /// The density sum of one particle over one list: sum_j mass_j W(|x_i - x_j|) by lanes, with
 /// the count of pairs closer than h added to `count`.
 template <KernelKind K, int D, std::floating_point R>
@@ -131,14 +159,7 @@ simd::Pack<R> density_sum(const simd::Pack<R> (&xi)[D], const R* pos, const R* m
     P rij[D];
     const P r2 = pair_offsets<D>(xi, pos, idx + k0, rij);
     const Mask in = valid & (r2 < h2v);
-    if constexpr (K == KernelKind::Paper) {
-      const P dd = h2v - r2;
-      // Paper Eq. 4: m_j W_poly6 = m_j C (h^2 - r^2)^3 inside the support.
-      sum = sum + select(in, P::template gather<1>(mass, idx + k0, 0) * (normv * dd * dd * dd), zero);
-    } else {
-      const P r = sqrt(select(in, r2, zero));
-      sum = sum + select(in, P::template gather<1>(mass, idx + k0, 0) * kernel.w(r), zero);
-    }
+    sum = sum + density_term<K, D>(r2, in, P::template gather<1>(mass, idx + k0, 0), h2v, normv, kernel);
     count += static_cast<std::uint64_t>(__builtin_popcount(in));
   }
   return sum;
@@ -216,195 +237,499 @@ simd::Pack<R> gradient_factor(const PackKernel<K, D, R>* kernel, const simd::Pac
   }
 }
 
-/// The force pass: viscosity, the Eq. 7 test when kExitTest, gravity, the walls, the boundary
-/// samples, and the pressure term of form kForm when kPressure (false with a gradient
-/// correction, whose pressure term corrected_pressure_pass adds).
+/// A particle's own terms of the force pass, one value per lane: the same particle in every lane
+/// (per-particle lists) or the particles of an i-cluster laid out by the cluster-pair pattern.
+template <int D, std::floating_point R>
+struct ForceSide {
+  simd::Pack<R> x[D], v[D];
+  // Pressure term P_ij, symmetric in i and j, so that each pair's contributions are equal and
+  // opposite: the paper's (p_i + p_j) / (2 rho_i rho_j), or p_i / rho_i^2 + p_j / rho_j^2.
+  simd::Pack<R> pi_half, pi_sym, inv_rho, visc, morris, rho;
+};
+
+/// The scalars of ForceSide for particle i (mu: the viscosity the pass applies; lap_c: the
+/// viscosity kernel's Laplacian constant), in the order ForceSide lists them after x and v.
+template <int D, std::floating_point R>
+std::array<R, 6> force_side_scalars(const ParticleSet<D, R>& ps, std::size_t i, R mu, R lap_c) {
+  const R inv_rhoi = R(1) / ps.density[i];
+  const R p = ps.pressure[i];
+  return {R(0.5) * p * inv_rhoi, p * inv_rhoi * inv_rhoi, inv_rhoi,
+          mu * inv_rhoi * lap_c, R(-2) * mu * inv_rhoi,   ps.density[i]};
+}
+
+/// A register of neighbors j: the offsets x_i - x_j, |x_ij|^2 and j's values.
+template <int D, std::floating_point R>
+struct ForceOther {
+  simd::Pack<R> rij[D], r2, rho, mass, v[D], p;
+};
+
+/// The force pass's arithmetic: the pair terms of a register, a particle's boundary samples and
+/// its total, shared by the pass over per-particle lists and the pass over cluster pairs.
+/// Viscosity, the Eq. 7 test when kExitTest, gravity, the walls, the boundary samples, and the
+/// pressure term of form kForm when kPressure (false with a gradient correction, whose pressure
+/// term corrected_pressure_pass adds).
+template <KernelKind K, PressureForce kForm, bool kPressure, bool kExitTest, int D, std::floating_point R>
+class ForceTerms {
+ public:
+  using P = simd::Pack<R>;
+  static constexpr int kW = simd::kLanes<R>;
+  static constexpr bool kVariational = kForm == PressureForce::Variational;
+
+  ForceTerms(ParticleSet<D, R>& ps, R h, const FluidParams& fluid, const Vec<D, R>& gravity,
+             const WallContact<D, R>& walls, std::span<std::uint8_t> flags, R dt, const BoundaryView<D, R>& boundary,
+             R exit_radius)
+      : ps_(ps),
+        h_(h),
+        gravity_(gravity),
+        walls_(walls),
+        flags_(flags),
+        boundary_(boundary),
+        fc_(h, fluid, boundary),
+        kernel_(h),
+        hv_(P::set1(h)),
+        h2v_(P::set1(h * h)),
+        exit2v_(P::set1(exit_radius * exit_radius)),  // Eq. 7's radius: h, or the lists' radius
+        grad_c_(P::set1(R(-3) * SpikyKernel<D, R>(h).norm())),
+        grad6_c_(P::set1(R(-6) * Poly6Kernel<D, R>(h).norm())),
+        lap_c_(ViscosityKernel<D, R>(h).laplacian_norm()),
+        eps_h2_(P::set1(R(0.01) * h * h)),                // Monaghan's and Morris's 0.01 h^2 in |x_ij|^2 + 0.01 h^2
+        art_i_(P::set1(R(-2) * fc_.alpha * fc_.c0 * h)),  // Monaghan's Pi_ij = -alpha c0 h mu_ij / rho_ij
+        dtv_(P::set1(dt)) {
+    solid_ = boundary.active();
+    bpos_ = solid_ ? flat(boundary.position) : nullptr;
+    bvel_ = solid_ && !boundary.velocity.empty() ? flat(boundary.velocity) : nullptr;
+    // (floating bodies: what each body's samples give a particle is recorded, per lane)
+    sample_body_ = solid_ && boundary.body_acceleration && !boundary.body.empty() ? boundary.body.data() : nullptr;
+  }
+
+  R mu() const { return fc_.mu; }
+  R lap_c() const { return lap_c_; }
+  bool solid() const { return solid_; }
+
+  /// Particle i's ForceSide with i in every lane.
+  ForceSide<D, R> side(std::size_t i) const {
+    ForceSide<D, R> s;
+    for (int d = 0; d < D; ++d) s.x[d] = P::set1(ps_.position[i][d]), s.v[d] = P::set1(ps_.velocity[i][d]);
+    const std::array<R, 6> c = force_side_scalars(ps_, i, fc_.mu, lap_c_);
+    s.pi_half = P::set1(c[0]), s.pi_sym = P::set1(c[1]), s.inv_rho = P::set1(c[2]);
+    s.visc = P::set1(c[3]), s.morris = P::set1(c[4]), s.rho = P::set1(c[5]);
+    return s;
+  }
+
+  /// Adds the pair terms of the lanes in `valid` to acc: -m_j P_ij times the spiky gradient
+  /// -3 C (h - r)^2 rij / r (Eq. 5), and the viscosity term mu m_j (v_j - v_i) C_lap (h - r) /
+  /// (rho_i rho_j) (Eq. 6); variational: the density kernel's gradient -6 C6 (h^2 - r^2)^2 rij.
+  void pairs(const ForceSide<D, R>& i, const ForceOther<D, R>& j, Mask valid, P (&acc)[D]) const {
+    const P zero = P::set1(R(0)), one = P::set1(R(1)), minus_one = P::set1(R(-1)), half = P::set1(R(0.5));
+    const Mask near = valid & (j.r2 < h2v_);  // inside the support
+    const P r = sqrt(select(near, j.r2, h2v_));
+    const P dh = hv_ - r;
+    const P inv_rhoj = one / j.rho;
+    P fp = zero, fv = zero;
+    if constexpr (kPressure) {
+      P pij;
+      if constexpr (kForm == PressureForce::Paper)
+        pij = (i.pi_half + half * j.p * i.inv_rho) * inv_rhoj;
+      else
+        pij = i.pi_sym + j.p * inv_rhoj * inv_rhoj;
+      if constexpr (K != KernelKind::Paper) {
+        fp = gradient_factor<K, false, D>(&kernel_, j.r2, r, near, h_) * (minus_one * j.mass * pij);
+      } else if constexpr (kVariational) {
+        const P d2 = h2v_ - j.r2;
+        fp = select(near, grad6_c_ * d2 * d2 * (minus_one * j.mass * pij), zero);
+      } else {
+        const Mask apart = near & (j.r2 > zero);  // and not coincident (gradient defined)
+        fp = select(apart, (grad_c_ * dh * dh / select(apart, r, one)) * (minus_one * j.mass * pij), zero);
+      }
+    }
+    if (fc_.artificial) {
+      // -m_j Pi_ij grad W_ij for approaching pairs (v_ij . x_ij < 0).
+      P vr = zero;
+      for (int d = 0; d < D; ++d) vr = vr + (i.v[d] - j.v[d]) * j.rij[d];
+      const Mask approaching = near & (vr < zero);
+      const P f = gradient_factor < K, kVariational && K == KernelKind::Paper, D > (&kernel_, j.r2, r, near, h_);
+      const P pi_ij = art_i_ * (vr / (j.r2 + eps_h2_)) / (i.rho + j.rho);
+      fp = fp + select(approaching, minus_one * j.mass * pi_ij * f, zero);
+    } else if constexpr (K == KernelKind::Paper) {
+      fv = select(near, i.visc * j.mass * inv_rhoj * dh, zero);
+    } else {
+      // Morris et al. 1997: 2 mu m_j / (rho_i rho_j) (x_ij . grad W) / (r^2 + 0.01 h^2) (v_i - v_j).
+      const P f = gradient_factor<K, false, D>(&kernel_, j.r2, r, near, h_);
+      fv = select(near, i.morris * j.mass * inv_rhoj * (f * j.r2) / (j.r2 + eps_h2_), zero);
+    }
+    for (int d = 0; d < D; ++d) {
+      if constexpr (kPressure) {
+        acc[d] = acc[d] + (j.rij[d] * fp + (j.v[d] - i.v[d]) * fv);
+      } else {
+        acc[d] = acc[d] + (j.v[d] - i.v[d]) * fv;
+        if (fc_.artificial) acc[d] = acc[d] + j.rij[d] * fp;
+      }
+    }
+  }
+
+  /// Eq. 7 on the lanes in `valid`: flags j (and returns true) for each pair predicted beyond the
+  /// exit radius after the step.
+  bool exit_test(const ForceSide<D, R>& i, const ForceOther<D, R>& j, Mask valid, const std::uint32_t* idx) const {
+    const P zero = P::set1(R(0));
+    P q2 = zero;  // squared pair distance after the step, predicted with today's velocities
+    for (int d = 0; d < D; ++d) {
+      const P t = j.rij[d] + (i.v[d] - j.v[d]) * dtv_;
+      q2 = q2 + t * t;
+    }
+    bool any = false;
+    for (Mask out = valid & (q2 > exit2v_); out != 0; out &= out - 1) {
+      any = true;
+      set_flag(idx[static_cast<std::size_t>(__builtin_ctz(out))]);
+    }
+    return any;
+  }
+
+  /// Adds particle i's boundary samples to acc (i in every lane of `s`): the pair's pressure term
+  /// with p_b = p_i, rho_b = rho_i (the paper's form: p_i / rho_i^2; the symmetric ones: 2 p_i /
+  /// rho_i^2), psi_b for the mass, and Akinci's friction, nu = sigma h c0 / (2 rho_i). Returns
+  /// whether Eq. 7 flags i for a sample.
+  bool boundary(std::size_t i, const ForceSide<D, R>& s, P (&acc)[D]) const {
+    const P zero = P::set1(R(0)), minus_one = P::set1(R(-1));
+    const R* prs = ps_.pressure.data();
+    const R inv_rhoi = R(1) / ps_.density[i];
+    const R pii = kForm == PressureForce::Paper ? prs[i] * inv_rhoi * inv_rhoi : R(2) * prs[i] * inv_rhoi * inv_rhoi;
+    const P pii_v = P::set1(kPressure ? pii : R(0));
+    // Extrapolated: P_ib = w (p_i + p_b) / rho_i^2 with w = 1/2 (paper's form) or 1, and
+    // p_b / rho_i^2 = p_i / rho_i^2 - (a . x_ib) / rho_i, clamped at 0 like p.
+    const bool extrapolate = kPressure && boundary_.extrapolate;
+    const R w = kForm == PressureForce::Paper ? R(0.5) : R(1);
+    const P w_v = P::set1(w), pi_sym_b = P::set1(prs[i] * inv_rhoi * inv_rhoi);
+    P ext_v[D];
+    for (int d = 0; d < D; ++d) ext_v[d] = P::set1(boundary_.extrapolation[d] * inv_rhoi);
+    const P nu_i = P::set1(fc_.friction * h_ * fc_.c0 * R(0.5) * inv_rhoi);
+    const auto bnb = boundary_.lists->of(i);
+    const std::uint32_t* bidx = bnb.data();
+    // (recorded only for the particles that have a floating body's sample in their list)
+    const bool record =
+        sample_body_ && std::any_of(bnb.begin(), bnb.end(), [&](std::uint32_t b) { return sample_body_[b] != 0; });
+    bool flag = false;
+    for (std::size_t k0 = 0; k0 < bnb.size(); k0 += kW) {
+      const Mask valid = simd::first_lanes<R>(bnb.size() - k0);
+      P rib[D];
+      const P r2 = pair_offsets<D>(s.x, bpos_, bidx + k0, rib);
+      const Mask near = valid & (r2 < h2v_);
+      const P r = sqrt(select(near, r2, h2v_));
+      const P f = gradient_factor < K, kVariational && K == KernelKind::Paper, D > (&kernel_, r2, r, near, h_);
+      const P psib = P::template gather<1>(boundary_.psi.data(), bidx + k0, 0);
+      // The velocity relative to the sample's (moving obstacles), else the particle's own.
+      P vib[D];
+      for (int d = 0; d < D; ++d) vib[d] = bvel_ ? s.v[d] - P::template gather<D>(bvel_, bidx + k0, d) : s.v[d];
+      P vr = zero;
+      for (int d = 0; d < D; ++d) vr = vr + vib[d] * rib[d];
+      const P pi_ib = minus_one * nu_i * select(vr < zero, vr, zero) / (r2 + eps_h2_);
+      P pterm = pii_v;
+      if (extrapolate) {
+        P ax = zero;
+        for (int d = 0; d < D; ++d) ax = ax + ext_v[d] * rib[d];
+        const P pb = pi_sym_b - ax;
+        pterm = w_v * (pi_sym_b + (boundary_.clamp ? select(pb > zero, pb, zero) : pb));
+      }
+      const P fb = minus_one * psib * (pterm + pi_ib) * f;
+      if (record) {
+        R fl[kW], rl[D][kW];
+        fb.store(fl);
+        for (int d = 0; d < D; ++d) rib[d].store(rl[d]);
+        Vec<D, R>* row = boundary_.body_row(i);
+        for (std::size_t l = 0; l < static_cast<std::size_t>(kW) && k0 + l < bnb.size(); ++l)
+          if (const std::uint16_t o = sample_body_[bidx[k0 + l]]; o != 0)
+            for (int d = 0; d < D; ++d) row[o - 1][d] += rl[d][l] * fl[l];
+      }
+      P q2 = zero;
+      for (int d = 0; d < D; ++d) {
+        acc[d] = acc[d] + rib[d] * fb;
+        if constexpr (kExitTest) {
+          const P t = rib[d] + vib[d] * dtv_;
+          q2 = q2 + t * t;
+        }
+      }
+      if constexpr (kExitTest)
+        if ((valid & (q2 > exit2v_)) != 0) flag = true;
+    }
+    return flag;
+  }
+
+  /// Stores particle i's acceleration: gravity, the pair and boundary terms `pairs`, the walls.
+  void finish(std::size_t i, const Vec<D, R>& pairs) const {
+    Vec<D, R> a = gravity_;
+    for (int d = 0; d < D; ++d) a[d] += pairs[d];
+    a += walls_(ps_.position[i], ps_.velocity[i], boundary_.body_row(i));
+    ps_.acceleration[i] = a;
+  }
+
+  void set_flag(std::size_t q) const { std::atomic_ref<std::uint8_t>(flags_[q]).store(1, std::memory_order_relaxed); }
+
+ private:
+  ParticleSet<D, R>& ps_;
+  R h_;
+  Vec<D, R> gravity_;
+  const WallContact<D, R>& walls_;
+  std::span<std::uint8_t> flags_;
+  const BoundaryView<D, R>& boundary_;
+  ForceConstants<D, R> fc_;
+  PackKernel<K, D, R> kernel_;
+  P hv_, h2v_, exit2v_, grad_c_, grad6_c_;
+  R lap_c_;
+  P eps_h2_, art_i_, dtv_;
+  bool solid_ = false;
+  const R* bpos_ = nullptr;
+  const R* bvel_ = nullptr;
+  const std::uint16_t* sample_body_ = nullptr;
+};
+
+/// The force pass over per-particle lists: each particle's neighbors gathered a register at a time.
 template <KernelKind K, PressureForce kForm, bool kPressure, bool kExitTest, int D, std::floating_point R>
 void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                 const Vec<D, R>& gravity, const WallContact<D, R>& walls, std::span<std::uint8_t> flags, R dt,
                 const BoundaryView<D, R>& boundary, R exit_radius) {
   using P = simd::Pack<R>;
   constexpr int W = simd::kLanes<R>;
-  constexpr bool kVariational = kForm == PressureForce::Variational;
-  const P hv = P::set1(h), h2v = P::set1(h * h), zero = P::set1(R(0)), one = P::set1(R(1)), minus_one = P::set1(R(-1)),
-          half = P::set1(R(0.5));
-  const P exit2v = P::set1(exit_radius * exit_radius);  // Eq. 7's radius: h, or the lists' radius
-  const P grad_c = P::set1(R(-3) * SpikyKernel<D, R>(h).norm());
-  const P grad6_c = P::set1(R(-6) * Poly6Kernel<D, R>(h).norm());
-  const R lap_c = ViscosityKernel<D, R>(h).laplacian_norm();
-  const ForceConstants<D, R> fc(h, fluid, boundary);
-  const R mu = fc.mu;
-  const P eps_h2 = P::set1(R(0.01) * h * h);  // Monaghan's and Morris's 0.01 h^2 in |x_ij|^2 + 0.01 h^2
+  const ForceTerms<K, kForm, kPressure, kExitTest, D, R> terms(ps, h, fluid, gravity, walls, flags, dt, boundary,
+                                                               exit_radius);
   const R* pos = flat(ps.position);
   const R* vel = flat(ps.velocity);
   const R* rho = ps.density.data();
   const R* prs = ps.pressure.data();
   const R* mass = ps.mass.data();
-  const bool solid = boundary.active();
-  const R* bpos = solid ? flat(boundary.position) : nullptr;
-  const R* psi = boundary.psi.data();
-  const R* bvel = solid && !boundary.velocity.empty() ? flat(boundary.velocity) : nullptr;
-  // (floating bodies: what each body's samples give a particle is recorded, per lane)
-  const std::uint16_t* sample_body =
-      solid && boundary.body_acceleration && !boundary.body.empty() ? boundary.body.data() : nullptr;
-  const P dtv = P::set1(dt);
-  const PackKernel<K, D, R> kernel_value(h);
-  const PackKernel<K, D, R>* kernel = &kernel_value;
-  const auto set_flag = [&](std::size_t q) {
-    std::atomic_ref<std::uint8_t>(flags[q]).store(1, std::memory_order_relaxed);
-  };
   parallel_for(ps.size(), [&](std::size_t i) {
-    P xi[D], vi[D], acc[D];
+    const ForceSide<D, R> side = terms.side(i);
+    P acc[D];
+    for (int d = 0; d < D; ++d) acc[d] = P::set1(R(0));
     bool flag_i = false;
-    for (int d = 0; d < D; ++d) xi[d] = P::set1(ps.position[i][d]), vi[d] = P::set1(ps.velocity[i][d]), acc[d] = zero;
-    const R inv_rhoi = R(1) / rho[i];
-    // Pressure term P_ij, symmetric in i and j, so that each pair's contributions are equal
-    // and opposite: the paper's (p_i + p_j) / (2 rho_i rho_j), or p_i / rho_i^2 + p_j / rho_j^2.
-    const P pi_half = P::set1(R(0.5) * prs[i] * inv_rhoi);
-    const P pi_sym = P::set1(prs[i] * inv_rhoi * inv_rhoi);
-    const P inv_rhoi_v = P::set1(inv_rhoi);
-    const P visc_i = P::set1(mu * inv_rhoi * lap_c);
-    const P morris_i = P::set1(R(-2) * mu * inv_rhoi);
-    // Monaghan's Pi_ij = -alpha c0 h mu_ij / rho_ij, rho_ij = (rho_i + rho_j) / 2.
-    const P art_i = P::set1(R(-2) * fc.alpha * fc.c0 * h);
-    const P rhoi_v = P::set1(rho[i]);
     const auto nb = lists.of(i);
     const std::uint32_t* idx = nb.data();
     for (std::size_t k0 = 0; k0 < nb.size(); k0 += W) {
       const Mask valid = simd::first_lanes<R>(nb.size() - k0);
-      P rij[D];
-      const P r2 = pair_offsets<D>(xi, pos, idx + k0, rij);
-      const Mask near = valid & (r2 < h2v);  // inside the support
-      const P r = sqrt(select(near, r2, h2v));
-      const P dh = hv - r;
-      const P rhoj = P::template gather<1>(rho, idx + k0, 0);
-      const P inv_rhoj = one / rhoj;
-      const P mj = P::template gather<1>(mass, idx + k0, 0);
-      P vj[D];
-      for (int d = 0; d < D; ++d) vj[d] = P::template gather<D>(vel, idx + k0, d);
-      // -m_j P_ij times the spiky gradient -3 C (h - r)^2 rij / r (Eq. 5), and the viscosity
-      // term mu m_j (v_j - v_i) C_lap (h - r) / (rho_i rho_j) (Eq. 6).
-      // Variational: the density kernel's gradient -6 C6 (h^2 - r^2)^2 rij instead.
-      P fp = zero, fv = zero;
-      if constexpr (kPressure) {
-        const P pj = P::template gather<1>(prs, idx + k0, 0);
-        P pij;
-        if constexpr (kForm == PressureForce::Paper)
-          pij = (pi_half + half * pj * inv_rhoi_v) * inv_rhoj;
-        else
-          pij = pi_sym + pj * inv_rhoj * inv_rhoj;
-        if constexpr (K != KernelKind::Paper) {
-          fp = gradient_factor<K, false, D>(kernel, r2, r, near, h) * (minus_one * mj * pij);
-        } else if constexpr (kVariational) {
-          const P d2 = h2v - r2;
-          fp = select(near, grad6_c * d2 * d2 * (minus_one * mj * pij), zero);
-        } else {
-          const Mask apart = near & (r2 > zero);  // and not coincident (gradient defined)
-          fp = select(apart, (grad_c * dh * dh / select(apart, r, one)) * (minus_one * mj * pij), zero);
-        }
-      }
-      if (fc.artificial) {
-        // -m_j Pi_ij grad W_ij for approaching pairs (v_ij . x_ij < 0).
-        P vr = zero;
-        for (int d = 0; d < D; ++d) vr = vr + (vi[d] - vj[d]) * rij[d];
-        const Mask approaching = near & (vr < zero);
-        const P f = gradient_factor < K, kVariational && K == KernelKind::Paper, D > (kernel, r2, r, near, h);
-        const P pi_ij = art_i * (vr / (r2 + eps_h2)) / (rhoi_v + rhoj);
-        fp = fp + select(approaching, minus_one * mj * pi_ij * f, zero);
-      } else if constexpr (K == KernelKind::Paper) {
-        fv = select(near, visc_i * mj * inv_rhoj * dh, zero);
-      } else {
-        // Morris et al. 1997: 2 mu m_j / (rho_i rho_j) (x_ij . grad W) / (r^2 + 0.01 h^2) (v_i - v_j).
-        const P f = gradient_factor<K, false, D>(kernel, r2, r, near, h);
-        fv = select(near, morris_i * mj * inv_rhoj * (f * r2) / (r2 + eps_h2), zero);
-      }
-      P q2 = zero;  // Eq. 7: squared pair distance after the step, predicted with today's velocities
-      for (int d = 0; d < D; ++d) {
-        if constexpr (kPressure) {
-          acc[d] = acc[d] + (rij[d] * fp + (vj[d] - vi[d]) * fv);
-        } else {
-          acc[d] = acc[d] + (vj[d] - vi[d]) * fv;
-          if (fc.artificial) acc[d] = acc[d] + rij[d] * fp;
-        }
-        if constexpr (kExitTest) {
-          const P t = rij[d] + (vi[d] - vj[d]) * dtv;
-          q2 = q2 + t * t;
-        }
-      }
-      if constexpr (kExitTest)
-        for (Mask out = valid & (q2 > exit2v); out != 0; out &= out - 1) {
-          flag_i = true;
-          set_flag(idx[k0 + static_cast<std::size_t>(__builtin_ctz(out))]);
-        }
+      ForceOther<D, R> j;
+      j.r2 = pair_offsets<D>(side.x, pos, idx + k0, j.rij);
+      j.rho = P::template gather<1>(rho, idx + k0, 0);
+      j.mass = P::template gather<1>(mass, idx + k0, 0);
+      for (int d = 0; d < D; ++d) j.v[d] = P::template gather<D>(vel, idx + k0, d);
+      if constexpr (kPressure) j.p = P::template gather<1>(prs, idx + k0, 0);
+      terms.pairs(side, j, valid, acc);
+      if constexpr (kExitTest) flag_i = terms.exit_test(side, j, valid, idx + k0) || flag_i;
     }
-    if (solid) {
-      // Boundary samples: the pair's pressure term with p_b = p_i, rho_b = rho_i (the paper's
-      // form: p_i / rho_i^2; the symmetric ones: 2 p_i / rho_i^2), psi_b for the mass, and
-      // Akinci's friction, nu = sigma h c0 / (2 rho_i).
-      const R pii = kForm == PressureForce::Paper ? prs[i] * inv_rhoi * inv_rhoi : R(2) * prs[i] * inv_rhoi * inv_rhoi;
-      const P pii_v = P::set1(kPressure ? pii : R(0));
-      // Extrapolated: P_ib = w (p_i + p_b) / rho_i^2 with w = 1/2 (paper's form) or 1, and
-      // p_b / rho_i^2 = p_i / rho_i^2 - (a . x_ib) / rho_i, clamped at 0 like p.
-      const bool extrapolate = kPressure && boundary.extrapolate;
-      const R w = kForm == PressureForce::Paper ? R(0.5) : R(1);
-      const P w_v = P::set1(w), pi_sym_b = P::set1(prs[i] * inv_rhoi * inv_rhoi);
-      P ext_v[D];
-      for (int d = 0; d < D; ++d) ext_v[d] = P::set1(boundary.extrapolation[d] * inv_rhoi);
-      const P nu_i = P::set1(fc.friction * h * fc.c0 * R(0.5) * inv_rhoi);
-      const auto bnb = boundary.lists->of(i);
-      const std::uint32_t* bidx = bnb.data();
-      // (recorded only for the particles that have a floating body's sample in their list)
-      const bool record =
-          sample_body && std::any_of(bnb.begin(), bnb.end(), [&](std::uint32_t b) { return sample_body[b] != 0; });
-      for (std::size_t k0 = 0; k0 < bnb.size(); k0 += W) {
-        const Mask valid = simd::first_lanes<R>(bnb.size() - k0);
-        P rib[D];
-        const P r2 = pair_offsets<D>(xi, bpos, bidx + k0, rib);
-        const Mask near = valid & (r2 < h2v);
-        const P r = sqrt(select(near, r2, h2v));
-        const P f = gradient_factor < K, kVariational && K == KernelKind::Paper, D > (kernel, r2, r, near, h);
-        const P psib = P::template gather<1>(psi, bidx + k0, 0);
-        // The velocity relative to the sample's (moving obstacles), else the particle's own.
-        P vib[D];
-        for (int d = 0; d < D; ++d) vib[d] = bvel ? vi[d] - P::template gather<D>(bvel, bidx + k0, d) : vi[d];
-        P vr = zero;
-        for (int d = 0; d < D; ++d) vr = vr + vib[d] * rib[d];
-        const P pi_ib = minus_one * nu_i * select(vr < zero, vr, zero) / (r2 + eps_h2);
-        P pterm = pii_v;
-        if (extrapolate) {
-          P ax = zero;
-          for (int d = 0; d < D; ++d) ax = ax + ext_v[d] * rib[d];
-          const P pb = pi_sym_b - ax;
-          pterm = w_v * (pi_sym_b + (boundary.clamp ? select(pb > zero, pb, zero) : pb));
-        }
-        const P fb = minus_one * psib * (pterm + pi_ib) * f;
-        if (record) {
-          R fl[W], rl[D][W];
-          fb.store(fl);
-          for (int d = 0; d < D; ++d) rib[d].store(rl[d]);
-          Vec<D, R>* row = boundary.body_row(i);
-          for (std::size_t l = 0; l < static_cast<std::size_t>(W) && k0 + l < bnb.size(); ++l)
-            if (const std::uint16_t o = sample_body[bidx[k0 + l]]; o != 0)
-              for (int d = 0; d < D; ++d) row[o - 1][d] += rl[d][l] * fl[l];
-        }
-        P q2 = zero;
-        for (int d = 0; d < D; ++d) {
-          acc[d] = acc[d] + rib[d] * fb;
-          if constexpr (kExitTest) {
-            const P t = rib[d] + vib[d] * dtv;
-            q2 = q2 + t * t;
-          }
-        }
-        if constexpr (kExitTest)
-          if ((valid & (q2 > exit2v)) != 0) flag_i = true;
-      }
-    }
+    if (terms.solid()) flag_i = terms.boundary(i, side, acc) || flag_i;
     if constexpr (kExitTest)
-      if (flag_i) set_flag(i);
-    Vec<D, R> a = gravity;
-    for (int d = 0; d < D; ++d) a[d] += simd::sum_lanes(acc[d]);
-    a += walls(ps.position[i], ps.velocity[i], boundary.body_row(i));
-    ps.acceleration[i] = a;
+      if (flag_i) terms.set_flag(i);
+    Vec<D, R> sums;
+    for (int d = 0; d < D; ++d) sums[d] = simd::sum_lanes(acc[d]);
+    terms.finish(i, sums);
+  });
+}
+
+/// The particles' values in cluster slot order (ClusterPairs::slots()), one array per scalar,
+/// each followed by a register of padding, so that a cluster's values are one contiguous load.
+/// Empty slots hold a particle far away (no pair within h), at rest, of no mass.
+template <int D, std::floating_point R>
+struct ClusterData {
+  std::vector<R> x[D], v[D], rho, p, mass;
+
+  void fill(const ParticleSet<D, R>& ps, std::span<const std::uint32_t> slots, bool forces) {
+    const std::size_t size = slots.size() + static_cast<std::size_t>(simd::kLanes<R>);
+    for (int d = 0; d < D; ++d) resize_with_room(x[d], size), resize_with_room(v[d], forces ? size : 0);
+    resize_with_room(mass, size);
+    resize_with_room(rho, forces ? size : 0);
+    resize_with_room(p, forces ? size : 0);
+    constexpr R kFar = R(1e18);  // (its square still fits a float)
+    parallel_for(slots.size(), [&](std::size_t s) {
+      const std::uint32_t i = slots[s];
+      const bool empty = i == ClusterPairs<D, R>::kEmpty;
+      for (int d = 0; d < D; ++d) {
+        x[d][s] = empty ? kFar : ps.position[i][d];
+        if (forces) v[d][s] = empty ? R(0) : ps.velocity[i][d];
+      }
+      mass[s] = empty ? R(0) : ps.mass[i];
+      if (forces) {
+        rho[s] = empty ? R(1) : ps.density[i];
+        p[s] = empty ? R(0) : ps.pressure[i];
+      }
+    });
+  }
+};
+
+/// The cluster passes' buffers, kept between steps (no allocation in steady state); one per
+/// calling thread, handed to the pass's worker threads by reference.
+template <int D, std::floating_point R>
+ClusterData<D, R>& kept_cluster_data() {
+  thread_local ClusterData<D, R> data;
+  return data;
+}
+
+/// How a register holds a pair of clusters: G = lanes / kSize j-slots by kSize i-slots, lane l
+/// pairing i-slot l / G with j-slot q G + l % G in part q (one part with floats, two with doubles).
+template <int D, std::floating_point R>
+struct ClusterLanes {
+  static constexpr int kSize = ClusterPairs<D, R>::kSize;
+  static constexpr int kW = simd::kLanes<R>;
+  static constexpr int kG = kW / kSize;
+  static constexpr int kParts = kSize / kG;
+  static_assert(kW % kSize == 0 && kSize % kG == 0);
+  using P = simd::Pack<R>;
+
+  ClusterLanes() : spread(P::lane_pattern([](int l) { return l / kG; })) {
+    for (int q = 0; q < kParts; ++q) {
+      tile[q] = P::lane_pattern([q](int l) { return q * kG + l % kG; });
+      self[q] = 0;
+      for (int l = 0; l < kW; ++l)
+        if (l / kG == q * kG + l % kG) self[q] |= Mask{1} << l;
+    }
+  }
+  /// Lanes whose i-slot holds a particle in cluster c.
+  static Mask real_i(std::span<const std::uint32_t> slots, std::size_t c) {
+    Mask m = 0;
+    for (int l = 0; l < kW; ++l)
+      if (slots[c * kSize + static_cast<std::size_t>(l / kG)] != ClusterPairs<D, R>::kEmpty) m |= Mask{1} << l;
+    return m;
+  }
+  simd::LanePattern<R> spread;        // lane l: i-slot l / G
+  simd::LanePattern<R> tile[kParts];  // lane l: j-slot q G + l % G
+  Mask self[kParts];                  // lanes pairing a slot with itself
+};
+
+/// The density pass over cluster pairs: the same sums as density_pass, each particle's fluid
+/// pairs summed by lanes in its cluster's list order, then its boundary samples as there.
+template <KernelKind K, int D, std::floating_point R>
+std::uint64_t cluster_density_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, R>& cp, R h, const FluidParams& fluid,
+                                   const BoundaryView<D, R>& boundary, std::vector<std::uint64_t>& within,
+                                   ClusterData<D, R>& data) {
+  using P = simd::Pack<R>;
+  using L = ClusterLanes<D, R>;
+  constexpr int S = L::kSize;
+  const L lanes;
+  const R w0 = SmoothingKernels<D, R>(fluid.kernel, h).w_zero();
+  const R rho0 = static_cast<R>(fluid.rest_density);
+  const R k = static_cast<R>(fluid.stiffness);
+  const bool clamp = fluid.negative_pressure == NegativePressure::Clamp;
+  const bool walls = boundary.active();
+  const R* bpos = walls ? flat(boundary.position) : nullptr;
+  const R* psi = boundary.psi.data();
+  const std::span<const std::uint32_t> slots = cp.slots();
+  data.fill(ps, slots, false);
+  const P h2v = P::set1(h * h), zero = P::set1(R(0));
+  const P normv = P::set1(Poly6Kernel<D, R>(h).norm());
+  [[maybe_unused]] const PackKernel<K, D, R> kernel(h);
+  const std::size_t clusters = cp.cluster_count();
+  assign_with_room(within, chunk_count(clusters), std::uint64_t{0});  // (the clusters' count varies)
+  parallel_chunks(clusters, [&](std::size_t chunk, std::size_t b, std::size_t e) {
+    std::uint64_t count = 0, boundary_count = 0;
+    for (std::size_t c = b; c < e; ++c) {
+      const std::size_t base = c * S;
+      P xi[D];
+      for (int d = 0; d < D; ++d) xi[d] = P::permuted(&data.x[d][base], lanes.spread);
+      const Mask real = L::real_i(slots, c);
+      P sum = zero;
+      for (const std::uint32_t jc : cp.of(c)) {
+        const std::size_t jb = std::size_t{jc} * S;
+        for (int q = 0; q < L::kParts; ++q) {
+          P r2 = zero;
+          for (int d = 0; d < D; ++d) {
+            const P rij = xi[d] - P::permuted(&data.x[d][jb], lanes.tile[q]);
+            r2 = r2 + rij * rij;
+          }
+          const Mask in = (jc == c ? real & ~lanes.self[q] : real) & (r2 < h2v);
+          if (in == 0) continue;  // (a register with no pair within h: most of a list's last ones)
+          sum = sum + density_term<K, D>(r2, in, P::permuted(&data.mass[jb], lanes.tile[q]), h2v, normv, kernel);
+          count += static_cast<std::uint64_t>(__builtin_popcount(in));
+        }
+      }
+      R sums[S];
+      simd::sum_lane_groups<L::kG>(sum, sums);
+      for (int s = 0; s < S; ++s) {
+        const std::uint32_t i = slots[base + static_cast<std::size_t>(s)];
+        if (i == ClusterPairs<D, R>::kEmpty) continue;
+        R rho = ps.mass[i] * w0 + sums[s];
+        if (walls) {
+          P x1[D];
+          for (int d = 0; d < D; ++d) x1[d] = P::set1(ps.position[i][d]);
+          rho += simd::sum_lanes(density_sum<K, D>(x1, bpos, psi, boundary.lists->of(i), h, boundary_count));
+        }
+        ps.density[i] = rho;
+        const R p = k * (rho - rho0);
+        ps.pressure[i] = clamp ? std::max(p, R(0)) : p;
+      }
+    }
+    within[chunk] = count;
+  });
+  std::uint64_t total = 0;
+  for (std::uint64_t w : within) total += w;
+  return total;
+}
+
+/// The force pass over cluster pairs: ForceTerms on registers of cluster pairs, each particle's
+/// lanes summed in lane order, then its boundary samples (their own registers) and its walls.
+template <KernelKind K, PressureForce kForm, bool kPressure, int D, std::floating_point R>
+void cluster_force_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, R>& cp, R h, const FluidParams& fluid,
+                        const Vec<D, R>& gravity, const WallContact<D, R>& walls, R dt,
+                        const BoundaryView<D, R>& boundary, ClusterData<D, R>& data) {
+  using P = simd::Pack<R>;
+  using L = ClusterLanes<D, R>;
+  constexpr int S = L::kSize, W = simd::kLanes<R>;
+  const L lanes;
+  const ForceTerms<K, kForm, kPressure, false, D, R> terms(ps, h, fluid, gravity, walls, {}, dt, boundary, h);
+  const std::span<const std::uint32_t> slots = cp.slots();
+  data.fill(ps, slots, true);
+  const Mask all = simd::first_lanes<R>(static_cast<std::size_t>(W));
+  const P h2v = P::set1(h * h);
+  const R* xs[D];
+  const R* vs[D];
+  for (int d = 0; d < D; ++d) xs[d] = data.x[d].data(), vs[d] = data.v[d].data();
+  const R *rhos = data.rho.data(), *masses = data.mass.data(), *ps_ = data.p.data();
+  parallel_for(cp.cluster_count(), [&](std::size_t c) {
+    const std::size_t base = c * S;
+    ForceSide<D, R> side;
+    for (int d = 0; d < D; ++d) {
+      side.x[d] = P::permuted(&data.x[d][base], lanes.spread);
+      side.v[d] = P::permuted(&data.v[d][base], lanes.spread);
+    }
+    R scalars[6][W] = {};
+    for (int s = 0; s < S; ++s)
+      if (const std::uint32_t i = slots[base + static_cast<std::size_t>(s)]; i != ClusterPairs<D, R>::kEmpty) {
+        const std::array<R, 6> a = force_side_scalars(ps, i, terms.mu(), terms.lap_c());
+        for (int k = 0; k < 6; ++k) scalars[k][s] = a[static_cast<std::size_t>(k)];
+      }
+    side.pi_half = P::permuted(scalars[0], lanes.spread), side.pi_sym = P::permuted(scalars[1], lanes.spread);
+    side.inv_rho = P::permuted(scalars[2], lanes.spread), side.visc = P::permuted(scalars[3], lanes.spread);
+    side.morris = P::permuted(scalars[4], lanes.spread), side.rho = P::permuted(scalars[5], lanes.spread);
+    P acc[D];
+    for (int d = 0; d < D; ++d) acc[d] = P::set1(R(0));
+    for (const std::uint32_t jc : cp.of(c)) {
+      const std::size_t jb = std::size_t{jc} * S;
+      for (int q = 0; q < L::kParts; ++q) {
+        ForceOther<D, R> j;
+        j.r2 = P::set1(R(0));
+        for (int d = 0; d < D; ++d) {
+          j.rij[d] = side.x[d] - P::permuted(xs[d] + jb, lanes.tile[q]);
+          j.r2 = j.r2 + j.rij[d] * j.rij[d];
+        }
+        const Mask valid = jc == c ? all & ~lanes.self[q] : all;
+        if ((valid & (j.r2 < h2v)) == 0) continue;  // (no pair within h in this register)
+        for (int d = 0; d < D; ++d) j.v[d] = P::permuted(vs[d] + jb, lanes.tile[q]);
+        j.rho = P::permuted(rhos + jb, lanes.tile[q]);
+        j.mass = P::permuted(masses + jb, lanes.tile[q]);
+        if constexpr (kPressure) j.p = P::permuted(ps_ + jb, lanes.tile[q]);
+        terms.pairs(side, j, valid, acc);
+      }
+    }
+    R sums[D][S];
+    for (int d = 0; d < D; ++d) simd::sum_lane_groups<L::kG>(acc[d], sums[d]);
+    for (int s = 0; s < S; ++s) {
+      const std::uint32_t i = slots[base + static_cast<std::size_t>(s)];
+      if (i == ClusterPairs<D, R>::kEmpty) continue;
+      Vec<D, R> total;
+      for (int d = 0; d < D; ++d) total[d] = sums[d][s];
+      if (terms.solid()) {
+        P bacc[D];
+        for (int d = 0; d < D; ++d) bacc[d] = P::set1(R(0));
+        terms.boundary(i, terms.side(i), bacc);
+        for (int d = 0; d < D; ++d) total[d] += simd::sum_lanes(bacc[d]);
+      }
+      terms.finish(i, total);
+    }
   });
 }
 
@@ -460,31 +785,47 @@ void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, 
 
 template <int D, std::floating_point R>
 std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                                       const BoundaryView<D, R>& boundary) {
-  check_pass_inputs(ps, lists);
+                                       const BoundaryView<D, R>& boundary, const ClusterPairs<D, R>* clusters) {
+  if (clusters)
+    check_cluster_inputs(ps, *clusters);
+  else
+    check_pass_inputs(ps, lists);
   if (boundary.active()) check_boundary_inputs(ps, boundary);
   thread_local std::vector<std::uint64_t> within;  // per-chunk counts, kept between steps
+  ClusterData<D, R>& data = kept_cluster_data<D, R>();
+  const auto run = [&]<KernelKind kKernel>() {
+    return clusters ? cluster_density_pass<kKernel>(ps, *clusters, h, fluid, boundary, within, data)
+                    : density_pass<kKernel>(ps, lists, h, fluid, boundary, within);
+  };
   switch (fluid.kernel) {
     case KernelKind::Cubic:
-      return density_pass<KernelKind::Cubic>(ps, lists, h, fluid, boundary, within);
+      return run.template operator()<KernelKind::Cubic>();
     case KernelKind::Wendland:
-      return density_pass<KernelKind::Wendland>(ps, lists, h, fluid, boundary, within);
+      return run.template operator()<KernelKind::Wendland>();
     case KernelKind::Paper:
       break;
   }
-  return density_pass<KernelKind::Paper>(ps, lists, h, fluid, boundary, within);
+  return run.template operator()<KernelKind::Paper>();
 }
 
 template <int D, std::floating_point R>
 void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                            const Vec<D, R>& gravity, const WallContact<D, R>& walls, std::span<std::uint8_t> exit_flags,
-                           R dt, const BoundaryView<D, R>& boundary, R exit_radius, bool pressure_terms) {
+                           R dt, const BoundaryView<D, R>& boundary, R exit_radius, bool pressure_terms,
+                           const ClusterPairs<D, R>* clusters) {
   SPH_CHECK(exit_flags.empty() || exit_flags.size() == ps.size(), "one exit flag per particle");
+  SPH_CHECK(!clusters || exit_flags.empty(), "no Eq. 7 test on cluster pairs");
   if (!(exit_radius > R(0))) exit_radius = h;
-  check_pass_inputs(ps, lists);
+  if (clusters)
+    check_cluster_inputs(ps, *clusters);
+  else
+    check_pass_inputs(ps, lists);
   if (boundary.active()) check_boundary_inputs(ps, boundary);
+  ClusterData<D, R>& data = kept_cluster_data<D, R>();
   const auto run = [&]<KernelKind kKernel, PressureForce kForm, bool kPressure>() {
-    if (exit_flags.empty())
+    if (clusters)
+      cluster_force_pass<kKernel, kForm, kPressure>(ps, *clusters, h, fluid, gravity, walls, dt, boundary, data);
+    else if (exit_flags.empty())
       force_pass<kKernel, kForm, kPressure, false>(ps, lists, h, fluid, gravity, walls, exit_flags, dt, boundary,
                                                    exit_radius);
     else
@@ -501,6 +842,7 @@ void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
     if (fluid.gradient_correction == GradientCorrection::Renormalize) {
       // The form only matters to the pressure terms, which the corrected pass adds.
       run.template operator()<kKernel, PressureForce::Paper, false>();
+      check_pass_inputs(ps, lists);
       corrected_pressure_pass(ps, lists, h, fluid, boundary);
       return;
     }
@@ -553,10 +895,11 @@ double lattice_mass(double rest_density, double spacing, double h, KernelKind ke
 
 #define SPH_INSTANTIATE(D, R)                                                                                       \
   template std::uint64_t compute_density_pressure<D, R>(ParticleSet<D, R>&, const NeighborLists&, R,                \
-                                                        const FluidParams&, const BoundaryView<D, R>&);             \
+                                                        const FluidParams&, const BoundaryView<D, R>&,              \
+                                                        const ClusterPairs<D, R>*);                                 \
   template void compute_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&,        \
                                             const Vec<D, R>&, const WallContact<D, R>&, std::span<std::uint8_t>, R, \
-                                            const BoundaryView<D, R>&, R, bool);
+                                            const BoundaryView<D, R>&, R, bool, const ClusterPairs<D, R>*);
 SPH_INSTANTIATE(2, float)
 SPH_INSTANTIATE(2, double)
 SPH_INSTANTIATE(3, float)

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <sph/core/particle_set.h>
+#include <sph/neighbors/cluster_pairs.h>
 #include <sph/neighbors/neighbor_lists.h>
 #include <sph/solver/params.h>
 
@@ -52,9 +53,14 @@ struct BoundaryView {
 /// at or beyond h contribute nothing.
 ///
 /// Returns the number of listed (directed) fluid pairs closer than h.
+///
+/// With `clusters` (cluster pairs covering every fluid pair within h: the verlet_clusters mode)
+/// the fluid pairs are taken from them and `lists` is not read. The sums are the same terms,
+/// added in another order: results agree with the per-particle lists' to rounding.
 template <int D, std::floating_point R>
 std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                                       const BoundaryView<D, R>& boundary = {});
+                                       const BoundaryView<D, R>& boundary = {},
+                                       const ClusterPairs<D, R>* clusters = nullptr);
 
 /// The damped penalty acceleration of the container walls and the obstacles on one particle.
 /// A particle interacts with a wall plane when closer than `particle_radius` to it; the contact
@@ -198,11 +204,14 @@ class WallContact {
 ///
 /// `pressure_terms` false leaves the pressure terms out (fluid pairs and boundary samples): the
 /// non-pressure accelerations that DFSPH's solves start from (dfsph.h).
+///
+/// `clusters`: as for compute_density_pressure (no Eq. 7 test then: exit_flags must be empty).
+/// `lists` is read only by the gradient correction's pass.
 template <int D, std::floating_point R>
 void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                            const Vec<D, R>& gravity, const WallContact<D, R>& walls,
                            std::span<std::uint8_t> exit_flags = {}, R dt = 0, const BoundaryView<D, R>& boundary = {},
-                           R exit_radius = 0, bool pressure_terms = true);
+                           R exit_radius = 0, bool pressure_terms = true, const ClusterPairs<D, R>* clusters = nullptr);
 
 /// Particle mass such that a particle inside a lattice of spacing dx (square in 2D, cubic in
 /// 3D) has exactly density rho0 under the density kernel's sum of Eq. 4 with support h (poly6

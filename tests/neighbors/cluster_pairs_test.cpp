@@ -114,6 +114,9 @@ TEST(ClusterPairs, EveryPairWithinTheRadiusIsInAListedClusterPair) {
   expect_cluster_pairs_cover<3, float>(random_points<3, float>(3000, 1.0, 2), 0.08f);
   expect_cluster_pairs_cover<2, double>(random_points<2, double>(3000, 1.0, 3), 0.03);
   expect_cluster_pairs_cover<2, float>(random_points<2, float>(3000, 1.0, 4), 0.03f);
+  // A radius of many columns: the neighbor columns beyond the build's window of cursors.
+  expect_cluster_pairs_cover<3, float>(random_points<3, float>(2000, 1.0, 17), 0.6f);
+  expect_cluster_pairs_cover<2, double>(random_points<2, double>(2000, 1.0, 18), 0.2);
 }
 
 TEST(ClusterPairs, CoversClumpsCoincidentPointsAndAStrayParticle) {

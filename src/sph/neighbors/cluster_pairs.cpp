@@ -128,25 +128,39 @@ void ClusterPairs<D, R>::build(const UniformGrid<D, R>& grid, std::span<const Ve
   resize_with_room(begin_, clusters);
   resize_with_room(end_, clusters);
   assign_with_room(chunk_pairs_, nchunks, std::size_t{0});
-  const auto scan_column = [&](std::size_t col, std::size_t k, std::vector<std::uint32_t>& out) {
-    const std::uint32_t* first = &column_cluster_[col];
-    std::size_t b = first[0];
-    const std::size_t e = first[1];
-    // First cluster whose top reaches the box's bottom (binary search: tops increase up a column).
-    std::size_t count = e - b;
+  // Up a column, clusters' bottoms and tops increase: for the clusters of one column taken in
+  // order, the first cluster of a neighbor column that reaches up to the box's bottom only moves
+  // up. Each neighbor column within kWindow columns keeps that cursor (found by binary search
+  // when a chunk or a column starts); beyond the window (a radius of many columns), each cluster
+  // searches again.
+  const auto first_reaching = [&](std::size_t col, R bottom) {
+    std::size_t b = column_cluster_[col], count = column_cluster_[col + 1] - b;
     while (count > 0) {
       const std::size_t half = count / 2;
-      if (hi_[b + half][D - 1] < lo_[k][D - 1] - reach) {
+      if (hi_[b + half][D - 1] < bottom) {
         b += half + 1;
         count -= half + 1;
       } else {
         count = half;
       }
     }
-    for (std::size_t m = b; m < e && !(lo_[m][D - 1] > hi_[k][D - 1] + reach); ++m) {
+    return static_cast<std::uint32_t>(b);
+  };
+  constexpr std::int64_t kWindow = 4;      // columns each side
+  constexpr int kSlots = D == 3 ? 81 : 9;  // (2 kWindow + 1)^(D - 1)
+  const auto scan = [&](std::size_t k, std::size_t col, std::uint32_t& cursor, std::vector<std::uint32_t>& out) {
+    const R bottom = lo_[k][D - 1] - reach, top = hi_[k][D - 1] + reach;
+    const std::size_t e = column_cluster_[col + 1];
+    std::size_t m = cursor;
+    while (m < e && hi_[m][D - 1] < bottom) ++m;
+    cursor = static_cast<std::uint32_t>(m);
+    for (; m < e && !(lo_[m][D - 1] > top); ++m) {
       R gap2 = 0;
       for (int d = 0; d < D; ++d) {
-        const R g = std::max({lo_[m][d] - hi_[k][d], lo_[k][d] - hi_[m][d], R(0)});
+        R g = lo_[m][d] - hi_[k][d];
+        const R g2 = lo_[k][d] - hi_[m][d];
+        if (g2 > g) g = g2;
+        if (g < R(0)) g = R(0);
         gap2 = gap2 + g * g;
       }
       if (gap2 < r2) out.push_back(static_cast<std::uint32_t>(m));
@@ -159,17 +173,37 @@ void ClusterPairs<D, R>::build(const UniformGrid<D, R>& grid, std::span<const Ve
     // whose clusters change from build to build does not allocate at each build)
     if (out.capacity() < longest_chunk_) out.reserve(longest_chunk_ + longest_chunk_ / 4 + 64);
     out.clear();
+    // The column of cluster kb, and the cursors of its neighbor columns (unset: kEmpty).
+    std::size_t col = static_cast<std::size_t>(
+        std::upper_bound(column_cluster_.begin(), column_cluster_.begin() + static_cast<std::ptrdiff_t>(columns) + 1,
+                         static_cast<std::uint32_t>(kb)) -
+        column_cluster_.begin() - 1);
+    std::uint32_t cursor[kSlots];
+    std::fill(cursor, cursor + kSlots, kEmpty);
     for (std::size_t k = kb; k < ke; ++k) {
-      begin_[k] = static_cast<std::uint32_t>(out.size());
-      if constexpr (D == 2) {
-        const std::int64_t x0 = column_coord(lo_[k][0] - reach, 0), x1 = column_coord(hi_[k][0] + reach, 0);
-        for (std::int64_t x = x0; x <= x1; ++x) scan_column(static_cast<std::size_t>(x), k, out);
-      } else {
-        const std::int64_t x0 = column_coord(lo_[k][0] - reach, 0), x1 = column_coord(hi_[k][0] + reach, 0);
-        const std::int64_t y0 = column_coord(lo_[k][1] - reach, 1), y1 = column_coord(hi_[k][1] + reach, 1);
-        for (std::int64_t y = y0; y <= y1; ++y)
-          for (std::int64_t x = x0; x <= x1; ++x) scan_column(static_cast<std::size_t>(y * ncol[0] + x), k, out);
+      if (k >= column_cluster_[col + 1]) {
+        while (k >= column_cluster_[col + 1]) ++col;
+        std::fill(cursor, cursor + kSlots, kEmpty);
       }
+      const auto cx = static_cast<std::int64_t>(col % static_cast<std::size_t>(ncol[0]));
+      const auto cy = D == 3 ? static_cast<std::int64_t>(col / static_cast<std::size_t>(ncol[0])) : std::int64_t{0};
+      begin_[k] = static_cast<std::uint32_t>(out.size());
+      const std::int64_t x0 = column_coord(lo_[k][0] - reach, 0), x1 = column_coord(hi_[k][0] + reach, 0);
+      std::int64_t y0 = 0, y1 = 0;
+      if constexpr (D == 3) y0 = column_coord(lo_[k][1] - reach, 1), y1 = column_coord(hi_[k][1] + reach, 1);
+      for (std::int64_t y = y0; y <= y1; ++y)
+        for (std::int64_t x = x0; x <= x1; ++x) {
+          const auto other = static_cast<std::size_t>(D == 3 ? y * ncol[0] + x : x);
+          if (x - cx >= -kWindow && x - cx <= kWindow && y - cy >= -kWindow && y - cy <= kWindow) {
+            const std::int64_t slot = (D == 3 ? (y - cy + kWindow) * (2 * kWindow + 1) : 0) + (x - cx + kWindow);
+            std::uint32_t& c = cursor[slot];
+            if (c == kEmpty) c = first_reaching(other, lo_[k][D - 1] - reach);
+            scan(k, other, c, out);
+          } else {
+            std::uint32_t c = first_reaching(other, lo_[k][D - 1] - reach);
+            scan(k, other, c, out);
+          }
+        }
       end_[k] = static_cast<std::uint32_t>(out.size());
     }
     chunk_pairs_[ch] = out.size();

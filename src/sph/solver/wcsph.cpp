@@ -531,10 +531,15 @@ struct ClusterData {
 
   void fill(const ParticleSet<D, R>& ps, std::span<const std::uint32_t> slots, bool forces) {
     const std::size_t size = slots.size() + static_cast<std::size_t>(simd::kLanes<R>);
-    for (int d = 0; d < D; ++d) resize_with_room(x[d], size), resize_with_room(v[d], forces ? size : 0);
+    // (the density pass leaves the force pass's arrays as they are: no shrinking and zero-filling
+    // them again at every step)
+    for (int d = 0; d < D; ++d) resize_with_room(x[d], size);
     resize_with_room(mass, size);
-    resize_with_room(rho, forces ? size : 0);
-    resize_with_room(p, forces ? size : 0);
+    if (forces) {
+      for (int d = 0; d < D; ++d) resize_with_room(v[d], size);
+      resize_with_room(rho, size);
+      resize_with_room(p, size);
+    }
     constexpr R kFar = R(1e18);  // (its square still fits a float)
     parallel_for(slots.size(), [&](std::size_t s) {
       const std::uint32_t i = slots[s];

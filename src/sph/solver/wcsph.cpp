@@ -619,8 +619,14 @@ std::uint64_t cluster_density_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, 
   const P normv = P::set1(Poly6Kernel<D, R>(h).norm());
   [[maybe_unused]] const PackKernel<K, D, R> kernel(h);
   const std::size_t clusters = cp.cluster_count();
-  assign_with_room(within, chunk_count(clusters), std::uint64_t{0});  // (the clusters' count varies)
-  parallel_chunks(clusters, [&](std::size_t chunk, std::size_t b, std::size_t e) {
+  // Blocks of clusters, each counting its pairs (a count is the same in any order; the blocks are
+  // small so that every thread has clusters: kChunkSize clusters would leave a 4,000-particle
+  // scene on one thread).
+  constexpr std::size_t kBlock = 64;
+  const std::size_t blocks = (clusters + kBlock - 1) / kBlock;
+  assign_with_room(within, blocks, std::uint64_t{0});  // (the clusters' count varies)
+  parallel_for(blocks, [&](std::size_t chunk) {
+    const std::size_t b = chunk * kBlock, e = std::min(clusters, b + kBlock);
     std::uint64_t count = 0, boundary_count = 0;
     for (std::size_t c = b; c < e; ++c) {
       const std::size_t base = c * S;

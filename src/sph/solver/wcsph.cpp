@@ -165,32 +165,56 @@ simd::Pack<R> density_sum(const simd::Pack<R> (&xi)[D], const R* pos, const R* m
   return sum;
 }
 
+/// What both density passes do with a particle's sum over its fluid pairs: add its own mass's
+/// m_i W(0) and its boundary samples' psi_b W_ib (Akinci et al. 2012 eq. 6: psi in place of the
+/// mass), store the density and the EOS pressure.
+template <KernelKind K, int D, std::floating_point R>
+class DensityStore {
+ public:
+  DensityStore(ParticleSet<D, R>& ps, R h, const FluidParams& fluid, const BoundaryView<D, R>& boundary)
+      : ps_(ps),
+        boundary_(boundary),
+        h_(h),
+        w0_(SmoothingKernels<D, R>(fluid.kernel, h).w_zero()),
+        rho0_(static_cast<R>(fluid.rest_density)),
+        k_(static_cast<R>(fluid.stiffness)),
+        clamp_(fluid.negative_pressure == NegativePressure::Clamp),
+        walls_(boundary.active()),
+        bpos_(walls_ ? flat(boundary.position) : nullptr) {}
+
+  /// Particle i (at xi, in every lane), whose fluid pairs sum to `pairs`.
+  void operator()(std::size_t i, const simd::Pack<R> (&xi)[D], R pairs, std::uint64_t& boundary_count) const {
+    R rho = ps_.mass[i] * w0_ + pairs;
+    if (walls_)
+      rho += simd::sum_lanes(
+          density_sum<K, D>(xi, bpos_, boundary_.psi.data(), boundary_.lists->of(i), h_, boundary_count));
+    ps_.density[i] = rho;
+    const R p = k_ * (rho - rho0_);
+    ps_.pressure[i] = clamp_ ? std::max(p, R(0)) : p;
+  }
+
+ private:
+  ParticleSet<D, R>& ps_;
+  const BoundaryView<D, R>& boundary_;
+  R h_, w0_, rho0_, k_;
+  bool clamp_, walls_;
+  const R* bpos_;
+};
+
 template <KernelKind K, int D, std::floating_point R>
 std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                            const BoundaryView<D, R>& boundary, std::vector<std::uint64_t>& within) {
   using P = simd::Pack<R>;
-  const R w0 = SmoothingKernels<D, R>(fluid.kernel, h).w_zero();
-  const R rho0 = static_cast<R>(fluid.rest_density);
-  const R k = static_cast<R>(fluid.stiffness);
-  const bool clamp = fluid.negative_pressure == NegativePressure::Clamp;
+  const DensityStore<K, D, R> store(ps, h, fluid, boundary);
   const R* pos = flat(ps.position);
   const R* mass = ps.mass.data();
-  const bool walls = boundary.active();
-  const R* bpos = walls ? flat(boundary.position) : nullptr;
-  const R* psi = boundary.psi.data();
   within.assign(chunk_count(ps.size()), 0);
   parallel_chunks(ps.size(), [&](std::size_t c, std::size_t b, std::size_t e) {
     std::uint64_t count = 0, boundary_count = 0;
     for (std::size_t i = b; i < e; ++i) {
       P xi[D];
       for (int d = 0; d < D; ++d) xi[d] = P::set1(ps.position[i][d]);
-      const P sum = density_sum<K, D>(xi, pos, mass, lists.of(i), h, count);
-      R rho = mass[i] * w0 + simd::sum_lanes(sum);
-      // Akinci et al. 2012 eq. 6: the samples' psi_b W_ib, psi in place of the mass.
-      if (walls) rho += simd::sum_lanes(density_sum<K, D>(xi, bpos, psi, boundary.lists->of(i), h, boundary_count));
-      ps.density[i] = rho;
-      const R p = k * (rho - rho0);
-      ps.pressure[i] = clamp ? std::max(p, R(0)) : p;
+      store(i, xi, simd::sum_lanes(density_sum<K, D>(xi, pos, mass, lists.of(i), h, count)), boundary_count);
     }
     within[c] = count;
   });
@@ -606,13 +630,7 @@ std::uint64_t cluster_density_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, 
   using L = ClusterLanes<D, R>;
   constexpr int S = L::kSize;
   const L lanes;
-  const R w0 = SmoothingKernels<D, R>(fluid.kernel, h).w_zero();
-  const R rho0 = static_cast<R>(fluid.rest_density);
-  const R k = static_cast<R>(fluid.stiffness);
-  const bool clamp = fluid.negative_pressure == NegativePressure::Clamp;
-  const bool walls = boundary.active();
-  const R* bpos = walls ? flat(boundary.position) : nullptr;
-  const R* psi = boundary.psi.data();
+  const DensityStore<K, D, R> store(ps, h, fluid, boundary);
   const std::span<const std::uint32_t> slots = cp.slots();
   data.fill(ps, slots, false);
   const P h2v = P::set1(h * h), zero = P::set1(R(0));
@@ -653,15 +671,9 @@ std::uint64_t cluster_density_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, 
       for (int s = 0; s < S; ++s) {
         const std::uint32_t i = slots[base + static_cast<std::size_t>(s)];
         if (i == ClusterPairs<D, R>::kEmpty) continue;
-        R rho = ps.mass[i] * w0 + sums[s];
-        if (walls) {
-          P x1[D];
-          for (int d = 0; d < D; ++d) x1[d] = P::set1(ps.position[i][d]);
-          rho += simd::sum_lanes(density_sum<K, D>(x1, bpos, psi, boundary.lists->of(i), h, boundary_count));
-        }
-        ps.density[i] = rho;
-        const R p = k * (rho - rho0);
-        ps.pressure[i] = clamp ? std::max(p, R(0)) : p;
+        P x1[D];
+        for (int d = 0; d < D; ++d) x1[d] = P::set1(ps.position[i][d]);
+        store(i, x1, sums[s], boundary_count);
       }
     }
     within[chunk] = count;

@@ -701,7 +701,7 @@ void cluster_force_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, R>& cp, R h
   const R* xs[D];
   const R* vs[D];
   for (int d = 0; d < D; ++d) xs[d] = data.x[d].data(), vs[d] = data.v[d].data();
-  const R *rhos = data.rho.data(), *masses = data.mass.data(), *ps_ = data.p.data();
+  const R *rhos = data.rho.data(), *masses = data.mass.data(), *prs = data.p.data();
   parallel_for(cp.cluster_count(), [&](std::size_t c) {
     const std::size_t base = c * S;
     ForceSide<D, R> side;
@@ -734,7 +734,7 @@ void cluster_force_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, R>& cp, R h
         for (int d = 0; d < D; ++d) j.v[d] = P::permuted(vs[d] + jb, lanes.tile[q]);
         j.rho = P::permuted(rhos + jb, lanes.tile[q]);
         j.mass = P::permuted(masses + jb, lanes.tile[q]);
-        if constexpr (kPressure) j.p = P::permuted(ps_ + jb, lanes.tile[q]);
+        if constexpr (kPressure) j.p = P::permuted(prs + jb, lanes.tile[q]);
         terms.pairs(side, j, valid, acc);
       }
     }

@@ -468,11 +468,13 @@ const StepInfo& Simulation<D, R>::step() {
   info.seconds.grid = info.neighbors.grid_seconds + reorder_seconds;
   info.seconds.lists = info.neighbors.lists_seconds;
   // verlet_clusters: the passes run on cluster pairs, and the per-particle lists are built only
-  // for what needs them.
+  // for what needs them (their build counted with the lists').
   const ClusterPairs<D, R>* clusters = neighbors_->cluster_pairs();
   const bool per_particle =
       !clusters || dfsph_ || viscosity_ || params_.fluid.gradient_correction == GradientCorrection::Renormalize;
+  Stopwatch asked;
   const NeighborLists& lists = per_particle ? neighbors_->lists() : no_lists_;
+  info.seconds.lists += asked.lap();
   BoundaryView<D, R> solid = boundary_view(neighbors_->boundary_lists());
   if (!bodies_.empty()) {  // (what each floating body gives each particle in this step)
     const std::size_t entries = particles_.size() * bodies_.size();

@@ -183,7 +183,9 @@ TEST(VerletClusters, NeverMissesAPairWithinHAndKeepsVerletsListsForWhoAsks) {
     EXPECT_EQ(clusters.counters().pairs_stored, clusters.cluster_pairs()->pair_count() * 16);
     const ListAudit a = auditor.audit_clusters(ps.position, *clusters.cluster_pairs(), h);
     ASSERT_EQ(a.missed_pairs, 0u) << "step " << step;
-    if (step % 10 == 0) ASSERT_TRUE(clusters.lists() == verlet.lists()) << "step " << step;
+    if (step % 10 == 0) {
+      ASSERT_TRUE(clusters.lists() == verlet.lists()) << "step " << step;
+    }
   }
   EXPECT_GT(rebuilds, 1);
   EXPECT_LT(rebuilds, 30);

@@ -175,16 +175,6 @@ struct Pack {
 template <class R>
 using LanePattern = decltype(Pack<R>::lane_pattern([](int l) { return l; }));
 
-/// Sum of the lanes, added in lane order (the same in both implementations).
-template <class R>
-inline R sum_lanes(const Pack<R>& p) {
-  R lanes[kLanes<R>];
-  p.store(lanes);
-  R s = 0;
-  for (int l = 0; l < kLanes<R>; ++l) s += lanes[l];
-  return s;
-}
-
 /// Sums of groups of G consecutive lanes, each added in lane order (the same in both
 /// implementations): out[g] = lane G g + lane G g + 1 + ... + lane G g + G - 1.
 template <int G, class R>
@@ -197,6 +187,14 @@ inline void sum_lane_groups(const Pack<R>& p, R* out) {
     for (int l = 0; l < G; ++l) s += lanes[G * g + l];
     out[g] = s;
   }
+}
+
+/// Sum of the lanes, added in lane order (the same in both implementations).
+template <class R>
+inline R sum_lanes(const Pack<R>& p) {
+  R s;
+  sum_lane_groups<kLanes<R>>(p, &s);
+  return s;
 }
 
 }  // namespace sph::simd

@@ -26,37 +26,48 @@ void parallel_for(std::size_t n, F&& f) {
   for (long long i = 0; i < count; ++i) f(static_cast<std::size_t>(i));
 }
 
-/// Fixed chunk size used by parallel_chunks: chunk boundaries depend only on n.
-inline constexpr std::size_t kChunkSize = 1024;
+/// Fixed chunk size used by parallel_chunks: chunk boundaries depend only on n. Small enough that
+/// the paper's scenes (3,200 to 8,000 particles) give each of two threads several chunks of
+/// every loop: with 1,024 the 2D dam break's second thread gave 1.22x, with 256 1.65x
+/// (docs/performance.md, "Threads").
+inline constexpr std::size_t kChunkSize = 256;
 
-/// Number of chunks of kChunkSize that cover [0, n).
-inline std::size_t chunk_count(std::size_t n) { return (n + kChunkSize - 1) / kChunkSize; }
+/// The blocks that sums feeding results are taken in (chunked_sum: DFSPH's residuals, the kinetic
+/// energy, momentum; the floating bodies' loads, the tracked modes' mean speed), fixed apart from
+/// kChunkSize: they do not change when the loops' chunking does.
+inline constexpr std::size_t kSumBlock = 1024;
 
-/// Calls f(chunk, begin, end) for each chunk of [0, n) of size kChunkSize, in parallel.
+/// Number of chunks of Size (kChunkSize, or kSumBlock for a sum) that cover [0, n).
+template <std::size_t Size = kChunkSize>
+std::size_t chunk_count(std::size_t n) {
+  return (n + Size - 1) / Size;
+}
+
+/// Calls f(chunk, begin, end) for each chunk of [0, n) of size Size, in parallel.
 /// The chunks are the same for any thread count, so per-chunk partial results combined in
 /// chunk order give thread-count-independent results. Each thread takes one contiguous run of
 /// chunks (a static schedule), as parallel_for takes one contiguous run of indices: the loops of
 /// a step then hand every particle to the same core, whose cache still holds what the previous
 /// loop wrote (dealt out one chunk at a time, the paper scenes ran 1.13x slower on 2 threads:
 /// docs/performance.md, "Static chunk schedule").
-template <class F>
+template <std::size_t Size = kChunkSize, class F>
 void parallel_chunks(std::size_t n, F&& f) {
-  const auto chunks = static_cast<long long>(chunk_count(n));
+  const auto chunks = static_cast<long long>(chunk_count<Size>(n));
 #pragma omp parallel for schedule(static)
   for (long long c = 0; c < chunks; ++c) {
-    const std::size_t begin = static_cast<std::size_t>(c) * kChunkSize;
-    const std::size_t end = begin + kChunkSize < n ? begin + kChunkSize : n;
+    const std::size_t begin = static_cast<std::size_t>(c) * Size;
+    const std::size_t end = begin + Size < n ? begin + Size : n;
     f(static_cast<std::size_t>(c), begin, end);
   }
 }
 
-/// The sum of term(i) over [0, n), the same for any thread count: each fixed chunk of
-/// parallel_chunks sums its terms in index order into `partial` (kept by the caller, so that a
-/// step allocates nothing), and the chunks' sums are added in chunk order.
+/// The sum of term(i) over [0, n), the same for any thread count: each fixed block of kSumBlock
+/// indices sums its terms in index order into `partial` (kept by the caller, so that a step
+/// allocates nothing), and the blocks' sums are added in block order.
 template <class F>
 double chunked_sum(std::size_t n, std::vector<double>& partial, F&& term) {
-  partial.assign(chunk_count(n), 0.0);
-  parallel_chunks(n, [&](std::size_t c, std::size_t begin, std::size_t end) {
+  partial.assign(chunk_count<kSumBlock>(n), 0.0);
+  parallel_chunks<kSumBlock>(n, [&](std::size_t c, std::size_t begin, std::size_t end) {
     double s = 0;
     for (std::size_t i = begin; i < end; ++i) s += term(i);
     partial[c] = s;

@@ -130,7 +130,9 @@ std::uint32_t gather(bool vector, const UniformGrid<D, R>& grid, const Stencil<D
 /// lists grow, little spare room once they are stable).
 void ensure_room(std::vector<std::uint32_t>& buf, std::size_t need) {
   if (buf.size() >= need) return;
-  buf.resize(std::max(need, buf.size() + buf.size() / 16 + 4096));
+  std::size_t size = std::max(need, buf.size() + buf.size() / 16 + 4096);
+  if (need <= buf.capacity()) size = std::min(size, buf.capacity());  // (no reallocation while it fits)
+  buf.resize(size);
 }
 
 // Room after the last list: a vector store may write this far past the last hit, and readers
@@ -201,13 +203,20 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
   else
     out.cap_.clear();
   chunk_entries_.resize(chunks);
+  old_copy_.resize(static_cast<std::size_t>(num_threads()));
 
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
-    auto& buf = out.chunks_[c];
+    // A chunk's first build goes to its thread's scratch, then into a buffer allocated once, at
+    // its size and a sixteenth more: grown from nothing in place, the buffer would be allocated
+    // several times over, and the blocks freed on the way stay with the process (resident).
+    std::vector<std::uint32_t>& own = out.chunks_[c];
+    const bool first = own.capacity() == 0;
+    std::vector<std::uint32_t>& buf = first ? old_copy_[static_cast<std::size_t>(thread_index())] : own;
     Stencil<D, R> st;
-    std::size_t used = 0, entries = 0;
+    std::size_t used = 0, entries = 0, most = 0;
     for (std::size_t i = b; i < e; ++i) {
       st.update(grid, query.cell(i));
+      most = std::max<std::size_t>(most, st.candidates);
       ensure_room(buf, used + st.candidates + kRoom);
       std::uint32_t m = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + used);
       if (filter_) m = filter_->keep(i, buf.data() + used, m);
@@ -224,6 +233,10 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
       }
     }
     std::fill_n(buf.data() + used, kRoom, 0u);  // readable padding, valid indices (not stale ones)
+    if (first) {
+      own.reserve(used + used / 16 + most + kRoom);
+      own.assign(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(used + kRoom));
+    }
     chunk_entries_[c] = entries;
   });
   out.entries_ = 0;

@@ -67,7 +67,10 @@ void NeighborLists::save(StateWriter& out) const {
 }
 
 void NeighborLists::load(StateReader& in, std::size_t index_limit) {
-  clear();
+  // (the chunks' buffers are kept, with their capacity: loading lists does not undo their growth)
+  begin_.clear();
+  cap_.clear();
+  entries_ = 0;
   in.get(end_);
   const std::size_t n = end_.size();
   const std::size_t limit = index_limit > 0 ? index_limit : n;

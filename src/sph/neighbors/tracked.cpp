@@ -112,13 +112,13 @@ template <int D, std::floating_point R>
 void TrackedNeighbors<D, R>::choose_skin(const ParticleSet<D, R>& particles) {
   if (fixed_skin_ > R(0)) return;
   const std::size_t n = particles.size();
-  chunk_speed_.assign(chunk_count(n), R(0));
-  parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
+  chunk_speed_.assign(chunk_count<kSumBlock>(n), R(0));
+  parallel_chunks<kSumBlock>(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     R sum = 0;
     for (std::size_t i = b; i < e; ++i) sum += std::sqrt(norm2(particles.velocity[i]));
     chunk_speed_[c] = sum;
   });
-  double sum = 0;  // in chunk order: the same for any thread count
+  double sum = 0;  // in block order: the same for any thread count
   for (R s : chunk_speed_) sum += static_cast<double>(s);
   const double mean = n > 0 ? sum / static_cast<double>(n) : 0.0;
   const R skin = static_cast<R>(tracked_skin(radius_, mean, dt_, D));

@@ -221,13 +221,14 @@ void Simulation<D, R>::advance_bodies(double dt) {
   const std::size_t nb = bodies_.size();
   if (nb == 0) return;
   // Per chunk and body: the fluid's momentum change from the body (D values) and its moment
-  // about the body's centre of mass (3), summed in chunk order (the same for any thread count).
+  // about the body's centre of mass (3), summed in blocks of kSumBlock particles and the blocks
+  // in order (the same for any thread count).
   constexpr std::size_t kPer = D + 3;
   const std::size_t n = particles_.size();
-  const std::size_t chunks = chunk_count(n);
+  const std::size_t chunks = chunk_count<kSumBlock>(n);
   body_partial_.assign(chunks * nb * kPer, 0.0);
   const bool dv = !body_velocity_change_.empty();
-  parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
+  parallel_chunks<kSumBlock>(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     double* out = &body_partial_[c * nb * kPer];
     for (std::size_t i = b; i < e; ++i)
       for (std::size_t s = 0; s < nb; ++s) {

@@ -660,8 +660,10 @@ std::uint64_t cluster_density_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, 
             const P rij = xi[d] - P::permuted(&data.x[d][jb], lanes.tile[q]);
             r2 = r2 + rij * rij;
           }
+          // (every register is summed, those with no pair within h too: their term is a few
+          // operations, and a branch on them, taken at random, cost the 3D block twice the pass's
+          // time; the force pass's terms are many, and it skips them)
           const Mask in = (jc == c ? real & ~lanes.self[q] : real) & (r2 < h2v);
-          if (in == 0) continue;  // (a register with no pair within h: most of a list's last ones)
           sum = sum + density_term<K, D>(r2, in, P::permuted(&data.mass[jb], lanes.tile[q]), h2v, normv, kernel);
           count += static_cast<std::uint64_t>(__builtin_popcount(in));
         }

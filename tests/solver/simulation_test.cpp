@@ -40,10 +40,9 @@ namespace {
 
 using test::ThreadCount;
 
-/// A 3D column of water collapsing in a box (dam break), n^3 particles, in a box `length` columns
-/// long, all moving along x at `speed` at the start.
+/// A 3D column of water collapsing in a box (dam break), n^3 particles.
 template <class R>
-Simulation<3, R> dam_break(int n, NeighborMode mode, int reorder_period, double length = 2.5, double speed = 0) {
+Simulation<3, R> dam_break(int n, NeighborMode mode, int reorder_period) {
   SimulationParams<3> p;
   p.particle_radius = 0.01;
   p.kernel_radius = 0.04;
@@ -56,7 +55,7 @@ Simulation<3, R> dam_break(int n, NeighborMode mode, int reorder_period, double 
   p.walls.damping = 300;
   p.gravity[1] = -9.81;
   p.container.lo = Vec<3, double>::filled(0);
-  p.container.hi = {{0.02 * n * length, 0.02 * n * 1.5, 0.02 * n}};
+  p.container.hi = {{0.02 * n * 2.5, 0.02 * n * 1.5, 0.02 * n}};
   p.neighbors = mode;
   p.full_rebuild_period = 200;
   p.reorder_period = reorder_period;
@@ -65,8 +64,7 @@ Simulation<3, R> dam_break(int n, NeighborMode mode, int reorder_period, double 
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j)
       for (int k = 0; k < n; ++k)
-        ps.add(Vec<3, R>{R(0.01 + 0.02 * i), R(0.01 + 0.02 * j), R(0.01 + 0.02 * k)}, Vec<3, R>{R(speed), 0, 0},
-               R(p.particle_mass));
+        ps.add(Vec<3, R>{R(0.01 + 0.02 * i), R(0.01 + 0.02 * j), R(0.01 + 0.02 * k)}, {}, R(p.particle_mass));
   return Simulation<3, R>(p, std::move(ps));
 }
 

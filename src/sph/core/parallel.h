@@ -28,8 +28,8 @@ void parallel_for(std::size_t n, F&& f) {
 
 /// Fixed chunk size used by parallel_chunks: chunk boundaries depend only on n. Small enough that
 /// the paper's scenes (3,200 to 8,000 particles) give each of two threads several chunks of
-/// every loop: with 1,024 the 2D dam break's second thread gave 1.22x, with 256 1.65x
-/// (docs/performance.md, "Threads").
+/// every loop: with 1,024 the 2D dam break's second thread gave 1.41-1.43x, with 256 1.66-1.69x
+/// (docs/performance.md, "Chunks of 256 particles").
 inline constexpr std::size_t kChunkSize = 256;
 
 /// The blocks that sums feeding results are taken in (chunked_sum: DFSPH's residuals, the kinetic

@@ -96,7 +96,7 @@ class ListBuilder {
   std::vector<std::int64_t> chunk_delta_;
   std::vector<std::size_t> chunk_written_;
   std::size_t written_ = 0;
-  std::vector<std::vector<std::uint32_t>> old_copy_;       // rebuild_some: one per thread
+  std::vector<std::vector<std::uint32_t>> old_copy_;       // one per thread: rebuild_some's old lists, a first build
   std::vector<std::vector<std::uint32_t>> relayout_copy_;  // rebuild_some in place: one per thread
 };
 

@@ -638,8 +638,8 @@ std::uint64_t cluster_density_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, 
   [[maybe_unused]] const PackKernel<K, D, R> kernel(h);
   const std::size_t clusters = cp.cluster_count();
   // Blocks of clusters, each counting its pairs (a count is the same in any order; the blocks are
-  // small so that every thread has clusters: kChunkSize clusters would leave a 4,000-particle
-  // scene on one thread).
+  // small so that every thread has clusters: kChunkSize clusters, 1,024 particles, would give a
+  // 4,000-particle scene four blocks).
   constexpr std::size_t kBlock = 64;
   const std::size_t blocks = (clusters + kBlock - 1) / kBlock;
   assign_with_room(within, blocks, std::uint64_t{0});  // (the clusters' count varies)

@@ -117,11 +117,19 @@ class PackKernel {
   P inv_h_, norm_{}, grad_norm_{};
 };
 
-/// The paper's kernels need no object: the loops write poly6, spiky and the viscosity kernel out.
+/// The paper's kernels: the loops write poly6, spiky and the viscosity kernel out; the object keeps
+/// the pressure gradients' constants for gradient_factor (made once: the constructors call
+/// std::pow).
 template <int D, std::floating_point R>
 class PackKernel<KernelKind::Paper, D, R> {
  public:
-  explicit PackKernel(R) {}
+  using P = simd::Pack<R>;
+  explicit PackKernel(R h)
+      : hv(P::set1(h)),
+        h2v(P::set1(h * h)),
+        spiky_grad(P::set1(R(-3) * SpikyKernel<D, R>(h).norm())),
+        poly6_grad(P::set1(R(-6) * Poly6Kernel<D, R>(h).norm())) {}
+  P hv, h2v, spiky_grad, poly6_grad;
 };
 
 /// m_j W(|x_ij|) on the lanes in `in` (pairs closer than h), zero on the others.
@@ -253,17 +261,17 @@ struct ForceConstants {
 /// own otherwise; zero outside `near` (and, for spiky, at r = 0).
 template <KernelKind K, bool kVariational, int D, std::floating_point R>
 simd::Pack<R> gradient_factor(const PackKernel<K, D, R>* kernel, const simd::Pack<R>& r2, const simd::Pack<R>& r,
-                              Mask near, R h) {
+                              Mask near) {
   using P = simd::Pack<R>;
   const P zero = P::set1(R(0)), one = P::set1(R(1));
   if constexpr (K == KernelKind::Paper) {
     if constexpr (kVariational) {
-      const P d2 = P::set1(h * h) - r2;
-      return select(near, P::set1(R(-6) * Poly6Kernel<D, R>(h).norm()) * d2 * d2, zero);
+      const P d2 = kernel->h2v - r2;
+      return select(near, kernel->poly6_grad * d2 * d2, zero);
     } else {
       const Mask apart = near & (r2 > zero);
-      const P dh = P::set1(h) - r;
-      return select(apart, P::set1(R(-3) * SpikyKernel<D, R>(h).norm()) * dh * dh / select(apart, r, one), zero);
+      const P dh = kernel->hv - r;
+      return select(apart, kernel->spiky_grad * dh * dh / select(apart, r, one), zero);
     }
   } else {
     return select(near, kernel->gradient_factor(r), zero);
@@ -366,7 +374,7 @@ class ForceTerms {
       else
         pij = i.pi_sym + j.p * inv_rhoj * inv_rhoj;
       if constexpr (K != KernelKind::Paper) {
-        fp = gradient_factor<K, false, D>(&kernel_, j.r2, r, near, h_) * (minus_one * j.mass * pij);
+        fp = gradient_factor<K, false, D>(&kernel_, j.r2, r, near) * (minus_one * j.mass * pij);
       } else if constexpr (kVariational) {
         const P d2 = h2v_ - j.r2;
         fp = select(near, grad6_c_ * d2 * d2 * (minus_one * j.mass * pij), zero);
@@ -380,14 +388,14 @@ class ForceTerms {
       P vr = zero;
       for (int d = 0; d < D; ++d) vr = vr + (i.v[d] - j.v[d]) * j.rij[d];
       const Mask approaching = near & (vr < zero);
-      const P f = gradient_factor < K, kVariational && K == KernelKind::Paper, D > (&kernel_, j.r2, r, near, h_);
+      const P f = gradient_factor < K, kVariational && K == KernelKind::Paper, D > (&kernel_, j.r2, r, near);
       const P pi_ij = art_i_ * (vr / (j.r2 + eps_h2_)) / (i.rho + j.rho);
       fp = fp + select(approaching, minus_one * j.mass * pi_ij * f, zero);
     } else if constexpr (K == KernelKind::Paper) {
       fv = select(near, i.visc * j.mass * inv_rhoj * dh, zero);
     } else {
       // Morris et al. 1997: 2 mu m_j / (rho_i rho_j) (x_ij . grad W) / (r^2 + 0.01 h^2) (v_i - v_j).
-      const P f = gradient_factor<K, false, D>(&kernel_, j.r2, r, near, h_);
+      const P f = gradient_factor<K, false, D>(&kernel_, j.r2, r, near);
       fv = select(near, i.morris * j.mass * inv_rhoj * (f * j.r2) / (j.r2 + eps_h2_), zero);
     }
     for (int d = 0; d < D; ++d) {
@@ -447,7 +455,7 @@ class ForceTerms {
       const P r2 = pair_offsets<D>(s.x, bpos_, bidx + k0, rib);
       const Mask near = valid & (r2 < h2v_);
       const P r = sqrt(select(near, r2, h2v_));
-      const P f = gradient_factor < K, kVariational && K == KernelKind::Paper, D > (&kernel_, r2, r, near, h_);
+      const P f = gradient_factor < K, kVariational && K == KernelKind::Paper, D > (&kernel_, r2, r, near);
       const P psib = P::template gather<1>(boundary_.psi.data(), bidx + k0, 0);
       // The velocity relative to the sample's (moving obstacles), else the particle's own.
       P vib[D];

@@ -1,3 +1,5 @@
+#include <algorithm>
+
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 
@@ -29,5 +31,73 @@ int thread_index() {
   return 0;
 #endif
 }
+
+namespace {
+thread_local detail::LoopSplit split_of_this_thread;
+}
+
+void balance_loops(std::size_t n, std::span<const std::uint64_t> chunk_work) {
+  SPH_CHECK(chunk_work.size() == chunk_count(n), "balance_loops needs one work figure per chunk");
+  detail::LoopSplit& s = split_of_this_thread;
+  const int threads = num_threads();
+  s.n = n;
+  s.threads = threads;
+  s.first.assign(static_cast<std::size_t>(threads) + 1, n);
+  double total = 0;
+  for (const std::uint64_t w : chunk_work) total += static_cast<double>(w);
+  // Thread t starts where the work before it reaches t / threads of the whole, a chunk's work
+  // taken as spread evenly over its items.
+  double before = 0;
+  std::size_t c = 0;
+  for (int t = 0; t < threads; ++t) {
+    const double share = total * t / threads;
+    while (c < chunk_work.size() && before + static_cast<double>(chunk_work[c]) <= share)
+      before += static_cast<double>(chunk_work[c++]);
+    std::size_t item = n;
+    if (c < chunk_work.size()) {
+      const std::size_t begin = c * kChunkSize, size = std::min(n, begin + kChunkSize) - begin;
+      const double into = (share - before) / static_cast<double>(chunk_work[c]);
+      item = begin + std::min(size, static_cast<std::size_t>(into * static_cast<double>(size)));
+    }
+    s.first[static_cast<std::size_t>(t)] = t == 0 ? 0 : std::max(item, s.first[static_cast<std::size_t>(t) - 1]);
+  }
+}
+
+void clear_balance() {
+  split_of_this_thread.n = 0;
+  split_of_this_thread.threads = 0;
+}
+
+namespace detail {
+
+const LoopSplit& loop_split() { return split_of_this_thread; }
+
+int team_size() {
+#ifdef _OPENMP
+  return omp_get_num_threads();
+#else
+  return 1;
+#endif
+}
+
+std::pair<std::size_t, std::size_t> item_run(const LoopSplit& split, std::size_t n) {
+  const auto team = static_cast<std::size_t>(team_size());
+  const auto t = static_cast<std::size_t>(thread_index());
+  if (split.n == n && static_cast<std::size_t>(split.threads) == team) return {split.first[t], split.first[t + 1]};
+  return {n * t / team, n * (t + 1) / team};
+}
+
+std::pair<std::size_t, std::size_t> chunk_run(const LoopSplit& split, std::size_t n, std::size_t chunks) {
+  const auto team = static_cast<std::size_t>(team_size());
+  const auto t = static_cast<std::size_t>(thread_index());
+  if (split.n == n && static_cast<std::size_t>(split.threads) == team) {
+    // The chunk boundary nearest to each thread's first item.
+    const auto nearest = [&](std::size_t item) { return std::min(chunks, (item + kChunkSize / 2) / kChunkSize); };
+    return {t == 0 ? 0 : nearest(split.first[t]), t + 1 == team ? chunks : nearest(split.first[t + 1])};
+  }
+  return {chunks * t / team, chunks * (t + 1) / team};
+}
+
+}  // namespace detail
 
 }  // namespace sph

@@ -4,6 +4,8 @@
 /// count, so that results are bitwise identical for any number of threads.
 
 #include <cstddef>
+#include <cstdint>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -18,19 +20,55 @@ int num_threads();
 /// Only for per-thread scratch: results must never depend on which thread ran what.
 int thread_index();
 
-/// Calls f(i) for i in [0, n), in parallel. f must only write data owned by index i.
-template <class F>
-void parallel_for(std::size_t n, F&& f) {
-  const auto count = static_cast<long long>(n);
-#pragma omp parallel for schedule(static)
-  for (long long i = 0; i < count; ++i) f(static_cast<std::size_t>(i));
-}
-
 /// Fixed chunk size used by parallel_chunks: chunk boundaries depend only on n. Small enough that
 /// the paper's scenes (3,200 to 8,000 particles) give each of two threads several chunks of
 /// every loop: with 1,024 the 2D dam break's second thread gave 1.41-1.43x, with 256 1.66-1.69x
 /// (docs/performance.md, "Chunks of 256 particles").
 inline constexpr std::size_t kChunkSize = 256;
+
+/// Balances the loops over n items between the threads by the work of each chunk of kChunkSize
+/// items (chunk_work[c], any unit, taken as spread evenly over the chunk's items): until the next
+/// call, parallel_for(n) gives each thread one contiguous run of items holding about an equal
+/// share of the work, instead of an equal share of the items, and parallel_chunks(n) the run of
+/// chunks nearest to it. Loops over another count split evenly. Only which
+/// thread runs an item changes, never what it computes: every loop writes only what its index or
+/// chunk owns, so results stay the same bit for bit. The split belongs to the calling thread
+/// (each host thread that runs loops keeps its own).
+void balance_loops(std::size_t n, std::span<const std::uint64_t> chunk_work);
+/// Forgets the split: every loop splits its items evenly again.
+void clear_balance();
+
+namespace detail {
+/// The split of balance_loops: thread t of a team of `threads` takes items [first[t], first[t+1]).
+struct LoopSplit {
+  std::size_t n = 0;
+  int threads = 0;
+  std::vector<std::size_t> first;
+};
+const LoopSplit& loop_split();
+int team_size();
+/// The calling thread's run [begin, end) of the items [0, n), and of the chunks [0, chunks) of a
+/// loop over n items: the balanced split when it applies to n and to this team, else an even one.
+std::pair<std::size_t, std::size_t> item_run(const LoopSplit& split, std::size_t n);
+std::pair<std::size_t, std::size_t> chunk_run(const LoopSplit& split, std::size_t n, std::size_t chunks);
+}  // namespace detail
+
+/// Calls f(i) for i in [0, n), in parallel. f must only write data owned by index i.
+template <class F>
+void parallel_for(std::size_t n, F&& f) {
+  const detail::LoopSplit& split = detail::loop_split();
+  if (split.n != n || split.threads < 2) {
+    const auto count = static_cast<long long>(n);
+#pragma omp parallel for schedule(static)
+    for (long long i = 0; i < count; ++i) f(static_cast<std::size_t>(i));
+    return;
+  }
+#pragma omp parallel
+  {
+    const auto [first, last] = detail::item_run(split, n);
+    for (std::size_t i = first; i < last; ++i) f(i);
+  }
+}
 
 /// The blocks that sums feeding results are taken in (chunked_sum: DFSPH's residuals, the kinetic
 /// energy, momentum; the floating bodies' loads, the tracked modes' mean speed), fixed apart from
@@ -52,12 +90,24 @@ std::size_t chunk_count(std::size_t n) {
 /// docs/performance.md, "Static chunk schedule").
 template <std::size_t Size = kChunkSize, class F>
 void parallel_chunks(std::size_t n, F&& f) {
-  const auto chunks = static_cast<long long>(chunk_count<Size>(n));
+  const detail::LoopSplit& split = detail::loop_split();
+  if (Size != kChunkSize || split.n != n || split.threads < 2) {
+    const auto chunks = static_cast<long long>(chunk_count<Size>(n));
 #pragma omp parallel for schedule(static)
-  for (long long c = 0; c < chunks; ++c) {
-    const std::size_t begin = static_cast<std::size_t>(c) * Size;
-    const std::size_t end = begin + Size < n ? begin + Size : n;
-    f(static_cast<std::size_t>(c), begin, end);
+    for (long long c = 0; c < chunks; ++c) {
+      const std::size_t begin = static_cast<std::size_t>(c) * Size;
+      const std::size_t end = begin + Size < n ? begin + Size : n;
+      f(static_cast<std::size_t>(c), begin, end);
+    }
+    return;
+  }
+#pragma omp parallel
+  {
+    const auto [first, last] = detail::chunk_run(split, n, chunk_count<Size>(n));
+    for (std::size_t c = first; c < last; ++c) {
+      const std::size_t begin = c * Size;
+      f(c, begin, begin + Size < n ? begin + Size : n);
+    }
   }
 }
 

@@ -7,6 +7,11 @@
 
 namespace sph {
 
+void NeighborLists::add_chunk_entries(std::span<std::uint64_t> work) const {
+  SPH_CHECK(work.size() == chunk_count(particle_count()), "one work figure per chunk of the lists' particles");
+  for (std::size_t i = 0; i < particle_count(); ++i) work[i / kChunkSize] += end_[i] - begin_[i];
+}
+
 std::size_t NeighborLists::memory_bytes() const {
   std::size_t bytes = chunks_.capacity() * sizeof(chunks_[0]) +
                       (begin_.capacity() + end_.capacity() + cap_.capacity()) * sizeof(std::uint32_t);

@@ -56,6 +56,9 @@ class NeighborLists {
   }
   /// Bytes of memory held (capacity, not just what is in use).
   std::size_t memory_bytes() const;
+  /// Adds each chunk's entries to work[c] (one figure per chunk of kChunkSize particles, the
+  /// chunks of parallel_chunks; for balance_loops).
+  void add_chunk_entries(std::span<std::uint64_t> work) const;
 
   /// Checks the padding promise: every chunk's buffer holds kPadding entries after its last
   /// list, all of them indices below particle_count() (tests).

@@ -436,6 +436,25 @@ typename Simulation<D, R>::StepTime Simulation<D, R>::choose_time_step() const {
 }
 
 template <int D, std::floating_point R>
+void Simulation<D, R>::balance_threads(const NeighborLists* lists) {
+  if (lists == nullptr || num_threads() < 2) {
+    clear_balance();
+    return;
+  }
+  // A particle's work in a step: its pairs (fluid and boundary, each visited by the density and
+  // the force pass) and what it costs without any (kParticleWork pairs' worth: the integration,
+  // the walls, the loops' own overhead).
+  constexpr std::uint64_t kParticleWork = 8;
+  const std::size_t n = particles_.size();
+  chunk_work_.assign(chunk_count(n), 0);
+  for (std::size_t c = 0; c < chunk_work_.size(); ++c)
+    chunk_work_[c] = kParticleWork * (std::min(n, (c + 1) * kChunkSize) - c * kChunkSize);
+  lists->add_chunk_entries(chunk_work_);
+  if (neighbors_->boundary_lists().particle_count() == n) neighbors_->boundary_lists().add_chunk_entries(chunk_work_);
+  balance_loops(n, chunk_work_);
+}
+
+template <int D, std::floating_point R>
 const StepInfo& Simulation<D, R>::step() {
   StepInfo info;
   info.step = steps_;
@@ -476,6 +495,7 @@ const StepInfo& Simulation<D, R>::step() {
   Stopwatch asked;
   const NeighborLists& lists = per_particle ? neighbors_->lists() : no_lists_;
   info.seconds.lists += asked.lap();
+  balance_threads(per_particle ? &lists : nullptr);
   BoundaryView<D, R> solid = boundary_view(neighbors_->boundary_lists());
   if (!bodies_.empty()) {  // (what each floating body gives each particle in this step)
     const std::size_t entries = particles_.size() * bodies_.size();

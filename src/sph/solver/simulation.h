@@ -173,6 +173,9 @@ class Simulation {
   void reserve_for_emitters();
   /// Places the moving obstacles (their poses, and their boundary samples) at the current time.
   void place_obstacles();
+  // Splits the step's loops between the threads by the pairs each chunk of particles holds
+  // (balance_loops), or evenly when the passes run on cluster pairs (lists == nullptr).
+  void balance_threads(const NeighborLists* lists);
   /// Obstacle k's pose now (obstacle_poses()).
   RigidPose<D> pose_now(std::size_t k) const;
   /// Sets up the floating bodies (constructor).
@@ -230,6 +233,7 @@ class Simulation {
   double cfl_limit_ = kNoLimit;                         // TimeStepping::Cfl: the scene's limits but the acoustic one, s
   std::unique_ptr<DfsphSolver<D, R>> dfsph_;            // SimulationMethod::Dfsph
   std::vector<R> gradient_correction_;                  // DFSPH with GradientCorrection::Renormalize: L
+  std::vector<std::uint64_t> chunk_work_;               // each chunk's pairs, for balance_threads
   NeighborLists no_lists_;                              // the lists the passes get when they run on cluster pairs
   std::unique_ptr<ImplicitViscosity<D, R>> viscosity_;  // ViscositySolve::Implicit
   SolveStats last_density_solve_;                       // its last constant-density solve (the CFL step's feedback)

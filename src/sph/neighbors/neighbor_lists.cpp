@@ -3,13 +3,18 @@
 #include <algorithm>
 
 #include <sph/core/error.h>
+#include <sph/core/parallel.h>
 #include <sph/core/state_stream.h>
 
 namespace sph {
 
 void NeighborLists::add_chunk_entries(std::span<std::uint64_t> work) const {
   SPH_CHECK(work.size() == chunk_count(particle_count()), "one work figure per chunk of the lists' particles");
-  for (std::size_t i = 0; i < particle_count(); ++i) work[i / kChunkSize] += end_[i] - begin_[i];
+  parallel_chunks(particle_count(), [&](std::size_t c, std::size_t b, std::size_t e) {
+    std::uint64_t entries = 0;
+    for (std::size_t i = b; i < e; ++i) entries += end_[i] - begin_[i];
+    work[c] += entries;
+  });
 }
 
 std::size_t NeighborLists::memory_bytes() const {

@@ -1,6 +1,7 @@
 // Runs of CFL steps (Configuration.cflMethod "cfl"): each step takes the limits of the state it
-// starts from, steps end exactly on frame times, emission times and the end time, a stopped run
-// resumes bit for bit, and the thread count changes nothing.
+// starts from, steps end exactly on frame times and the end time, emitter batches falling inside
+// a step come with the next one where their layers have flown, a stopped run resumes bit for
+// bit, and the thread count changes nothing.
 
 #include <algorithm>
 #include <cmath>
@@ -14,6 +15,7 @@
 #include <sph/run/driver.h>
 #include <sph/run/resume.h>
 #include <sph/scene/scene_reader.h>
+#include <sph/solver/nozzle.h>
 
 #include "support/resume.h"
 #include "support/temp_dir.h"
@@ -80,24 +82,86 @@ TEST(CflSteps, FramesComeExactlyOnTheirTimes) {
   EXPECT_EQ(run.output()->frames_written(), 11u);
 }
 
-TEST(CflSteps, EmitterBatchesComeOnTheirTimes) {
+TEST(CflSteps, ARunEndsAtItsEndTimeWhateverStepsTheFramesShortened) {
+  // Steps held at 1.4e-4 s and a frame every 4 ms: each frame's last steps are shortened to end
+  // on it (29 steps a frame where 28.6 would do), more steps in all than stopAt / the smallest
+  // step. Such a run once stopped at that count, short of its end time, and called itself done.
+  TempDir tmp;
+  SceneDesc desc = read_scene_file(
+      SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json",
+      {"Configuration.cflMethod=\"cfl\"", "Configuration.stopAt=0.04", "Configuration.cflMinTimeStepSize=1.4e-4",
+       "Configuration.cflMaxTimeStepSize=1.4e-4", "Configuration.outputEveryNSteps=0", "Configuration.outputFps=250"});
+  RunDriver<2, double> run(desc, RunSettings{tmp / "run"});
+  const RunResult r = run.run({}, {});
+  ASSERT_EQ(r.status, RunStatus::Completed) << r.message;
+  EXPECT_EQ(run.simulation().time(), 0.04);
+  EXPECT_GT(r.steps_done, static_cast<std::int64_t>(std::ceil(0.04 / 1.4e-4)));
+  EXPECT_LE(r.steps_done, desc.steps) << "the estimate the progress bar shows is an upper bound";
+  EXPECT_EQ(run.output()->frames_written(), 11u);
+}
+
+TEST(CflSteps, EmitterBatchesAreEmittedAtTheStepThatReachesThemWhereTheirLayersHaveFlown) {
   // The paper's tank: a 6 x 6 batch every emitEveryNSteps * timeStepSize = 16 * 3e-4 s.
   const double stop = 0.05, period = 16 * 3e-4;
   const SceneDesc desc = read_scene_file(
       SPH_SOURCE_DIR "/scenes/paper/tank_fill_3d.json",
       {"Configuration.cflMethod=\"cfl\"", "Configuration.stopAt=0.05", "Configuration.outputEveryNSteps=0"});
   RunDriver<3, double> run(desc, RunSettings{});
-  std::vector<double> emitted_at;
+  std::vector<double> starts;
+  std::size_t emitted = 0, shortened = 0;
+  double last_dt = 0;
   while (run.simulation().time() < stop * (1 - 1e-12)) {
     const double t = run.simulation().time();
-    if (run.step().emitted > 0) emitted_at.push_back(t);
+    const StepInfo& info = run.step();
+    // Batch k (time k p) comes with the first step starting at or after it.
+    const auto due = static_cast<std::size_t>(std::floor(t / period + 1e-9)) + 1;
+    emitted += info.emitted;
+    EXPECT_EQ(emitted, 36 * due) << "the step starting at " << t;
+    // Steps do not shorten for batches: only the end time (and the rule's own limits) cut one.
+    if (last_dt > 0 && info.dt < 0.5 * last_dt && run.simulation().time() < stop * (1 - 1e-12)) ++shortened;
+    last_dt = info.dt;
+    starts.push_back(t);
   }
-  // Batches at 0, p, 2p, ... before the end (a batch is emitted as the step starting on it begins).
-  const auto batches = static_cast<std::size_t>(std::ceil(stop / period - 1e-9));
-  ASSERT_EQ(emitted_at.size(), batches);
-  for (std::size_t k = 0; k < batches; ++k)
-    EXPECT_NEAR(emitted_at[k], static_cast<double>(k) * period, 1e-12) << "batch " << k;
-  EXPECT_EQ(run.simulation().particles().size(), 36 * batches);
+  EXPECT_EQ(shortened, 0u);
+  // Before this rule a step ended on every batch time: now most batch times fall inside steps.
+  std::size_t inside = 0;
+  for (double k = 1; k * period < stop; ++k)
+    inside += std::find_if(starts.begin(), starts.end(), [&](double t) { return std::abs(t - k * period) < 1e-12; }) ==
+              starts.end();
+  EXPECT_GT(inside, 5u);
+}
+
+TEST(CflSteps, AStepLongerThanTheEmitterPeriodEmitsEveryBatchWhereItsLayerHasFlown) {
+  // No gravity and layers farther apart than a spacing (density below rest, pressure clamped at
+  // zero, equal velocities): nothing acts on the emitted particles, which fly at the nozzle's
+  // speed. Steps of 2.5 emitter periods: each emits two or three batches.
+  const double period = 16 * 3e-4, dt = 2.5 * period;
+  const SceneDesc desc = read_scene_file(SPH_SOURCE_DIR "/scenes/paper/tank_fill_3d.json",
+                                         {"Configuration.cflMethod=\"cfl\"", "Configuration.gravitation=[0,0,0]",
+                                          "Configuration.cflMinTimeStepSize=" + std::to_string(dt),
+                                          "Configuration.cflMaxTimeStepSize=" + std::to_string(dt),
+                                          "Configuration.stopAt=0.048", "Configuration.outputEveryNSteps=0"});
+  RunDriver<3, double> run(desc, RunSettings{});
+  const EmitterParams<3>& e = run.simulation().params().emitters.at(0);
+  const auto [u, w] = nozzle_axes<3>(e.direction);
+  for (int step = 1; step <= 4; ++step) {
+    run.step();
+    const double t = run.simulation().time();
+    EXPECT_NEAR(t, step * dt, 1e-15) << "no step shortened";
+    const ParticleSet<3, double>& ps = run.simulation().particles();
+    // Batches 0 .. floor((t - dt) / p): those due by the step's start.
+    const auto batches = static_cast<std::size_t>(std::floor((t - dt) / period + 1e-9)) + 1;
+    ASSERT_EQ(ps.size(), 36 * batches) << "step " << step;
+    double worst = 0;
+    for (std::size_t i = 0; i < ps.size(); ++i) {
+      const std::uint64_t m = ps.id[i];  // (the m-th particle emitted: 36 a layer, a across, b up)
+      const auto k = static_cast<double>(m / 36);
+      const Vec<3, double> nozzle = nozzle_position<3>(e, u, w, static_cast<int>(m % 6), static_cast<int>(m / 6 % 6));
+      worst = std::max(worst, norm(ps.position[i] - (nozzle + e.direction * (e.speed * (t - k * period)))));
+      EXPECT_EQ(ps.velocity[i], e.direction * e.speed) << "particle " << m;
+    }
+    EXPECT_LT(worst, 1e-12) << "step " << step;
+  }
 }
 
 TEST(CflSteps, AStoppedRunResumesBitForBit) {

@@ -143,7 +143,8 @@ TEST(SceneWriter, ASceneThatSetsEveryKeyReadsBackEqual) {
 
 TEST(SceneWriter, ARunOfCflStepsToATimeWritesItsStopAt) {
   // CFL steps and stopAt: the run ends at that time (numberOfSteps is then only the most steps
-  // the smallest step could take), so the writer gives stopAt, and frames by time by default.
+  // the smallest step and the steps shortened to end on a barrier could take), so the writer
+  // gives stopAt, and frames by time by default.
   json j = every_key_2d();
   j["Configuration"].erase("numberOfSteps");
   j["Configuration"].erase("outputEveryNSteps");
@@ -154,7 +155,7 @@ TEST(SceneWriter, ARunOfCflStepsToATimeWritesItsStopAt) {
   expect_round_trip(j.dump(), "cfl_stop_at.json");
   const sph::SceneDesc d = sph::parse_scene(j.dump(), "cfl_stop_at.json");
   EXPECT_EQ(d.end_time, 0.25);
-  EXPECT_EQ(d.steps, 25000) << "stopAt / cflMinTimeStepSize";
+  EXPECT_EQ(d.steps, 25000 + 2 * (100 + 1)) << "stopAt / cflMinTimeStepSize, and two for each frame's time and the end";
   EXPECT_EQ(d.output.fps, 400.0) << "100 frames by default";
   EXPECT_EQ(d.output.every_steps, 0);
   const json w = json::parse(sph::scene_text(d));

@@ -57,7 +57,8 @@ RunToResume open_run_to_resume(const std::filesystem::path& dir, std::int64_t st
   SceneDesc& desc = run.desc;
   desc.set_audit(h.audit);
   check_finished_run(dir, h.step, steps, run.warnings);
-  if (desc.steps <= h.step)
+  // (a run to an end time is finished by its time, which check_finished_run saw)
+  if (desc.steps <= h.step && (steps > 0 || desc.end_time <= 0))
     throw Error(steps > 0
                     ? fmt::format("--steps {} is not beyond the checkpoint, which is at step {}; give a larger total",
                                   steps, h.step)

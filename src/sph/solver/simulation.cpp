@@ -333,30 +333,43 @@ std::size_t Simulation<D, R>::emit() {
   for (std::size_t k = 0; k < params_.emitters.size(); ++k) {
     const EmitterParams<D>& e = params_.emitters[k];
     EmitterState& s = emitters_[k];
-    if (s.emitted >= e.max_particles || t > e.end_time) continue;
+    // One layer, emitted `late` seconds after its batch's time: where it has flown since then
+    // (x + v late + g late^2 / 2, at v + g late), so that layers keep their spacing whatever
+    // the steps.
+    const std::pair<Vec<D, double>, Vec<D, double>> axes = nozzle_axes<D>(e.direction);
+    const auto add_layer = [&](double late) {
+      const int rows = D == 3 ? e.height : 1;
+      const Vec<D, double> v0 = e.direction * e.speed;
+      const Vec<D, double> flown = late > 0 ? v0 * late + params_.gravity * (0.5 * late * late) : Vec<D, double>{};
+      const Vec<D, R> vel = vec_cast<R>(late > 0 ? v0 + params_.gravity * late : v0);
+      for (int b = 0; b < rows && s.emitted < e.max_particles; ++b)
+        for (int a = 0; a < e.width && s.emitted < e.max_particles; ++a) {
+          const Vec<D, double> x = nozzle_position<D>(e, axes.first, axes.second, a, b);
+          particles_.add(vec_cast<R>(late > 0 ? x + flown : x), vel, static_cast<R>(params_.particle_mass));
+          ++s.emitted;
+          ++added;
+        }
+    };
     if (cfl()) {
-      // Batches every emitEveryNSteps * timeStepSize seconds from the start time; steps end on them.
+      // Batches every emitEveryNSteps * timeStepSize seconds from the start time, up to the end
+      // time: each batch due by this step's start, placed where its layer has flown since its
+      // time (a step longer than the period emits several). Steps never shorten for a batch.
       const double period = e.every_steps * params_.time_step;
       if (s.next_time < 0) s.next_time = e.start_time;
-      if (t + 1e-9 * period < s.next_time) continue;
-      s.next_time += period;
-    } else if (s.next_step < 0) {
+      while (s.emitted < e.max_particles && s.next_time <= e.end_time && t + 1e-9 * period >= s.next_time) {
+        add_layer(t - s.next_time);
+        s.next_time += period;
+      }
+      continue;
+    }
+    if (s.emitted >= e.max_particles || t > e.end_time) continue;
+    if (s.next_step < 0) {
       if (t + 0.5 * params_.time_step < e.start_time) continue;
       s.next_step = steps_;
     }
-    if (!cfl()) {
-      if (steps_ != s.next_step) continue;
-      s.next_step += e.every_steps;
-    }
-    const auto [u, w] = nozzle_axes<D>(e.direction);
-    const int rows = D == 3 ? e.height : 1;
-    const Vec<D, R> vel = vec_cast<R>(e.direction * e.speed);
-    for (int b = 0; b < rows && s.emitted < e.max_particles; ++b)
-      for (int a = 0; a < e.width && s.emitted < e.max_particles; ++a) {
-        particles_.add(vec_cast<R>(nozzle_position<D>(e, u, w, a, b)), vel, static_cast<R>(params_.particle_mass));
-        ++s.emitted;
-        ++added;
-      }
+    if (steps_ != s.next_step) continue;
+    s.next_step += e.every_steps;
+    add_layer(0);
   }
   return added;
 }
@@ -409,14 +422,9 @@ typename Simulation<D, R>::StepTime Simulation<D, R>::choose_time_step() const {
   StepTime st;
   st.dt = st.cfl_dt = next_time_step();
   if (!cfl()) return st;
-  // The nearest barrier ahead: the caller's (frames, the end), the emitters' next batches.
+  // The nearest barrier ahead: the caller's (frames, the end). (Emitter batches are not: the
+  // next step's emit() places a batch that fell inside this one where its layer has flown.)
   double end = barrier_;
-  for (std::size_t k = 0; k < emitters_.size(); ++k) {
-    const EmitterParams<D>& e = params_.emitters[k];
-    if (emitters_[k].emitted >= e.max_particles) continue;
-    const double next = emitters_[k].next_time < 0 ? e.start_time : emitters_[k].next_time;
-    if (next > time_) end = std::min(end, next);
-  }
   // Keyframes: a step ends on the next key, where the obstacle's velocity jumps (the step's
   // length took the speed at its start).
   for (std::size_t k = 0; k < moving_.size(); ++k)

@@ -30,10 +30,10 @@ inline constexpr std::size_t kChunkSize = 256;
 /// items (chunk_work[c], any unit, taken as spread evenly over the chunk's items): until the next
 /// call, parallel_for(n) gives each thread one contiguous run of items holding about an equal
 /// share of the work, instead of an equal share of the items, and parallel_chunks(n) the run of
-/// chunks nearest to it. Loops over another count split evenly. Only which
-/// thread runs an item changes, never what it computes: every loop writes only what its index or
-/// chunk owns, so results stay the same bit for bit. The split belongs to the calling thread
-/// (each host thread that runs loops keeps its own).
+/// chunks nearest to it. Loops over another count split evenly. Only which thread runs an item
+/// changes, never what it computes: every loop writes only what its index or chunk owns, so
+/// results stay the same bit for bit. The split belongs to the calling thread (each host thread
+/// that runs loops keeps its own).
 void balance_loops(std::size_t n, std::span<const std::uint64_t> chunk_work);
 /// Forgets the split: every loop splits its items evenly again.
 void clear_balance();

@@ -478,8 +478,8 @@ void read_run_length(ObjectReader& c, SceneDesc& desc, double dt, bool cfl, doub
   } else {
     const double stop = c.positive("stopAt", what_stop);
     // The first step whose end reaches stopAt (an end time that is a whole number of steps,
-    // up to rounding, is that number). CFL steps: the run ends at stopAt, in at most as many
-    // steps as the smallest step needs.
+    // up to rounding, is that number). CFL steps: the run ends at stopAt; the count (an
+    // estimate, below) starts from the steps the smallest step needs.
     if (cfl) {
       desc.end_time = stop;
       dt = min_dt;

@@ -330,8 +330,6 @@ class ForceTerms {
         hv_(P::set1(h)),
         h2v_(P::set1(h * h)),
         exit2v_(P::set1(exit_radius * exit_radius)),  // Eq. 7's radius: h, or the lists' radius
-        grad_c_(P::set1(R(-3) * SpikyKernel<D, R>(h).norm())),
-        grad6_c_(P::set1(R(-6) * Poly6Kernel<D, R>(h).norm())),
         lap_c_(ViscosityKernel<D, R>(h).laplacian_norm()),
         eps_h2_(P::set1(R(0.01) * h * h)),                // Monaghan's and Morris's 0.01 h^2 in |x_ij|^2 + 0.01 h^2
         art_i_(P::set1(R(-2) * fc_.alpha * fc_.c0 * h)),  // Monaghan's Pi_ij = -alpha c0 h mu_ij / rho_ij
@@ -377,10 +375,10 @@ class ForceTerms {
         fp = gradient_factor<K, false, D>(&kernel_, j.r2, r, near) * (minus_one * j.mass * pij);
       } else if constexpr (kVariational) {
         const P d2 = h2v_ - j.r2;
-        fp = select(near, grad6_c_ * d2 * d2 * (minus_one * j.mass * pij), zero);
+        fp = select(near, kernel_.poly6_grad * d2 * d2 * (minus_one * j.mass * pij), zero);
       } else {
         const Mask apart = near & (j.r2 > zero);  // and not coincident (gradient defined)
-        fp = select(apart, (grad_c_ * dh * dh / select(apart, r, one)) * (minus_one * j.mass * pij), zero);
+        fp = select(apart, (kernel_.spiky_grad * dh * dh / select(apart, r, one)) * (minus_one * j.mass * pij), zero);
       }
     }
     if (fc_.artificial) {
@@ -513,7 +511,7 @@ class ForceTerms {
   const BoundaryView<D, R>& boundary_;
   ForceConstants<D, R> fc_;
   PackKernel<K, D, R> kernel_;
-  P hv_, h2v_, exit2v_, grad_c_, grad6_c_;
+  P hv_, h2v_, exit2v_;
   R lap_c_;
   P eps_h2_, art_i_, dtv_;
   bool solid_ = false;
@@ -650,9 +648,8 @@ std::uint64_t cluster_density_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, 
   const DensityStore<K, D, R> store(ps, h, fluid, boundary);
   const std::span<const std::uint32_t> slots = cp.slots();
   data.fill(ps, slots, false);
-  const P h2v = P::set1(h * h), zero = P::set1(R(0));
-  const P normv = P::set1(Poly6Kernel<D, R>(h).norm());
-  [[maybe_unused]] const PackKernel<K, D, R> kernel(h);
+  const DensityKernel<K, D, R> dk(h);
+  const P zero = P::set1(R(0));
   const std::size_t clusters = cp.cluster_count();
   // Blocks of clusters, each counting its pairs (a count is the same in any order; the blocks are
   // small so that every thread has clusters: kChunkSize clusters, 1,024 particles, would give a
@@ -680,8 +677,9 @@ std::uint64_t cluster_density_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, 
           // (every register is summed, those with no pair within h too: their term is a few
           // operations, and a branch on them, taken at random, cost the 3D block twice the pass's
           // time; the force pass's terms are many, and it skips them)
-          const Mask in = (jc == c ? real & ~lanes.self[q] : real) & (r2 < h2v);
-          sum = sum + density_term<K, D>(r2, in, P::permuted(&data.mass[jb], lanes.tile[q]), h2v, normv, kernel);
+          const Mask in = (jc == c ? real & ~lanes.self[q] : real) & (r2 < dk.h2v);
+          sum =
+              sum + density_term<K, D>(r2, in, P::permuted(&data.mass[jb], lanes.tile[q]), dk.h2v, dk.normv, dk.kernel);
           count += static_cast<std::uint64_t>(__builtin_popcount(in));
         }
       }

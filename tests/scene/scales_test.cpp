@@ -101,6 +101,32 @@ TEST(SceneScales, MovingBlockEmitterAndFillDepth3d) {
   EXPECT_LT(e.speed * (e.every_steps - 1) * sim.time_step, 0.02);
 }
 
+TEST(SceneScales, WithCflStepsAnEmitterWithoutAnIntervalMakesAContinuousJet) {
+  // DFSPH takes CFL steps, its batches come every emitEveryNSteps * timeStepSize seconds, and its
+  // "auto" timeStepSize is long: the usual 16 would put the layers many spacings apart. Absent,
+  // the interval is the fewest steps in which a layer moves one spacing (0.02 m here).
+  const json scene = json::parse(R"({ "version": 1, "dimension": 3,
+    "Configuration": { "particleRadius": 0.01, "stopAt": 1.0, "simulationMethod": "dfsph",
+                       "boundaryHandling": "particles" },
+    "Container": { "start": [0, 0, 0], "end": [0.5, 0.5, 0.5] },
+    "Emitters": [ { "translation": [0.05, 0.35, 0.25], "direction": [1, 0, 0], "velocity": 3, "width": 5,
+                    "height": 5, "maxParticles": 3000 } ] })");
+  for (const bool fixed_step : {false, true}) {
+    const sph::SceneDesc d = parse(
+        scene, fixed_step ? std::vector<std::string>{"Configuration.timeStepSize=0.001"} : std::vector<std::string>{});
+    const auto& sim = d.body<3>().sim;
+    const auto& e = sim.emitters.at(0);
+    EXPECT_LT(e.every_steps, 16) << "timeStepSize " << sim.time_step;
+    EXPECT_GE(e.speed * e.every_steps * sim.time_step, 0.02 * (1 - 1e-12));
+    EXPECT_LT(e.speed * (e.every_steps - 1) * sim.time_step, 0.02);
+  }
+  // Fixed steps keep the paper's 16 when the time step is given.
+  const sph::SceneDesc fixed =
+      parse(scene, {"Configuration.simulationMethod=\"wcsph\"", "Configuration.boundaryHandling=\"penalty\"",
+                    "Configuration.timeStepSize=0.0005"});
+  EXPECT_EQ(fixed.body<3>().sim.emitters.at(0).every_steps, 16);
+}
+
 TEST(SceneScales, EmittersFillingATankSetTheHead) {
   // 2500 particles of 0.01 m spacing: 0.25 m^2 over a 0.5 m floor fills 0.5 m (the nozzle is at 0.8 m).
   const sph::SceneDesc d = parse(json::parse(R"({ "version": 1, "dimension": 2,

@@ -629,17 +629,20 @@ EmitterParams<D> read_emitter(ObjectReader& e, const SimulationParams<D>& sim) {
 /// Each emitter's batch must have left the nozzle before the next one is placed there (checked
 /// once the time step is known). An emitter without emitEveryNSteps (every_steps 0 here) emits
 /// every 16 steps, or, when the time step is "auto", every as many steps as a batch needs to
-/// move one spacing if 16 are too few.
+/// move one spacing if 16 are too few. With CFL steps, whose batches come every emitEveryNSteps
+/// timeStepSize seconds, it emits as soon as a batch has moved one spacing: a continuous jet
+/// (with 16, DFSPH's long "auto" timeStepSize spread the layers many spacings apart).
 template <int D>
 void check_emitter_travel(const detail::ReadContext& ctx, SimulationParams<D>& sim, bool auto_time_step) {
   const double dx = 2.0 * sim.particle_radius;
   for (std::size_t i = 0; i < sim.emitters.size(); ++i) {
     EmitterParams<D>& em = sim.emitters[i];
-    if (em.every_steps == 0 && !auto_time_step) em.every_steps = 16;
+    const bool cfl = sim.time_stepping == TimeStepping::Cfl;
+    if (em.every_steps == 0 && !auto_time_step && !cfl) em.every_steps = 16;
     if (em.every_steps == 0) {
       double needed = std::ceil(dx / (em.speed * sim.time_step));
       if (em.speed * needed * sim.time_step < dx) needed += 1;  // (rounding)
-      em.every_steps = static_cast<int>(std::clamp(needed, 16.0, 1e9));
+      em.every_steps = static_cast<int>(std::clamp(needed, cfl ? 1.0 : 16.0, 1e9));
     }
     const double travel = em.speed * em.every_steps * sim.time_step;
     if (travel < dx)

@@ -720,15 +720,17 @@ void warn_from_scales(SceneDesc& desc, const SimulationParams<D>& sim, const Der
         viscosity_for_sound_speed(D, kArtificialViscosityAlpha, sim.kernel_radius, std::sqrt(k),
                                   sim.fluid.rest_density),
         kArtificialViscosityAlpha));
-  // DFSPH at wide supports gains energy from rest (docs/physics.md, "DFSPH", "Kernels"): the 2D
-  // validation tank fails at step 22 on 3 spacings and at step 23 on 2.75; 2.5 and 2.15 hold.
+  // DFSPH at wide supports fails from rest (docs/physics.md, "DFSPH", "Kernels"): the validation
+  // tanks run on up to 2.8 spacings (3D) and 3.5 (2D), and fail in their first steps on 2.95 (3D)
+  // and 4 (2D).
   const double spacings = sim.kernel_radius / (2 * r);
-  if (sim.method == SimulationMethod::Dfsph && spacings > 2.5 + 1e-9)
+  const double widest = D == 3 ? 2.8 : 3.5;
+  if (sim.method == SimulationMethod::Dfsph && spacings > widest + 1e-9)
     desc.warnings.push_back(fmt::format(
-        "Configuration.kernelRadius = {:g} m is {:.3g} particle spacings: DFSPH runs on supports above 2.5 spacings "
-        "gained energy and failed in this project's tests (a resting tank on 2.75 spacings within 25 steps; "
+        "Configuration.kernelRadius = {:g} m is {:.3g} particle spacings: DFSPH runs on supports above {:g} spacings "
+        "in {}D failed in this project's tests (a resting tank on {:g} spacings within its first steps; "
         "docs/physics.md, \"DFSPH\"); use 2 spacings, kernelRadius = 4 particleRadius = {:g} m",
-        sim.kernel_radius, spacings, 4 * r));
+        sim.kernel_radius, spacings, widest, D, D == 3 ? 2.95 : 4.0, 4 * r));
 }
 
 template <int D>

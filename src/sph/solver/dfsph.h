@@ -21,15 +21,11 @@
 ///    dt A s = J v, and v changes by dt a(s) (a change that does not depend on dt).
 /// As in the papers, only compression is an error and no s is negative (no tension): the
 /// solution is that of a complementarity problem (s >= 0, error <= 0, one of them 0 for each
-/// particle). The published solves iterate a projected Jacobi step s += max(e, 0) / (dt^2 beta),
-/// which needs many iterations on the smooth, deep modes a hydrostatic column has. Here each
-/// solve first runs conjugate gradients, preconditioned by beta, on the active set: the
-/// particles compressed now or under pressure in the last step, whose errors it drives to zero
-/// both ways (it converges in about the square root of Jacobi's iterations). A negative s is
-/// then released (s = 0), and the published projected Jacobi steps finish the solve: they add
-/// pressure where particles outside the set were left compressed. A solve stops when the
-/// average compression over all particles is below its tolerance (after at least its least
-/// iterations), or at its most iterations.
+/// particle). Each solve iterates the published projected Jacobi step
+/// s += max(e, 0) / (dt^2 beta) (the density solve; the divergence solve's is e / (dt beta)):
+/// every s only grows from its non-negative warm start, so none is ever negative and nothing
+/// has to be released. A solve stops when the average compression over all particles is below
+/// its tolerance (after at least its least iterations), or at its most iterations.
 ///
 /// Each solve starts from its s of the last step (warm start; kept per particle as s for the
 /// density solve and s dt for the divergence solve, the dt-free quantities). beta has a floor, a
@@ -102,9 +98,8 @@ class DfsphSolver {
   bool lattice_done_ = false;
   R beta_floor_ = 0;
   int full_count_ = 0;
-  std::vector<R> beta_;               // per particle: A's diagonal
-  std::vector<std::uint8_t> active_;  // per particle: under pressure in this solve
-  std::vector<std::uint8_t> full_;    // per particle: a full neighbourhood (compute_factors)
+  std::vector<R> beta_;             // per particle: A's diagonal
+  std::vector<std::uint8_t> full_;  // per particle: a full neighbourhood (compute_factors)
   // The step's fluid pairs within h (compute_factors): particle i's are begin_[i] .. begin_[i+1],
   // each its neighbour j and m_j grad W_ij; and sum_b psi_b grad W_ib over its boundary samples.
   std::vector<std::size_t> begin_;
@@ -120,7 +115,7 @@ class DfsphSolver {
   std::vector<Vec<D, R>> body_solid_;
   Vec<D, R>* body_acceleration_ = nullptr;
   Vec<D, R>* body_velocity_change_ = nullptr;
-  std::vector<R> b_, s_, r_, z_, p_, as_, ap_;
+  std::vector<R> b_, s_, p_, as_, ap_;  // b, s, the iteration's ds, A s, A ds
   std::vector<Vec<D, R>> acc_s_, acc_p_;
   std::vector<double> partial_;  // per-chunk sums
 };

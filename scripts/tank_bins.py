@@ -8,7 +8,9 @@ Runs the scene (KEY=VALUE as --set) and averages each particle's pressure, densi
 over the steps of the run's last tenth, as sph validate does. The free surface is the mean of each
 column's top particle plus half a spacing. Prints, for each 2-spacing depth bin below the second
 layer, the mean p / (rho0 g d) of the whole bin and of its interior (the particles at least 3
-spacings from the side walls), with their counts.
+spacings from the side walls), with their counts. Then how one step's pressure differs from the
+averaged one: the least and the largest of each step's interior mean p / (rho0 g d), over the
+same steps (the interior below the second layer and above the floor's two layers).
 """
 import json
 import sys
@@ -36,23 +38,34 @@ def main():
     sim = sph.Simulation(scene)
     while sim.time < 0.9 * end:
         sim.step(1)
-    sums, n = None, 0
+
+    def surface_of(x):
+        tops = {}
+        for xx in x:
+            key = (int(np.floor(xx[0] / dx)), int(np.floor(xx[2] / dx)) if dim == 3 else 0)
+            tops[key] = max(tops.get(key, -np.inf), xx[1])
+        return float(np.mean(list(tops.values()))) + dx / 2
+
+    def wall_distance(x):
+        wall = np.full(len(x), np.inf)
+        for a in [0] + ([2] if dim == 3 else []):
+            wall = np.minimum(wall, np.minimum(x[:, a] - lo[a], hi[a] - x[:, a]))
+        return wall
+
+    sums, n, steps = None, 0, []
     while sim.time < end * (1 - 1e-12):  # the last tenth, by particle id
         sim.step(1)
         order = np.argsort(np.asarray(sim.ids))
         now = [np.asarray(a)[order] for a in (sim.pressures, sim.positions, sim.densities)]
         sums = now if sums is None else [s + a for s, a in zip(sums, now)]
         n += 1
+        d = surface_of(now[1]) - now[1][:, 1]
+        inner = (d > 2 * dx) & (wall_distance(now[1]) > 3 * dx) & (now[1][:, 1] - lo[1] > 2 * dx)
+        steps.append(np.mean(now[0][inner] / (rho0 * g * d[inner])))
     p, x, rho = (s / n for s in sums)
-    tops = {}
-    for xx in x:
-        key = (int(np.floor(xx[0] / dx)), int(np.floor(xx[2] / dx)) if dim == 3 else 0)
-        tops[key] = max(tops.get(key, -np.inf), xx[1])
-    surface = float(np.mean(list(tops.values()))) + dx / 2
+    surface = surface_of(x)
     depth = surface - x[:, 1]
-    wall = np.full(len(x), np.inf)
-    for a in [0] + ([2] if dim == 3 else []):
-        wall = np.minimum(wall, np.minimum(x[:, a] - lo[a], hi[a] - x[:, a]))
+    wall = wall_distance(x)
     print(f"{n} steps averaged, surface {surface:.4f} m, mean |rho - rho0| / rho0 "
           f"{np.mean(np.abs(rho - rho0)) / rho0:.2e}")
     deep = depth > 2 * dx
@@ -64,6 +77,7 @@ def main():
         inside = p[inner].mean() / (rho0 * g * depth[inner].mean()) if inner.any() else float("nan")
         print(f"bin {k:2d}  depth {depth[whole].mean():.4f} m  whole {ratio:.3f} ({whole.sum()})  "
               f"interior {inside:.3f} ({inner.sum()})")
+    print(f"one step's interior mean p / (rho0 g d): {min(steps):.3f} to {max(steps):.3f} over {n} steps")
 
 
 if __name__ == "__main__":

@@ -67,11 +67,10 @@ TEST(ImplicitViscosity, AViscousColumnAtTheFlowsStepsEndsWhereTheExplicitRunAtSm
   EXPECT_EQ(ref.viscosity_iterations, 0);  // (the explicit term solves nothing)
   EXPECT_GT(imp.viscosity_iterations, 0);
   EXPECT_TRUE(imp.converged);
-  // Over 15 times longer steps (136 against 2,500 when measured; the density solve's iterations
-  // hold the implicit run's steps below the flow's CFL step).
-  EXPECT_GT(ref.steps, 15 * imp.steps);
+  // Over 20 times longer steps (112 against 2,500 when measured).
+  EXPECT_GT(ref.steps, 20 * imp.steps);
   // The column has slumped (it starts 0.2 m wide and tall) to the same shape, within a spacing
-  // (measured: front 0.347 m against 0.344 m, top 0.135 m against 0.142 m).
+  // (measured: front 0.348 m against 0.344 m, top 0.134 m against 0.142 m).
   EXPECT_GT(ref.front, 0.3);
   EXPECT_LT(ref.top, 0.16);
   EXPECT_NEAR(imp.front, ref.front, 0.01);

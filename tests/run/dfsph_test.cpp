@@ -145,8 +145,8 @@ TEST(Dfsph, ASupportWiderThanTheTestedOnesIsWarnedOfAndTheWarningIsTrue) {
   }
   // The 3D tank on 3 spacings is warned of, and fails in its first steps.
   const std::string tank3 = SPH_SOURCE_DIR "/scenes/validation/hydrostatic_3d_dfsph.json";
-  EXPECT_FALSE(warned(read_scene_file(tank3, {"Configuration.kernelRadius=0.01375"})));  // 2.75 spacings
-  EXPECT_TRUE(warned(read_scene_file(tank3, {"Configuration.kernelRadius=0.014"})));     // 2.8
+  EXPECT_FALSE(warned(read_scene_file(tank3, {"Configuration.kernelRadius=0.0125"})));  // 2.5 spacings
+  EXPECT_TRUE(warned(read_scene_file(tank3, {"Configuration.kernelRadius=0.01375"})));  // 2.75
   const SceneDesc wide3 = read_scene_file(tank3, {"Configuration.kernelRadius=0.015"});
   EXPECT_TRUE(warned(wide3));
   RunDriver<3, double> run(wide3, RunSettings{});

@@ -235,6 +235,29 @@ TEST(Health, EnergyGrowthInAClosedSceneWarns) {
   EXPECT_EQ(s.new_warnings, 0u);
 }
 
+TEST(Health, UnderCflStepsTheAdviceNamesTheCflSettings) {
+  // With CFL steps Configuration.timeStepSize only starts the run: the advice names cflFactor and
+  // cflMaxTimeStepSize, with their values (it named timeStepSize with the largest step's value).
+  HealthScene scene;
+  scene.sound_speed = 10, scene.kernel_radius = 0.04, scene.time_step = 5e-3;
+  scene.cfl = true, scene.cfl_factor = 0.4;
+  HealthStats s;
+  s.energy = 250.0;
+  HealthMonitor monitor(scene);
+  monitor.set_initial(100.0, 1.0);
+  const std::string e = error_of([&] { monitor.check(s, 2, 3e-3, 10); });
+  EXPECT_NE(e.find("lower Configuration.cflFactor (now 0.4, e.g. to 0.2) or cflMaxTimeStepSize (now 0.005 s)"),
+            std::string::npos)
+      << e;
+  EXPECT_EQ(e.find("timeStepSize ("), std::string::npos) << e;
+  s.energy = 0, s.rho_max = 1.5;  // WCSPH's compression advice
+  HealthMonitor squeezed(scene);
+  squeezed.set_initial(0.0, 1.0);
+  squeezed.check(s, 2, 3e-3, 10);
+  const std::string c = squeezed.warning(HealthKind::Compression);
+  EXPECT_NE(c.find("or lower Configuration.cflFactor (now 0.4) or cflMaxTimeStepSize"), std::string::npos) << c;
+}
+
 TEST(Health, TheMonitorsStateSurvivesSaveAndLoad) {
   HealthScene scene;
   scene.sound_speed = 10, scene.kernel_radius = 0.04;

@@ -19,15 +19,29 @@ double suggested_viscosity(const HealthScene& s) {
   return s.rest_density * 0.1 * (0.5 * s.kernel_radius) * s.sound_speed / 8.0;
 }
 
+/// The setting that shortens the steps, with its value: "Configuration.timeStepSize (now 0.0001
+/// s)", or under CFL steps "Configuration.cflFactor (now 0.5) or cflMaxTimeStepSize (now 0.005 s)".
+/// `lower`: with a value half as large suggested ("e.g. to ...").
+std::string step_setting(const HealthScene& s, bool lower = false) {
+  if (s.cfl)
+    return lower ? fmt::format(
+                       "Configuration.cflFactor (now {:.3g}, e.g. to {:.3g}) or cflMaxTimeStepSize (now {:.3g} s)",
+                       s.cfl_factor, 0.5 * s.cfl_factor, s.time_step)
+                 : fmt::format("Configuration.cflFactor (now {:.3g}) or cflMaxTimeStepSize (now {:.3g} s)",
+                               s.cfl_factor, s.time_step);
+  return lower ? fmt::format("Configuration.timeStepSize (now {:.3g} s, e.g. to {:.3g} s)", s.time_step,
+                             0.5 * s.time_step)
+               : fmt::format("Configuration.timeStepSize (now {:.3g} s)", s.time_step);
+}
+
 /// What walls that hold a particle need: stiffness for the speed v within r and for the head,
 /// critical damping, and the step the springs allow.
 std::string wall_advice(const HealthScene& s, double v) {
   if (s.boundary_particles)
     return fmt::format(
         "boundary particles hold a particle that sees them within h = {:.3g} m; at the run's top speed v = {:.3g} "
-        "m/s a step of {:.3g} s moves it {:.2g} h: take smaller steps (Configuration.timeStepSize, or cflFactor and "
-        "cflMaxTimeStepSize){}",
-        s.kernel_radius, v, s.time_step, v * s.time_step / s.kernel_radius,
+        "m/s a step of {:.3g} s moves it {:.2g} h: take smaller steps ({}){}",
+        s.kernel_radius, v, s.time_step, v * s.time_step / s.kernel_radius, step_setting(s),
         s.misses_pairs ? ", or a neighbor mode that never misses a pair (standard, verlet, tracked, adaptive_exact): "
                          "the adaptive mode's lists miss the pairs a particle comes to (fluid pairs, and the boundary "
                          "samples of solids at rest)"
@@ -40,9 +54,9 @@ std::string wall_advice(const HealthScene& s, double v) {
       "walls that stop a particle at the run's top speed v = {:.3g} m/s within r = {:.3g} m need "
       "Container.wallStiffness >= (v / r)^2 = {:.3g}, and >= g H / (2 r^2) = {:.3g} for the head H = {:.3g} m "
       "(now {:.3g}), with Container.wallDamping about 2 sqrt(wallStiffness) = {:.3g} (now {:.3g}) and "
-      "Configuration.timeStepSize <= 0.5 / sqrt(wallStiffness) = {:.3g} s (now {:.3g} s)",
+      "Configuration.{} <= 0.5 / sqrt(wallStiffness) = {:.3g} s (now {:.3g} s)",
       v, r, ks_speed, ks_head, s.head, s.wall_stiffness, 2.0 * std::sqrt(ks), s.wall_damping,
-      0.5 / std::sqrt(std::max(ks, s.wall_stiffness)), s.time_step);
+      s.cfl ? "cflMaxTimeStepSize" : "timeStepSize", 0.5 / std::sqrt(std::max(ks, s.wall_stiffness)), s.time_step);
 }
 
 std::string speed_advice(const HealthScene& s, double v) {
@@ -81,7 +95,11 @@ HealthScene health_scene(const SimulationParams<D>& p) {
   s.boundary_particles = p.boundary.handling == BoundaryHandling::Particles;
   s.misses_pairs = p.neighbors == NeighborMode::Adaptive;
   s.implicit_viscosity = p.fluid.viscosity_solve == ViscositySolve::Implicit;
-  if (p.time_stepping == TimeStepping::Cfl) s.time_step = p.cfl.max_dt;
+  if (p.time_stepping == TimeStepping::Cfl) {
+    s.cfl = true;
+    s.cfl_factor = p.cfl.factor;
+    s.time_step = p.cfl.max_dt;
+  }
   return s;
 }
 
@@ -121,10 +139,10 @@ void HealthMonitor::check(HealthStats& st, std::int64_t step, double time, std::
   // Supersonic first: it is the cause of most of what follows (DFSPH's fluid is incompressible:
   // its Mach number against sqrt(Fluid.stiffness) means nothing and is not judged).
   if (!s.incompressible && st.max_mach > watch(HealthKind::Mach).fail)
-    fail(
-        fmt::format("simulation went supersonic {}: particle id {} moves at {:.4g} m/s, Mach {:.3g} (sound "
-                    "speed sqrt(Fluid.stiffness) = {:.4g} m/s); {}, or lower Configuration.timeStepSize (now {:.3g} s)",
-                    at(), st.mach_id, top_speed, st.max_mach, s.sound_speed, speed_advice(s, top_speed), s.time_step));
+    fail(fmt::format(
+        "simulation went supersonic {}: particle id {} moves at {:.4g} m/s, Mach {:.3g} (sound "
+        "speed sqrt(Fluid.stiffness) = {:.4g} m/s); {}, or lower {}",
+        at(), st.mach_id, top_speed, st.max_mach, s.sound_speed, speed_advice(s, top_speed), step_setting(s)));
   const auto contained = [&](HealthKind kind, std::uint64_t count, double depth, std::uint64_t id, double speed,
                              const char* where) {
     const double fraction = static_cast<double>(count) / n;
@@ -157,13 +175,10 @@ void HealthMonitor::check(HealthStats& st, std::int64_t step, double time, std::
     if (s.incompressible)
       return fmt::format(
           "DFSPH's constant-density solve did not hold it: lower Configuration.maxError, raise "
-          "Configuration.maxIterations, or take smaller steps (Configuration.cflFactor, "
-          "cflMaxTimeStepSize or timeStepSize, now {:.3g} s)",
-          s.time_step);
-    return fmt::format(
-        "Fluid.stiffness >= {:.3g} (now {:.3g}) keeps the compression near 1 %, or lower "
-        "Configuration.timeStepSize (now {:.3g} s)",
-        stiff_for_1pct, s.stiffness, s.time_step);
+          "Configuration.maxIterations, or take smaller steps (lower {})",
+          step_setting(s));
+    return fmt::format("Fluid.stiffness >= {:.3g} (now {:.3g}) keeps the compression near 1 %, or lower {}",
+                       stiff_for_1pct, s.stiffness, step_setting(s));
   };
   if (st.rho_max > watch(HealthKind::Compression).fail)
     fail(fmt::format("simulation collapsed {}: particle id {} is compressed to {:.3g} times the rest density; {}", at(),
@@ -181,10 +196,8 @@ void HealthMonitor::check(HealthStats& st, std::int64_t step, double time, std::
   if (s.closed) {
     const double growth = (st.energy - initial_energy_) / energy_scale();
     const auto advice = [&] {
-      const std::string smaller_step = fmt::format(
-          "a closed, damped scene cannot gain energy: lower Configuration.timeStepSize (now {:.3g} s, "
-          "e.g. to {:.3g} s)",
-          s.time_step, 0.5 * s.time_step);
+      const std::string smaller_step =
+          fmt::format("a closed, damped scene cannot gain energy: lower {}", step_setting(s, true));
       const double viscous = s.viscosity / suggested_viscosity(s);
       // A fluid far more viscous than the damping needs: its explicit viscous term is what a long
       // step makes unstable, and more viscosity would make it worse.

@@ -90,6 +90,10 @@ struct HealthScene {
   bool boundary_particles = false;  ///< BoundaryHandling::Particles (no wall springs to advise on)
   bool misses_pairs = false;        ///< NeighborMode::Adaptive: the lists can miss pairs coming into range
   bool implicit_viscosity = false;  ///< ViscositySolve::Implicit (no viscous step limit to advise on)
+  /// CFL steps (`cflMethod` "cfl"): time_step is then cflMaxTimeStepSize, and the advice names it
+  /// and cflFactor instead of timeStepSize.
+  bool cfl = false;
+  double cfl_factor = 0;
 };
 
 template <int D>

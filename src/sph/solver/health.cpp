@@ -40,7 +40,7 @@ std::string wall_advice(const HealthScene& s, double v) {
   if (s.boundary_particles)
     return fmt::format(
         "boundary particles hold a particle that sees them within h = {:.3g} m; at the run's top speed v = {:.3g} "
-        "m/s a step of {:.3g} s moves it {:.2g} h: take smaller steps ({}){}",
+        "m/s a step of {:.3g} s moves it {:.2g} h: take smaller steps, lower {}{}",
         s.kernel_radius, v, s.time_step, v * s.time_step / s.kernel_radius, step_setting(s),
         s.misses_pairs ? ", or a neighbor mode that never misses a pair (standard, verlet, tracked, adaptive_exact): "
                          "the adaptive mode's lists miss the pairs a particle comes to (fluid pairs, and the boundary "

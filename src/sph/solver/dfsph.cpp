@@ -192,7 +192,7 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
   // Tolerance on the average error over rho0: % and % per second.
   const double tolerance =
       0.01 * (kDensity ? params_.max_error : params_.max_error_v) * static_cast<double>(rho0) * static_cast<double>(n);
-  for (auto* v : {&b_, &s_, &p_, &as_, &ap_}) v->assign(n, R(0));
+  for (auto* v : {&b_, &s_, &p_, &as_}) v->assign(n, R(0));
   acc_s_.resize(n);
   acc_p_.resize(n);
 
@@ -227,16 +227,33 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
   };
   // The published iteration (projected Jacobi): each compressed particle adds the pressure that
   // would remove its own compression, ds = e / (scale beta) >= 0, so no s is ever negative.
+  // Two passes an iteration: the accelerations a(ds) of the step ds (each particle's needs its
+  // neighbours' ds), then per particle A ds, the update, its error (summed in the fixed blocks of
+  // error_sum) and the next iteration's ds (which no other particle reads in that pass).
+  const auto step_of = [&](std::size_t i) { return std::max(b_[i] - as_[i], R(0)) / beta_[i]; };
+  if (!finished()) parallel_for(n, [&](std::size_t i) { p_[i] = step_of(i); });
   while (!finished()) {
-    parallel_for(n, [&](std::size_t i) { p_[i] = std::max(b_[i] - as_[i], R(0)) / beta_[i]; });
-    apply(p_, acc_p_, ap_);
-    ++iterations;
     parallel_for(n, [&](std::size_t i) {
-      s_[i] += p_[i];
-      acc_s_[i] += acc_p_[i];
-      as_[i] += ap_[i];
+      const R pi = p_[i];
+      Vec<D, R> a = solid_[i] * (-pi);
+      for (std::size_t k = begin_[i]; k < begin_[i + 1]; ++k) a -= pair_g_[k] * (pi + p_[pair_j_[k]]);
+      acc_p_[i] = a;
     });
-    error = error_sum();
+    ++iterations;
+    partial_.assign(chunk_count<kSumBlock>(n), 0.0);
+    parallel_chunks<kSumBlock>(n, [&](std::size_t c, std::size_t first, std::size_t last) {
+      double sum = 0;
+      for (std::size_t i = first; i < last; ++i) {
+        s_[i] += p_[i];
+        acc_s_[i] += acc_p_[i];
+        as_[i] += -density_rate(i, [&](std::size_t j) { return acc_p_[j]; });
+        sum += static_cast<double>(std::max(scale * (b_[i] - as_[i]), R(0)));
+        p_[i] = step_of(i);
+      }
+      partial_[c] = sum;
+    });
+    error = 0;
+    for (const double part : partial_) error += part;
   }
   stats.iterations = iterations;
   stats.error = 100.0 * error / static_cast<double>(n) / static_cast<double>(rho0);

@@ -115,7 +115,7 @@ class DfsphSolver {
   std::vector<Vec<D, R>> body_solid_;
   Vec<D, R>* body_acceleration_ = nullptr;
   Vec<D, R>* body_velocity_change_ = nullptr;
-  std::vector<R> b_, s_, p_, as_, ap_;  // b, s, the iteration's ds, A s, A ds
+  std::vector<R> b_, s_, p_, as_;  // b, s, the iteration's ds, A s
   std::vector<Vec<D, R>> acc_s_, acc_p_;
   std::vector<double> partial_;  // per-chunk sums
 };

@@ -162,15 +162,19 @@ R DfsphSolver<D, R>::density_rate(std::size_t i, V&& v) const {
 }
 
 template <int D, std::floating_point R>
-void DfsphSolver<D, R>::apply(const std::vector<R>& x, std::vector<Vec<D, R>>& out, std::vector<R>& ax) {
-  const std::size_t n = beta_.size();
-  parallel_for(n, [&](std::size_t i) {
+void DfsphSolver<D, R>::accelerations(const std::vector<R>& x, std::vector<Vec<D, R>>& out) const {
+  parallel_for(beta_.size(), [&](std::size_t i) {
     const R xi = x[i];
     Vec<D, R> a = solid_[i] * (-xi);
     for (std::size_t k = begin_[i]; k < begin_[i + 1]; ++k) a -= pair_g_[k] * (xi + x[pair_j_[k]]);
     out[i] = a;
   });
-  parallel_for(n, [&](std::size_t i) { ax[i] = -density_rate(i, [&](std::size_t j) { return out[j]; }); });
+}
+
+template <int D, std::floating_point R>
+void DfsphSolver<D, R>::apply(const std::vector<R>& x, std::vector<Vec<D, R>>& out, std::vector<R>& ax) {
+  accelerations(x, out);
+  parallel_for(beta_.size(), [&](std::size_t i) { ax[i] = -density_rate(i, [&](std::size_t j) { return out[j]; }); });
 }
 
 template <int D, std::floating_point R>
@@ -233,12 +237,7 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
   const auto step_of = [&](std::size_t i) { return std::max(b_[i] - as_[i], R(0)) / beta_[i]; };
   if (!finished()) parallel_for(n, [&](std::size_t i) { p_[i] = step_of(i); });
   while (!finished()) {
-    parallel_for(n, [&](std::size_t i) {
-      const R pi = p_[i];
-      Vec<D, R> a = solid_[i] * (-pi);
-      for (std::size_t k = begin_[i]; k < begin_[i + 1]; ++k) a -= pair_g_[k] * (pi + p_[pair_j_[k]]);
-      acc_p_[i] = a;
-    });
+    accelerations(p_, acc_p_);
     ++iterations;
     partial_.assign(chunk_count<kSumBlock>(n), 0.0);
     parallel_chunks<kSumBlock>(n, [&](std::size_t c, std::size_t first, std::size_t last) {

@@ -85,7 +85,9 @@ class DfsphSolver {
   enum class Solve { Density, Divergence };
   template <Solve kSolve>
   SolveStats solve(ParticleSet<D, R>& ps, R rho0, R dt);
-  /// out = a(x) (the pressure accelerations of a field x), then ax = A x = -J out.
+  /// out = a(x): the pressure accelerations of a field x.
+  void accelerations(const std::vector<R>& x, std::vector<Vec<D, R>>& out) const;
+  /// out = a(x), then ax = A x = -J out.
   void apply(const std::vector<R>& x, std::vector<Vec<D, R>>& out, std::vector<R>& ax);
   /// (J v)_i: the density rate of particle i under the velocities v(j), on the step's pairs.
   template <class V>

@@ -219,12 +219,9 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
   });
 
   // The error of the current s: the average compression (as the papers measure it).
-  const auto error_sum = [&] {
-    return sph::chunked_sum(
-        n, partial_, [&](std::size_t i) { return static_cast<double>(std::max(scale * (b_[i] - as_[i]), R(0))); });
-  };
+  const auto compression = [&](std::size_t i) { return static_cast<double>(std::max(scale * (b_[i] - as_[i]), R(0))); };
   apply(s_, acc_s_, as_);
-  double error = error_sum();
+  double error = sph::chunked_sum(n, partial_, compression);
   int iterations = 0;
   const auto finished = [&] {
     return iterations >= max_iterations || (iterations >= min_iterations && error <= tolerance);
@@ -232,8 +229,8 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
   // The published iteration (projected Jacobi): each compressed particle adds the pressure that
   // would remove its own compression, ds = e / (scale beta) >= 0, so no s is ever negative.
   // Two passes an iteration: the accelerations a(ds) of the step ds (each particle's needs its
-  // neighbours' ds), then per particle A ds, the update, its error (summed in the fixed blocks of
-  // error_sum) and the next iteration's ds (which no other particle reads in that pass).
+  // neighbours' ds), then per particle A ds, the update, its compression (summed in chunked_sum's
+  // fixed blocks) and the next iteration's ds (which no other particle reads in that pass).
   const auto step_of = [&](std::size_t i) { return std::max(b_[i] - as_[i], R(0)) / beta_[i]; };
   if (!finished()) parallel_for(n, [&](std::size_t i) { p_[i] = step_of(i); });
   while (!finished()) {
@@ -246,7 +243,7 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
         s_[i] += p_[i];
         acc_s_[i] += acc_p_[i];
         as_[i] += -density_rate(i, [&](std::size_t j) { return acc_p_[j]; });
-        sum += static_cast<double>(std::max(scale * (b_[i] - as_[i]), R(0)));
+        sum += compression(i);
         p_[i] = step_of(i);
       }
       partial_[c] = sum;

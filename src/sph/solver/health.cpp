@@ -23,15 +23,12 @@ double suggested_viscosity(const HealthScene& s) {
 /// s)", or under CFL steps "Configuration.cflFactor (now 0.5) or cflMaxTimeStepSize (now 0.005 s)".
 /// `lower`: with a value half as large suggested ("e.g. to ...").
 std::string step_setting(const HealthScene& s, bool lower = false) {
-  if (s.cfl)
-    return lower ? fmt::format(
-                       "Configuration.cflFactor (now {:.3g}, e.g. to {:.3g}) or cflMaxTimeStepSize (now {:.3g} s)",
-                       s.cfl_factor, 0.5 * s.cfl_factor, s.time_step)
-                 : fmt::format("Configuration.cflFactor (now {:.3g}) or cflMaxTimeStepSize (now {:.3g} s)",
-                               s.cfl_factor, s.time_step);
-  return lower ? fmt::format("Configuration.timeStepSize (now {:.3g} s, e.g. to {:.3g} s)", s.time_step,
-                             0.5 * s.time_step)
-               : fmt::format("Configuration.timeStepSize (now {:.3g} s)", s.time_step);
+  const double now = s.cfl ? s.cfl_factor : s.time_step;
+  const char* unit = s.cfl ? "" : " s";
+  std::string value = fmt::format("now {:.3g}{}", now, unit);
+  if (lower) value += fmt::format(", e.g. to {:.3g}{}", 0.5 * now, unit);
+  return s.cfl ? fmt::format("Configuration.cflFactor ({}) or cflMaxTimeStepSize (now {:.3g} s)", value, s.time_step)
+               : fmt::format("Configuration.timeStepSize ({})", value);
 }
 
 /// What walls that hold a particle need: stiffness for the speed v within r and for the head,

@@ -336,8 +336,8 @@ std::size_t Simulation<D, R>::emit() {
     // One layer, emitted `late` seconds after its batch's time: where it has flown since then
     // (x + v late + g late^2 / 2, at v + g late), so that layers keep their spacing whatever
     // the steps.
-    const std::pair<Vec<D, double>, Vec<D, double>> axes = nozzle_axes<D>(e.direction);
     const auto add_layer = [&](double late) {
+      const std::pair<Vec<D, double>, Vec<D, double>> axes = nozzle_axes<D>(e.direction);
       const int rows = D == 3 ? e.height : 1;
       const Vec<D, double> v0 = e.direction * e.speed;
       const Vec<D, double> flown = late > 0 ? v0 * late + params_.gravity * (0.5 * late * late) : Vec<D, double>{};

@@ -3,7 +3,8 @@
 (docs/physics.md, "Implicit viscosity").
 
 The validation's 2D DFSPH tank scene with a 0.2 m x 0.2 m column (1,600 particles, spacing
-5 mm, h = 2 spacings, the cubic spline) of viscosity MU Pa s in a 0.6 m x 0.3 m tank, run to T
+5 mm, h = 2 spacings, the cubic spline, boundary samples without a pressure of their own:
+boundaryPressure "none", DFSPH's default) of viscosity MU Pa s in a 0.6 m x 0.3 m tank, run to T
 seconds with each solver and each largest step given (`None`: the scene's CFL steps; `fixed`
 after it: every step that long). Prints,
 per run, the steps, the wall seconds, the front (largest x) and top (largest y) at the end, the
@@ -28,7 +29,7 @@ for run in runs:
     solver, cap, *fixed = run.split(":")
     overrides = {"Container.end": [0.6, 0.3], "FluidBlocks": [{"start": [0, 0], "end": [0.2, 0.2]}],
                  "Configuration.kernelRadius": 0.01, "Configuration.stopAt": end, "Fluid.viscosity": mu,
-                 "Fluid.viscositySolver": solver}
+                 "Fluid.viscositySolver": solver, "Configuration.boundaryPressure": "none"}
     if cap != "None":
         overrides["Configuration.cflMaxTimeStepSize"] = float(cap)
         if fixed:

@@ -18,7 +18,10 @@ namespace sph {
 namespace {
 
 /// A 0.2 m x 0.2 m column of 400 particles (mu = 100 Pa s) at the left wall of a 0.6 m x 0.3 m
-/// tank, DFSPH with boundary particles and the cubic spline, for 0.25 s.
+/// tank, DFSPH with boundary particles and the cubic spline, for 0.25 s. The samples carry no
+/// pressure of their own (boundaryPressure "none", DFSPH's default, as when the figures below were
+/// measured; the validation scene extrapolates it, and with that the two runs' fronts end 0.0117 m
+/// apart, against 0.004 m).
 SceneDesc viscous_column(const std::string& solver, const std::vector<std::string>& more = {}) {
   std::vector<std::string> sets{"Configuration.particleRadius=0.005",
                                 "Configuration.kernelRadius=0.02",
@@ -27,6 +30,7 @@ SceneDesc viscous_column(const std::string& solver, const std::vector<std::strin
                                 "Container.end=[0.6, 0.3]",
                                 R"(FluidBlocks=[{"start": [0, 0], "end": [0.2, 0.2]}])",
                                 "Fluid.viscosity=100",
+                                R"(Configuration.boundaryPressure="none")",
                                 "Fluid.viscositySolver=" + solver};
   sets.insert(sets.end(), more.begin(), more.end());
   return read_scene_file(SPH_SOURCE_DIR "/scenes/validation/hydrostatic_2d_dfsph.json", sets);

@@ -111,6 +111,27 @@ TEST(SceneReader, MinimalSceneParsesWithDefaults) {
   EXPECT_EQ(e.body<2>().sim.emitters.size(), 1u);
 }
 
+TEST(SceneReader, BoundaryPressureDefaultsToEachSolversForm) {
+  // Weakly compressible SPH extrapolates the samples' pressure; DFSPH's samples carry none
+  // (Akinci's term) unless the scene says otherwise.
+  json j = valid_scene();
+  j["Configuration"]["boundaryHandling"] = "particles";
+  j["Configuration"]["kernel"] = "cubic";
+  EXPECT_EQ(parse(j).body<2>().sim.boundary.pressure, sph::BoundaryPressure::Extrapolate);
+  j["Configuration"]["simulationMethod"] = "dfsph";
+  EXPECT_EQ(parse(j).body<2>().sim.boundary.pressure, sph::BoundaryPressure::None);
+  for (const auto& [name, value] :
+       {std::pair{"extrapolate", sph::BoundaryPressure::Extrapolate},
+        std::pair{"mirror", sph::BoundaryPressure::Mirror}, std::pair{"none", sph::BoundaryPressure::None}}) {
+    j["Configuration"]["boundaryPressure"] = name;
+    EXPECT_EQ(parse(j).body<2>().sim.boundary.pressure, value) << name;
+  }
+  j["Configuration"]["boundaryPressure"] = "mirrored";
+  const std::string m = error_of(j);
+  EXPECT_CONTAINS(m, "boundaryPressure");
+  EXPECT_CONTAINS(m, "none");
+}
+
 TEST(SceneReader, MissingFileNamesThePath) {
   const std::string path = SPH_SOURCE_DIR "/tests/scene/does_not_exist.json";
   try {

@@ -16,6 +16,7 @@
 #include <sph/core/state_stream.h>
 #include <sph/neighbors/standard.h>
 #include <sph/solver/boundary.h>
+#include <sph/solver/dfsph.h>
 #include <sph/solver/simulation.h>
 #include <sph/solver/smoothing.h>
 #include <sph/solver/wcsph.h>
@@ -341,6 +342,110 @@ TEST(BoundaryForces, ExtrapolatedPressureAddsEachSamplesHydrostaticHead) {
     EXPECT_GT(ps.acceleration[0][1], 0);
   }
 }
+
+TEST(BoundaryForces, ASampleWithoutPressureGivesHalfTheMirroredTerm) {
+  // BoundaryPressure::None: p_b = 0, so each sample's pressure term is (p_i + 0) where the mirrored
+  // one is (p_i + p_i), in both pressure forms; with no friction, no gravity and no fluid
+  // neighbour the acceleration is the samples' alone, and exactly halves.
+  for (const PressureForce form : {PressureForce::Symmetric, PressureForce::Paper}) {
+    SimulationParams<2> p = filled_box_params<2>(10, KernelKind::Cubic);
+    p.fluid.pressure_force = form;
+    ParticleSet<2, double> ps;
+    ps.add(V2{0.05, 0.006}, V2{}, p.particle_mass);
+    const BoundarySet<2, double> b = make_boundary<2, double>(p);
+    StandardNeighbors<2, double> s(p.kernel_radius);
+    s.set_boundary(b.position);
+    s.update(ps);
+    BoundaryView<2, double> view{b.position, b.psi, &s.boundary_lists(), 0};
+    compute_density_pressure(ps, s.lists(), p.kernel_radius, p.fluid, view);
+    ps.pressure[0] = 500;
+    const WallContact<2, double> walls(p.container, p.obstacles, p.particle_radius, p.walls, false);
+    compute_accelerations(ps, s.lists(), p.kernel_radius, p.fluid, V2{}, walls, {}, 0.0, view);
+    const V2 mirrored = ps.acceleration[0];
+    view.sample_pressure = false;
+    compute_accelerations(ps, s.lists(), p.kernel_radius, p.fluid, V2{}, walls, {}, 0.0, view);
+    ASSERT_GT(mirrored[1], 0);  // (the floor pushes up)
+    for (int d = 0; d < 2; ++d) EXPECT_NEAR(ps.acceleration[0][d], 0.5 * mirrored[d], 1e-12 * mirrored[1]) << d;
+  }
+}
+
+/// DFSPH with boundary samples that carry a pressure (BoundaryPressure Mirror, Extrapolate) or
+/// not (None), on a block of fluid spread to 1.3 spacings (below rest density: nothing to solve)
+/// standing on the floor of a box: beta is the diagonal of the operator whose boundary terms
+/// have weight w = 2 or 1, |sum_j m_j grad W_ij + w sum_b psi_b grad W_ib|^2 + m_i sum_j m_j
+/// |grad W_ij|^2 (the constraint takes the force's weight: the matrix stays symmetric), and the
+/// density solve adds, with Extrapolate only, each sample's head beyond the particle's own
+/// pressure: -sum_b psi_b e_b grad W_ib with e_b = g . (x_b - x_i) / rho_i, clamped at -s_i
+/// (the last step's s, 0 on the first step: only the samples below push).
+template <int D>
+void check_dfsph_samples(BoundaryPressure pressure) {
+  SimulationParams<D> p = filled_box_params<D>(D == 2 ? 14 : 8, KernelKind::Cubic);
+  p.kernel_radius = 0.025;
+  const double dx = 2 * p.particle_radius;
+  const int n = D == 2 ? 8 : 5;
+  ParticleSet<D, double> ps;
+  const int total = D == 2 ? n * n : n * n * n;
+  for (int k = 0; k < total; ++k) {
+    Vec<D, double> x;
+    int rest = k;
+    for (int d = 0; d < D; ++d) x[d] = (d == 1 ? 0.5 + 1.3 * (rest % n) : 1.3 + 1.3 * (rest % n)) * dx, rest /= n;
+    ps.add(x, Vec<D, double>{}, p.particle_mass);
+  }
+  const BoundarySet<D, double> b = make_boundary<D, double>(p);
+  StandardNeighbors<D, double> s(p.kernel_radius);
+  s.set_boundary(b.position);
+  s.update(ps);
+  Vec<D, double> g{};
+  g[1] = -9.81;
+  BoundaryView<D, double> view{b.position, b.psi, &s.boundary_lists(), 0};
+  view.extrapolate = pressure == BoundaryPressure::Extrapolate;
+  view.sample_pressure = pressure != BoundaryPressure::None;
+  view.extrapolation = g;
+  compute_density_pressure(ps, s.lists(), p.kernel_radius, p.fluid, view);
+  const SmoothingKernels<D, double> kernels(p.fluid, p.kernel_radius);
+  DfsphSolver<D, double> solver(DfsphParams{}, ps, dx);
+  solver.compute_factors(ps, s.lists(), kernels, view);
+  const double w = pressure == BoundaryPressure::None ? 1 : 2, h2 = p.kernel_radius * p.kernel_radius;
+  std::vector<Vec<D, double>> head(ps.size());
+  std::size_t near_floor = 0;
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    Vec<D, double> sum{}, solid{};
+    double squares = 0;
+    for (const std::uint32_t j : s.lists().of(i)) {
+      const Vec<D, double> xij = ps.position[i] - ps.position[j];
+      if (norm2(xij) >= h2) continue;
+      sum += kernels.gradient(xij) * ps.mass[j];
+      squares += ps.mass[j] * norm2(kernels.gradient(xij));
+    }
+    for (const std::uint32_t k : s.boundary_lists().of(i)) {
+      const Vec<D, double> xib = ps.position[i] - b.position[k];
+      if (norm2(xib) >= h2) continue;
+      solid += kernels.gradient(xib) * b.psi[k];
+      const double e = std::max(dot(g, b.position[k] - ps.position[i]) / ps.density[i], 0.0);
+      head[i] -= kernels.gradient(xib) * (b.psi[k] * e);
+    }
+    const double beta = norm2(sum + solid * w) + ps.mass[i] * squares;
+    if (norm2(solid) > 0) {
+      ++near_floor;
+      EXPECT_NEAR(solver.factors()[i], beta, 1e-12 * beta) << D << "D, particle " << i;
+    }
+  }
+  EXPECT_GE(near_floor, D == 2 ? 8u : 25u);
+  const SolveStats stats = solver.density_solve(ps, 1000, 1e-4);
+  EXPECT_EQ(stats.error, 0);  // (spread out: no compression, no pressure)
+  double up = 0;
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    const Vec<D, double> expected = pressure == BoundaryPressure::Extrapolate ? head[i] : Vec<D, double>{};
+    for (int d = 0; d < D; ++d) EXPECT_NEAR(ps.acceleration[i][d], expected[d], 1e-12 * (1 + norm(head[i]))) << i;
+    up = std::max(up, ps.acceleration[i][1]);
+  }
+  if (pressure == BoundaryPressure::Extrapolate) EXPECT_GT(up, 1.0);  // (m/s^2: the floor layer is pushed up)
+}
+
+TEST(BoundaryForces, DfsphSamplesWithoutPressure2D) { check_dfsph_samples<2>(BoundaryPressure::None); }
+TEST(BoundaryForces, DfsphMirroredSamples2D) { check_dfsph_samples<2>(BoundaryPressure::Mirror); }
+TEST(BoundaryForces, DfsphExtrapolatedSamples2D) { check_dfsph_samples<2>(BoundaryPressure::Extrapolate); }
+TEST(BoundaryForces, DfsphExtrapolatedSamples3D) { check_dfsph_samples<3>(BoundaryPressure::Extrapolate); }
 
 TEST(ArtificialViscosity, ActsOnApproachingPairsOnlyEqualAndOpposite) {
   FluidParams fluid;

@@ -110,7 +110,8 @@ inline constexpr Named<BoundaryHandling> kBoundaryHandlingNames[] = {{BoundaryHa
 inline constexpr Named<BoundaryVolume> kBoundaryVolumeNames[] = {{BoundaryVolume::RestFluid, "rest_fluid"},
                                                                  {BoundaryVolume::Akinci, "akinci"}};
 inline constexpr Named<BoundaryPressure> kBoundaryPressureNames[] = {{BoundaryPressure::Extrapolate, "extrapolate"},
-                                                                     {BoundaryPressure::Mirror, "mirror"}};
+                                                                     {BoundaryPressure::Mirror, "mirror"},
+                                                                     {BoundaryPressure::None, "none"}};
 inline constexpr Named<KernelKind> kKernelNames[] = {
     {KernelKind::Paper, "paper"}, {KernelKind::Cubic, "cubic"}, {KernelKind::Wendland, "wendland"}};
 inline constexpr Named<SimulationMethod> kSimulationMethodNames[] = {{SimulationMethod::Wcsph, "wcsph"},

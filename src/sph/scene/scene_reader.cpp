@@ -426,14 +426,14 @@ void read_configuration(ObjectReader& c, SceneDesc& desc, SimulationParams<D>& s
                   c.choice("boundaryHandling", names_of(detail::kBoundaryHandlingNames), kDefaultBoundaryHandling));
   sim.boundary.volume = value_named(detail::kBoundaryVolumeNames,
                                     c.choice("boundaryVolume", names_of(detail::kBoundaryVolumeNames), "rest_fluid"));
-  sim.boundary.pressure =
-      value_named(detail::kBoundaryPressureNames,
-                  c.choice("boundaryPressure", names_of(detail::kBoundaryPressureNames), "extrapolate"));
   sim.boundary.friction =
       c.positive("boundaryFriction", "a boundary friction sigma >= 0 (Akinci et al. 2012; 0: free slip)",
                  sim.boundary.friction, true);
   sim.fluid.kernel = value_named(detail::kKernelNames, c.choice("kernel", names_of(detail::kKernelNames), "paper"));
   read_solver<D>(c, sim);
+  sim.boundary.pressure = value_named(detail::kBoundaryPressureNames,
+                                      c.choice("boundaryPressure", names_of(detail::kBoundaryPressureNames),
+                                               sim.method == SimulationMethod::Dfsph ? "none" : "extrapolate"));
   read_time_stepping<D>(c, sim);
   sim.verlet_skin = c.positive("verletSkin", "a positive verlet skin in metres (default 0.1 h)",
                                kDefaultSkinFraction * sim.kernel_radius);

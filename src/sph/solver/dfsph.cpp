@@ -32,6 +32,14 @@ constexpr double kWarmStartDivergence = 0.5;
 /// 3D and 7 of 12 in 2D, with h = 2 spacings).
 constexpr double kFullNeighbourhood = 0.75;
 
+/// The weight of a boundary sample's term when it carries a pressure of its own (BoundaryPressure
+/// Mirror or Extrapolate, as in the WCSPH force): psi_b (s_i + s_b) grad W_ib with s_b = s_i is
+/// twice Akinci's psi_b s_i grad W_ib (None). The constraint's boundary term takes the same
+/// weight, so that the solve's matrix stays J M^-1 J^T (symmetric): with the force's weight alone
+/// the floor layer of the resting 2D tank oscillated (neighbours in opposite phases, at up to
+/// 0.1 m/s) and never settled.
+constexpr double kSampleWeight = 2;
+
 /// Adds the real field `name` (its units in 2D and 3D) to `ps` if absent.
 template <int D, std::floating_point R>
 void warm_field(ParticleSet<D, R>& ps, const char* name, const char* unit_2d, const char* unit_3d, const char* what) {
@@ -102,12 +110,24 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
   full_.resize(n);
   solid_.resize(n);
   solid_rate_.assign(boundary.velocity.empty() ? 0 : n, R(0));
+  // BoundaryPressure::Extrapolate: s_b = s_i + e_b, e_b = g . (x_b - x_i) / rho_i (p_b = p_i +
+  // rho_i g . (x_b - x_i), as the WCSPH force's), whose part that does not depend on s is the
+  // acceleration hydro_i = -sum_b psi_b e_b grad W_ib. A sample's pressure is clamped at 0 as
+  // WCSPH's is, by the last step's s of the particle: e_b >= -s_i (the clamp at the free surface,
+  // where a wall's samples above the particle would otherwise pull it up).
+  const bool extrapolate = boundary.active() && boundary.extrapolate;
+  hydro_.assign(extrapolate ? n : 0, Vec<D, R>{});
+  const std::ptrdiff_t warm_index = ps.added_field_index(kDensityField);
+  const std::vector<R>* last_s =
+      extrapolate && warm_index >= 0 ? &ps.real_field(static_cast<std::size_t>(warm_index)) : nullptr;
   // Floating bodies: each body's share of sum_b psi_b grad W_ib, whose pressure the solves record.
   const bool bodies = boundary.active() && !boundary.body.empty() && boundary.body_acceleration;
   bodies_ = bodies ? boundary.bodies : 0;
   body_acceleration_ = bodies ? boundary.body_acceleration : nullptr;
   body_velocity_change_ = bodies ? boundary.body_velocity_change : nullptr;
   body_solid_.assign(n * bodies_, Vec<D, R>{});
+  body_hydro_.assign(extrapolate ? n * bodies_ : 0, Vec<D, R>{});
+  const R weight = boundary.sample_pressure ? static_cast<R>(kSampleWeight) : R(1);
   // The step's pairs within h, once: each solve iteration then reads m_j grad W_ij instead of
   // evaluating the kernel again (about half the entries of a list are within h).
   begin_.resize(n + 1);
@@ -122,7 +142,8 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
   pair_j_.resize(begin_[n]);
   pair_g_.resize(begin_[n]);
   parallel_for(n, [&](std::size_t i) {
-    Vec<D, R> sum{}, solid{};
+    Vec<D, R> sum{}, solid{}, hydro{};
+    const Vec<D, R> xi = ps.position[i];
     R squares = 0;
     int count = 0;
     std::size_t k = begin_[i];
@@ -139,14 +160,23 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
         },
         [&](std::uint32_t b, const Vec<D, R>& plain) {
           const Vec<D, R> g = li ? corrected_gradient<D, R>(li, li, plain) : plain;
-          solid += g * boundary.psi[b];
-          if (!boundary.velocity.empty()) solid_rate_[i] += boundary.psi[b] * dot(boundary.velocity[b], g);
-          if (bodies_ > 0 && boundary.body[b] != 0)
-            body_solid_[i * bodies_ + boundary.body[b] - 1] += g * boundary.psi[b];
+          const R w = weight * boundary.psi[b];
+          solid += g * w;
+          if (!boundary.velocity.empty()) solid_rate_[i] += w * dot(boundary.velocity[b], g);
+          const std::size_t body = bodies_ > 0 ? boundary.body[b] : 0;
+          if (body != 0) body_solid_[i * bodies_ + body - 1] += g * w;
+          if (extrapolate) {
+            R e = dot(boundary.extrapolation, boundary.position[b] - xi) / ps.density[i];
+            if (boundary.clamp && last_s) e = std::max(e, -std::max((*last_s)[i], R(0)));
+            const Vec<D, R> a = g * (-boundary.psi[b] * e);
+            hydro += a;
+            if (body != 0) body_hydro_[i * bodies_ + body - 1] += a;
+          }
           ++count;
         });
     sum += solid;
     solid_[i] = solid;
+    if (extrapolate) hydro_[i] = hydro;
     beta_[i] = std::max(norm2(sum) + ps.mass[i] * squares, beta_floor_);
     full_[i] = count >= full_count_;
   });
@@ -200,6 +230,14 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
   acc_s_.resize(n);
   acc_p_.resize(n);
 
+  // (the extrapolated samples' push that does not depend on s acts like the other forces: the
+  // density solve's prediction sees it)
+  if (kDensity && !hydro_.empty())
+    parallel_for(n, [&](std::size_t i) {
+      ps.acceleration[i] += hydro_[i];
+      if (body_acceleration_)
+        for (std::size_t k = 0; k < bodies_; ++k) body_acceleration_[i * bodies_ + k] += body_hydro_[i * bodies_ + k];
+    });
   // The right-hand side b (an error over scale), and the warm start.
   parallel_for(n, [&](std::size_t i) {
     R err;

@@ -5,14 +5,19 @@
 ///
 /// Both solves find per-particle values s_i (a pressure over density squared, p_i / rho_i^2)
 /// whose pressure accelerations
-///   a_i(s) = -sum_j m_j (s_i + s_j) grad W_ij - sum_b psi_b s_i grad W_ib
-/// (fluid neighbours j, boundary samples b with psi_b in place of a mass and the particle's own
-/// s mirrored onto them; the symmetric pair form, so momentum is conserved) cancel a predicted
-/// density error. With the density rate of a velocity field,
-///   (J v)_i = sum_j m_j (v_i - v_j) . grad W_ij + sum_b psi_b v_i . grad W_ib,
+///   a_i(s) = -sum_j m_j (s_i + s_j) grad W_ij - sum_b w psi_b s_i grad W_ib
+/// (fluid neighbours j, boundary samples b with psi_b in place of a mass; the symmetric pair
+/// form, so momentum is conserved) cancel a predicted density error. The samples' weight w is
+/// 1 when they have no pressure of their own (BoundaryPressure::None: Akinci et al. 2012's term)
+/// and 2 when they take the particle's, s_b = s_i (Mirror, Extrapolate: psi_b (s_i + s_b)).
+/// Extrapolate adds to s_b each sample's hydrostatic head e_b = g . (x_b - x_i) / rho_i (clamped
+/// at -s_i by the last step's s), whose acceleration -sum_b psi_b e_b grad W_ib does not depend
+/// on s and joins the step's other accelerations before the density solve. With the density
+/// rate of a velocity field, the samples at the same weight,
+///   (J v)_i = sum_j m_j (v_i - v_j) . grad W_ij + sum_b w psi_b v_i . grad W_ib,
 /// the operator A s = -J a(s) is symmetric positive semi-definite (all particles have the same
 /// mass: A = J M^-1 J^T m), and its diagonal is DFSPH's factor
-///   beta_i = |sum_j m_j grad W_ij + sum_b psi_b grad W_ib|^2 + m_i sum_j m_j |grad W_ij|^2
+///   beta_i = |sum_j m_j grad W_ij + sum_b w psi_b grad W_ib|^2 + m_i sum_j m_j |grad W_ij|^2
 /// (the papers' alpha_i = rho_i / beta_i).
 ///  - The constant-density solve (after the non-pressure forces, with v* = v + dt a): the
 ///    predicted error e_i = rho_i + dt (J v*)_i - rho0 must vanish, dt^2 A s = e, and the
@@ -108,6 +113,9 @@ class DfsphSolver {
   std::vector<std::uint32_t> pair_j_;
   std::vector<Vec<D, R>> pair_g_;
   std::vector<Vec<D, R>> solid_;
+  // BoundaryPressure::Extrapolate: each particle's acceleration from its samples' pressure beyond
+  // its own (-sum_b psi_b e_b grad W_ib), and each body's share of it (empty: mirrored samples).
+  std::vector<Vec<D, R>> hydro_, body_hydro_;
   // Moving obstacles: sum_b psi_b v_b . grad W_ib, the samples' share of the density rate (empty
   // when every sample is at rest).
   std::vector<R> solid_rate_;

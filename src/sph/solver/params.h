@@ -136,6 +136,11 @@ enum class BoundaryPressure {
   /// p_b = p_i (Akinci et al. 2012's mirroring): the sample below a resting particle has the
   /// particle's pressure, less than the fluid's at its depth.
   Mirror,
+  /// p_b = 0: the sample has no pressure of its own, and its term is the particle's alone (with
+  /// the symmetric forms p_i / rho_i^2: Akinci et al. 2012's eq. 10, and SPlisHSPlasH's DFSPH
+  /// boundary term). A resting particle next to a wall then needs about twice the fluid's
+  /// pressure at its depth to be held (DFSPH's default).
+  None,
 };
 
 /// Boundary particles' settings.

@@ -313,6 +313,7 @@ BoundaryView<D, R> Simulation<D, R>::boundary_view(const NeighborLists& lists) c
   v.lists = &lists;
   v.friction = static_cast<R>(params_.boundary.friction);
   v.extrapolate = params_.boundary.pressure == BoundaryPressure::Extrapolate;
+  v.sample_pressure = params_.boundary.pressure != BoundaryPressure::None;
   v.clamp = params_.fluid.negative_pressure == NegativePressure::Clamp;
   v.extrapolation = vec_cast<R>(params_.gravity);
   return v;

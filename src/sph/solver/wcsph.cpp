@@ -424,14 +424,16 @@ class ForceTerms {
   }
 
   /// Adds particle i's boundary samples to acc (i in every lane of `s`): the pair's pressure term
-  /// with p_b = p_i, rho_b = rho_i (the paper's form: p_i / rho_i^2; the symmetric ones: 2 p_i /
-  /// rho_i^2), psi_b for the mass, and Akinci's friction, nu = sigma h c0 / (2 rho_i). Returns
-  /// whether Eq. 7 flags i for a sample.
+  /// with rho_b = rho_i and p_b mirrored (p_i: the paper's form gives p_i / rho_i^2, the symmetric
+  /// ones 2 p_i / rho_i^2), extrapolated, or 0 (BoundaryPressure), psi_b for the mass, and Akinci's friction, nu =
+  /// sigma h c0 / (2 rho_i). Returns whether Eq. 7 flags i for a sample.
   bool boundary(std::size_t i, const ForceSide<D, R>& s, P (&acc)[D]) const {
     const P zero = P::set1(R(0)), minus_one = P::set1(R(-1));
     const R* prs = ps_.pressure.data();
     const R inv_rhoi = R(1) / ps_.density[i];
-    const R pii = kForm == PressureForce::Paper ? prs[i] * inv_rhoi * inv_rhoi : R(2) * prs[i] * inv_rhoi * inv_rhoi;
+    // (BoundaryPressure::None: p_b = 0, half the mirrored term)
+    const R mirrored = (kForm == PressureForce::Paper ? R(1) : R(2)) * (boundary_.sample_pressure ? R(1) : R(0.5));
+    const R pii = mirrored * prs[i] * inv_rhoi * inv_rhoi;
     const P pii_v = P::set1(kPressure ? pii : R(0));
     // Extrapolated: P_ib = w (p_i + p_b) / rho_i^2 with w = 1/2 (paper's form) or 1, and
     // p_b / rho_i^2 = p_i / rho_i^2 - (a . x_ib) / rho_i, clamped at 0 like p.
@@ -834,7 +836,8 @@ void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, 
       acc -= corrected_gradient<D, R>(li, &L[std::size_t{j} * D * D], g) * (ps.mass[j] * pij);
     }
     if (solid) {
-      const R pii = (paper ? R(1) : R(2)) * ps.pressure[i] * inv_rhoi * inv_rhoi;
+      const R pii =
+          (paper ? R(1) : R(2)) * (boundary.sample_pressure ? R(1) : R(0.5)) * ps.pressure[i] * inv_rhoi * inv_rhoi;
       const R w = paper ? R(0.5) : R(1), pi_sym = ps.pressure[i] * inv_rhoi * inv_rhoi;
       for (const std::uint32_t b : boundary.lists->of(i)) {
         const Vec<D, R> xib = ps.position[i] - boundary.position[b];

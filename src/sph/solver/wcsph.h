@@ -27,6 +27,8 @@ struct BoundaryView {
   /// at rest), and whether p_b is clamped at 0. Mirror: `extrapolate` false, p_b = p_i.
   bool extrapolate = false;
   bool clamp = true;
+  /// BoundaryPressure::None: the sample has no pressure (p_b = 0); else mirrored or extrapolated.
+  bool sample_pressure = true;
   Vec<D, R> extrapolation{};
   /// Each sample's velocity (moving obstacles; empty: all at rest): the friction and the Eq. 7
   /// test see the fluid's velocity relative to it.

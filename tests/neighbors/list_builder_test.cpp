@@ -219,6 +219,24 @@ void expect_morton_is_stable_permutation() {
   std::vector<std::uint32_t> again;
   order.compute(x, 0.05, again);
   EXPECT_EQ(perm, again);
+  // And with a grid's arrays lent for the sort's second copies: the same permutation, the grid
+  // built afterwards as without the loan, and the lent arrays keep their room (no new block).
+  UniformGrid<D, double> grid, plain;
+  grid.build(x, 0.05);
+  const std::array<std::vector<std::uint32_t>*, 2> lent = grid.lend_scratch(x.size());
+  const std::size_t room0 = lent[0]->capacity(), room1 = lent[1]->capacity();
+  const std::uint32_t* block0 = lent[0]->data();
+  MortonOrder<D, double> borrowing;
+  std::vector<std::uint32_t> with_loan;
+  borrowing.compute(x, 0.05, with_loan, lent);
+  EXPECT_EQ(with_loan, perm);
+  EXPECT_EQ(lent[0]->capacity(), room0);
+  EXPECT_EQ(lent[1]->capacity(), room1);
+  EXPECT_EQ(lent[0]->data(), block0);
+  grid.build(x, 0.05);
+  plain.build(x, 0.05);
+  for (std::size_t i = 0; i < x.size(); ++i) ASSERT_EQ(grid.sorted()[i], plain.sorted()[i]);
+  EXPECT_EQ(lent[0]->data(), block0);  // (the build found its room)
 }
 
 TEST(MortonOrder, StablePermutationWithLocality3d) { expect_morton_is_stable_permutation<3>(); }

@@ -34,6 +34,7 @@ class AdaptiveNeighbors final : public NeighborStrategy<D, R> {
   /// The next update is a full rebuild (Simulation reorders on full-rebuild steps by default,
   /// so that this costs nothing extra).
   void invalidate() override { invalid_ = true; }
+  UniformGrid<D, R>* fluid_grid() override { return &grid_; }
   void save_state(StateWriter& out) const override;
   void load_state(StateReader& in, std::size_t particles) override;
 

@@ -38,7 +38,8 @@ std::uint64_t morton_key(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
 }
 
 template <int D, std::floating_point R>
-void MortonOrder<D, R>::compute(std::span<const Vec<D, R>> positions, R cell, std::vector<std::uint32_t>& perm) {
+void MortonOrder<D, R>::compute(std::span<const Vec<D, R>> positions, R cell, std::vector<std::uint32_t>& perm,
+                                std::array<std::vector<std::uint32_t>*, 2> scratch) {
   SPH_CHECK(cell > R(0) && std::isfinite(cell), "Morton cell size must be positive and finite");
   SPH_CHECK(positions.size() < std::numeric_limits<std::uint32_t>::max(), "too many points for 32-bit indices");
   const std::size_t n = positions.size();
@@ -67,17 +68,18 @@ void MortonOrder<D, R>::compute(std::span<const Vec<D, R>> positions, R cell, st
   int bits = 0;
   while (bits < 32 && (top >> bits) != 0) ++bits;
   // 32-bit keys whenever they are enough (half the memory and passes of 64-bit ones).
+  std::vector<std::uint32_t>& tmp = scratch[1] ? *scratch[1] : tmp_;
   if (bits * D <= 32)
-    sort_by_key(positions, lo, inv, kMaxCoord, keys32_, keys32_tmp_, perm);
+    sort_by_key(positions, lo, inv, kMaxCoord, keys32_, scratch[0] ? *scratch[0] : keys32_tmp_, perm, tmp);
   else
-    sort_by_key(positions, lo, inv, kMaxCoord, keys64_, keys64_tmp_, perm);
+    sort_by_key(positions, lo, inv, kMaxCoord, keys64_, keys64_tmp_, perm, tmp);
 }
 
 template <int D, std::floating_point R>
 template <class Key>
 void MortonOrder<D, R>::sort_by_key(std::span<const Vec<D, R>> positions, const Vec<D, R>& lo, R inv,
                                     std::uint32_t max_coord, std::vector<Key>& keys, std::vector<Key>& keys_tmp,
-                                    std::vector<std::uint32_t>& perm) {
+                                    std::vector<std::uint32_t>& perm, std::vector<std::uint32_t>& tmp) {
   const std::size_t n = positions.size();
   keys.resize(n);
   parallel_for(n, [&](std::size_t i) {
@@ -99,12 +101,17 @@ void MortonOrder<D, R>::sort_by_key(std::span<const Vec<D, R>> positions, const 
   while (passes < static_cast<int>(sizeof(Key)) && (static_cast<std::uint64_t>(all) >> (8 * passes)) != 0) ++passes;
   for (std::size_t i = 0; i < n; ++i) perm[i] = static_cast<std::uint32_t>(i);
   keys_tmp.resize(n);
-  tmp_.resize(n);
+  tmp.resize(n);
   histogram_.resize(256);
+  // Each pass scatters from one copy into the other. The buffers keep their owners (the second
+  // copies may be lent by the grid, whose room must stay its own), and a result that ends in the
+  // second copy is copied back.
+  Key *key = keys.data(), *key_out = keys_tmp.data();
+  std::uint32_t *index = perm.data(), *index_out = tmp.data();
   for (int p = 0; p < passes; ++p) {
     const int shift = 8 * p;
     std::fill(histogram_.begin(), histogram_.end(), 0u);
-    for (std::size_t i = 0; i < n; ++i) ++histogram_[(keys[i] >> shift) & 0xff];
+    for (std::size_t i = 0; i < n; ++i) ++histogram_[(key[i] >> shift) & 0xff];
     std::uint32_t sum = 0;
     for (auto& h : histogram_) {
       const std::uint32_t c = h;
@@ -112,13 +119,14 @@ void MortonOrder<D, R>::sort_by_key(std::span<const Vec<D, R>> positions, const 
       sum += c;
     }
     for (std::size_t i = 0; i < n; ++i) {
-      const std::uint32_t dst = histogram_[(keys[i] >> shift) & 0xff]++;
-      keys_tmp[dst] = keys[i];
-      tmp_[dst] = perm[i];
+      const std::uint32_t dst = histogram_[(key[i] >> shift) & 0xff]++;
+      key_out[dst] = key[i];
+      index_out[dst] = index[i];
     }
-    keys.swap(keys_tmp);
-    perm.swap(tmp_);
+    std::swap(key, key_out);
+    std::swap(index, index_out);
   }
+  if (index != perm.data()) std::copy_n(index, n, perm.data());
 }
 
 template class MortonOrder<2, float>;

@@ -3,6 +3,7 @@
 /// particles close in space are close in memory (neighbor search and the SPH loops then read
 /// memory almost sequentially, even after a flow has scrambled the particle order).
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -20,12 +21,16 @@ class MortonOrder {
   /// Points in the same cell keep their relative order (stable), so the result depends only on
   /// the input. Non-finite positions are a bug upstream (the solver stops a blow-up first): refused with
   /// std::logic_error (SPH_CHECK). cell must be > 0.
-  void compute(std::span<const Vec<D, R>> positions, R cell, std::vector<std::uint32_t>& perm);
+  /// `scratch`: two arrays the sort may use for its second copy of the 32-bit keys and of the
+  /// permutation (UniformGrid::lend_scratch), instead of its own; null: its own.
+  void compute(std::span<const Vec<D, R>> positions, R cell, std::vector<std::uint32_t>& perm,
+               std::array<std::vector<std::uint32_t>*, 2> scratch = {});
 
  private:
   template <class Key>
   void sort_by_key(std::span<const Vec<D, R>> positions, const Vec<D, R>& lo, R inv, std::uint32_t max_coord,
-                   std::vector<Key>& keys, std::vector<Key>& keys_tmp, std::vector<std::uint32_t>& perm);
+                   std::vector<Key>& keys, std::vector<Key>& keys_tmp, std::vector<std::uint32_t>& perm,
+                   std::vector<std::uint32_t>& tmp);
 
   std::vector<std::uint32_t> keys32_, keys32_tmp_;
   std::vector<std::uint64_t> keys64_, keys64_tmp_;

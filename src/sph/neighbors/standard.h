@@ -16,6 +16,7 @@ class StandardNeighbors final : public NeighborStrategy<D, R> {
   const NeighborLists& lists() const override { return lists_; }
   const NeighborCounters& counters() const override { return counters_; }
   void invalidate() override {}  // every update rebuilds everything anyway
+  UniformGrid<D, R>* fluid_grid() override { return &grid_; }
 
  private:
   R list_radius() const override { return radius_; }

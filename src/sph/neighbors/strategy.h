@@ -9,6 +9,7 @@
 #include <sph/neighbors/cluster_pairs.h>
 #include <sph/neighbors/neighbor_lists.h>
 #include <sph/neighbors/neighbor_mode.h>
+#include <sph/neighbors/uniform_grid.h>
 
 namespace sph {
 
@@ -97,6 +98,10 @@ class NeighborStrategy {
   /// The particles were reordered in memory: the lists refer to old indices, so the next
   /// update() rebuilds every list (and restarts whatever the strategy tracks per particle).
   virtual void invalidate() = 0;
+  /// The grid of the fluid particles, whose arrays a reorder may borrow as scratch
+  /// (UniformGrid::lend_scratch) before invalidate(): its next update() builds it again before
+  /// reading it. Null for a strategy without one.
+  virtual UniformGrid<D, R>* fluid_grid() { return nullptr; }
 
   /// Writes what the strategy carries from one update() to the next (checkpoints: lists,
   /// flags, reference positions), so that a resumed run makes exactly the choices the

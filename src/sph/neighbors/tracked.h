@@ -62,6 +62,7 @@ class TrackedNeighbors final : public NeighborStrategy<D, R> {
     return exit_test_ ? std::span<std::uint8_t>(flags_) : std::span<std::uint8_t>{};
   }
   void invalidate() override { invalid_ = true; }
+  UniformGrid<D, R>* fluid_grid() override { return &grid_; }
   void set_time(double t) override { time_ = t; }
   void save_state(StateWriter& out) const override;
   void load_state(StateReader& in, std::size_t particles) override;

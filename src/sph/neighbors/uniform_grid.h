@@ -97,6 +97,18 @@ class UniformGrid {
   /// Maximum number of dense cells, relative to the point count (plus a constant).
   static constexpr std::size_t kMaxCellsPerPoint = 8;
 
+  /// The grid's two arrays of a 32-bit value per point (the sorted indices and each point's
+  /// cell), lent as scratch for n values to a caller that builds the grid again before it is
+  /// queried (the Morton reorder's sort: the reorder invalidates the lists, so the next update
+  /// builds the grid first). Their contents are lost. They get the room a build of n points
+  /// needs first, so that the build after the caller's use does not allocate (a block outgrown
+  /// and freed can stay resident).
+  std::array<std::vector<std::uint32_t>*, 2> lend_scratch(std::size_t n) {
+    sorted_.reserve(n + kPad);
+    cell_of_.reserve(n);
+    return {&sorted_, &cell_of_};
+  }
+
  private:
   /// Sets origin_, inv_cell_ and dims_ for `positions` (cells of size >= radius, at most
   /// kMaxCellsPerPoint per point plus a constant); returns the number of cells.

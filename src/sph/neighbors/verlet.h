@@ -28,6 +28,7 @@ class VerletNeighbors final : public NeighborStrategy<D, R> {
   const ClusterPairs<D, R>* cluster_pairs() const override { return clusters_ ? &pairs_ : nullptr; }
   const NeighborCounters& counters() const override { return counters_; }
   void invalidate() override { built_at_.clear(); }  // the next update rebuilds
+  UniformGrid<D, R>* fluid_grid() override { return &grid_; }
   void save_state(StateWriter& out) const override;
   void load_state(StateReader& in, std::size_t particles) override;
 

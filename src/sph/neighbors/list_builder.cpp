@@ -196,12 +196,14 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
   const R r2 = radius * radius;
   const std::size_t chunks = chunk_count(n);
   out.chunks_.resize(chunks);
-  out.begin_.resize(n);
   out.end_.resize(n);
-  if (room_)
+  if (room_) {
+    out.begin_.resize(n);
     out.cap_.resize(n);
-  else
+  } else {
+    out.begin_.clear();
     out.cap_.clear();
+  }
   chunk_entries_.resize(chunks);
   old_copy_.resize(static_cast<std::size_t>(num_threads()));
 
@@ -220,7 +222,7 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
       ensure_room(buf, used + st.candidates + kRoom);
       std::uint32_t m = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + used);
       if (filter_) m = filter_->keep(i, buf.data() + used, m);
-      out.begin_[i] = static_cast<std::uint32_t>(used);
+      if (room_) out.begin_[i] = static_cast<std::uint32_t>(used);
       out.end_[i] = static_cast<std::uint32_t>(used + m);
       entries += m;
       used += m;
@@ -256,9 +258,8 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
   const R r2 = radius * radius;
   const std::size_t chunks = chunk_count(n);
   lists.chunks_.resize(chunks);
-  lists.begin_.resize(n);
   lists.end_.resize(n);
-  if (room_) lists.cap_.resize(n);
+  if (room_) lists.begin_.resize(n), lists.cap_.resize(n);
   chunk_entries_.resize(chunks);
   chunk_written_.assign(chunks, 0);
 
@@ -268,7 +269,7 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
   std::size_t largest_old = 0;
   for (std::size_t c = 0; c * kChunkSize < old_n; ++c) {
     const std::size_t last = std::min(old_n, (c + 1) * kChunkSize) - 1;
-    largest_old = std::max<std::size_t>(largest_old, lists.begin_[last] + lists.capacity(last));
+    largest_old = std::max<std::size_t>(largest_old, lists.begin(last) + lists.capacity(last));
   }
   old_copy_.resize(static_cast<std::size_t>(num_threads()));
   for (auto& copy : old_copy_) ensure_room(copy, largest_old);
@@ -296,11 +297,14 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
     // belongs to the chunk and keeps its room, so it grows only when the chunk's lists do.
     std::vector<std::uint32_t>& buf = lists.chunks_[c];
     const std::size_t last_old = std::min(e, old_n);  // particles [b, last_old) had lists
-    const std::size_t old_size = last_old > b ? lists.begin_[last_old - 1] + lists.capacity(last_old - 1) : 0;
+    const std::size_t old_size = last_old > b ? lists.begin(last_old - 1) + lists.capacity(last_old - 1) : 0;
     std::vector<std::uint32_t>& old_copy = old_copy_[static_cast<std::size_t>(thread_index())];
     std::copy_n(buf.data(), old_size, old_copy.data());
     Stencil<D, R> st;
     std::size_t at = 0, entries = 0, written = 0;
+    // (the old lists have no room of their own here, so each started at the end of the one
+    // before it: that old end, read before list i - 1's is rewritten)
+    std::uint32_t old_end = 0;
     for (std::size_t i = b; i < e; ++i) {
       std::uint32_t len = 0, cap = 0;
       if (marked(i)) {
@@ -312,14 +316,14 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
         cap = room_ ? list_capacity(len) : len;
         ensure_room(buf, at + cap + kRoom);
       } else {
-        const std::uint32_t old_begin = lists.begin_[i];
-        len = lists.end_[i] - old_begin;
-        cap = static_cast<std::uint32_t>(lists.capacity(i));
+        len = lists.end_[i] - old_end;
+        cap = len;
         ensure_room(buf, at + cap + kRoom);
-        std::copy_n(old_copy.data() + old_begin, len, buf.data() + at);
+        std::copy_n(old_copy.data() + old_end, len, buf.data() + at);
       }
       std::fill_n(buf.data() + at + len, cap - len, 0u);  // a list's room holds valid indices
-      lists.begin_[i] = static_cast<std::uint32_t>(at);
+      if (i < old_n) old_end = lists.end_[i];
+      if (room_) lists.begin_[i] = static_cast<std::uint32_t>(at);
       lists.end_[i] = static_cast<std::uint32_t>(at + len);
       if (room_) lists.cap_[i] = cap;
       at += cap;

@@ -12,7 +12,7 @@ void NeighborLists::add_chunk_entries(std::span<std::uint64_t> work) const {
   SPH_CHECK(work.size() == chunk_count(particle_count()), "one work figure per chunk of the lists' particles");
   parallel_chunks(particle_count(), [&](std::size_t c, std::size_t b, std::size_t e) {
     std::uint64_t entries = 0;
-    for (std::size_t i = b; i < e; ++i) entries += end_[i] - begin_[i];
+    for (std::size_t i = b; i < e; ++i) entries += end_[i] - begin(i);
     work[c] += entries;
   });
 }
@@ -28,12 +28,10 @@ NeighborLists NeighborLists::from(const std::vector<std::vector<std::uint32_t>>&
   NeighborLists out;
   const std::size_t n = lists.size();
   out.chunks_.resize(chunk_count(n));
-  out.begin_.resize(n);
   out.end_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     auto& chunk = out.chunks_[i / kChunkSize];
     SPH_CHECK(chunk.size() + lists[i].size() < (std::size_t{1} << 32), "neighbor list chunk too large");
-    out.begin_[i] = static_cast<std::uint32_t>(chunk.size());
     chunk.insert(chunk.end(), lists[i].begin(), lists[i].end());
     out.end_[i] = static_cast<std::uint32_t>(chunk.size());
     out.entries_ += lists[i].size();
@@ -46,10 +44,10 @@ bool NeighborLists::padding_is_valid() const {
   const std::size_t n = particle_count();
   for (std::size_t c = 0; c < chunks_.size(); ++c) {
     const std::size_t last = std::min(n, (c + 1) * kChunkSize) - 1;
-    const std::size_t end = begin_[last] + capacity(last);
+    const std::size_t end = begin(last) + capacity(last);
     if (chunks_[c].size() < end + kPadding) return false;
     for (std::size_t i = c * kChunkSize; i <= last; ++i)  // a list's unused room, too
-      for (std::size_t k = end_[i]; k < begin_[i] + capacity(i); ++k)
+      for (std::size_t k = end_[i]; k < begin(i) + capacity(i); ++k)
         if (chunks_[c][k] >= n) return false;
     for (std::size_t k = end; k < end + kPadding; ++k)
       if (chunks_[c][k] >= n) return false;
@@ -63,7 +61,7 @@ void NeighborLists::save(StateWriter& out) const {
   const std::size_t n = end_.size();
   std::vector<std::uint32_t> end(n);
   std::vector<std::uint32_t> data;
-  for (std::size_t i = 0; i < n; ++i) end[i] = (i % kChunkSize != 0 ? end[i - 1] : 0) + (end_[i] - begin_[i]);
+  for (std::size_t i = 0; i < n; ++i) end[i] = (i % kChunkSize != 0 ? end[i - 1] : 0) + (end_[i] - begin(i));
   out.put(end);
   for (std::size_t c = 0; c < chunks_.size(); ++c) {
     data.clear();
@@ -85,12 +83,10 @@ void NeighborLists::load(StateReader& in, std::size_t index_limit) {
   const std::size_t n = end_.size();
   const std::size_t limit = index_limit > 0 ? index_limit : n;
   chunks_.resize(chunk_count(n));
-  begin_.resize(n);
   for (std::size_t c = 0; c < chunks_.size(); ++c) {
     const std::size_t first = c * kChunkSize, last = std::min(n, first + kChunkSize) - 1;
     for (std::size_t i = first + 1; i <= last; ++i)
       in.expect(end_[i - 1] <= end_[i], "neighbor list offsets go backwards");
-    for (std::size_t i = first; i <= last; ++i) begin_[i] = i == first ? 0 : end_[i - 1];
     std::vector<std::uint32_t>& chunk = chunks_[c];
     in.get(chunk);
     in.expect(chunk.size() == end_[last], "a neighbor list chunk of the wrong length");
@@ -102,7 +98,10 @@ void NeighborLists::load(StateReader& in, std::size_t index_limit) {
   in.get(cap);
   in.expect(cap.empty() || cap.size() == n, "neighbor list capacities do not match the lists");
   if (cap.empty()) return;
-  for (std::size_t i = 0; i < n; ++i) in.expect(cap[i] >= end_[i] - begin_[i], "a neighbor list over its capacity");
+  for (std::size_t i = 0; i < n; ++i) in.expect(cap[i] >= end_[i] - begin(i), "a neighbor list over its capacity");
+  // (with room: the starts of the compact layout, which relayout_chunk lays the room into)
+  begin_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) begin_[i] = i % kChunkSize != 0 ? end_[i - 1] : 0;
   cap_ = std::move(cap);
   std::vector<std::uint32_t> scratch;
   for (std::size_t c = 0; c < chunks_.size(); ++c) relayout_chunk(c, scratch, [](std::size_t) { return 0; });

@@ -41,10 +41,18 @@ class NeighborLists {
   /// Number of stored (directed) entries: twice the number of pairs for symmetric lists.
   std::size_t entry_count() const { return entries_; }
   std::span<const std::uint32_t> of(std::size_t i) const {
-    return {chunks_[i / kChunkSize].data() + begin_[i], end_[i] - begin_[i]};
+    const std::uint32_t b = begin(i);
+    return {chunks_[i / kChunkSize].data() + b, end_[i] - b};
+  }
+  /// Where list i starts in its chunk's buffer: lists without room of their own lie one after
+  /// the other, each from the last one's end (no start is stored: 4 bytes a particle); lists with
+  /// room keep their starts.
+  std::uint32_t begin(std::size_t i) const {
+    if (!begin_.empty()) return begin_[i];
+    return i % kChunkSize != 0 ? end_[i - 1] : 0;
   }
   /// Slots list i may fill before its chunk is laid out again (its size without room of its own).
-  std::size_t capacity(std::size_t i) const { return cap_.empty() ? end_[i] - begin_[i] : cap_[i]; }
+  std::size_t capacity(std::size_t i) const { return cap_.empty() ? end_[i] - begin(i) : cap_[i]; }
   /// Whether the lists keep room of their own (capacity() beyond their size).
   bool has_room() const { return !cap_.empty(); }
   void clear() {
@@ -89,9 +97,9 @@ class NeighborLists {
   void relayout_chunk(std::size_t c, std::vector<std::uint32_t>& scratch, const NewCap& new_cap);
 
   std::vector<std::vector<std::uint32_t>> chunks_;  // chunk c: lists of particles [c K, (c+1) K)
-  std::vector<std::uint32_t> begin_;                // start of list i in its chunk's buffer
-  std::vector<std::uint32_t> end_;                  // end of list i in its chunk's buffer
-  std::vector<std::uint32_t> cap_;                  // lists with room of their own: capacity of list i; else empty
+  std::vector<std::uint32_t> begin_;  // lists with room: start of list i in its chunk's buffer; else empty
+  std::vector<std::uint32_t> end_;    // end of list i in its chunk's buffer
+  std::vector<std::uint32_t> cap_;    // lists with room of their own: capacity of list i; else empty
   std::size_t entries_ = 0;
 };
 

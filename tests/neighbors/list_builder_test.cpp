@@ -221,22 +221,44 @@ void expect_morton_is_stable_permutation() {
   EXPECT_EQ(perm, again);
   // And with a grid's arrays lent for the sort's second copies: the same permutation, the grid
   // built afterwards as without the loan, and the lent arrays keep their room (no new block).
-  UniformGrid<D, double> grid, plain;
-  grid.build(x, 0.05);
-  const std::array<std::vector<std::uint32_t>*, 2> lent = grid.lend_scratch(x.size());
-  const std::size_t room0 = lent[0]->capacity(), room1 = lent[1]->capacity();
-  const std::uint32_t* block0 = lent[0]->data();
-  MortonOrder<D, double> borrowing;
-  std::vector<std::uint32_t> with_loan;
-  borrowing.compute(x, 0.05, with_loan, lent);
-  EXPECT_EQ(with_loan, perm);
-  EXPECT_EQ(lent[0]->capacity(), room0);
-  EXPECT_EQ(lent[1]->capacity(), room1);
-  EXPECT_EQ(lent[0]->data(), block0);
-  grid.build(x, 0.05);
-  plain.build(x, 0.05);
-  for (std::size_t i = 0; i < x.size(); ++i) ASSERT_EQ(grid.sorted()[i], plain.sorted()[i]);
-  EXPECT_EQ(lent[0]->data(), block0);  // (the build found its room)
+  // Cells of 0.05 take 2 radix passes, of 0.004 3 (the result copied back from the second copy),
+  // and 3D cells of 0.0002 need 64-bit keys.
+  for (const double cell : {0.05, 0.004, 0.0002}) {
+    std::vector<std::uint32_t> own;
+    MortonOrder<D, double>().compute(x, cell, own);
+    // (the reference: a stable sort of the indices by their Morton keys, computed here)
+    Vec<D, double> lo = x[0];
+    for (const auto& p : x)
+      for (int d = 0; d < D; ++d) lo[d] = std::min(lo[d], p[d]);
+    const double inv = 1.0 / cell;
+    std::vector<std::uint64_t> key(x.size());
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      std::uint32_t c[3] = {0, 0, 0};
+      for (int d = 0; d < D; ++d) c[d] = static_cast<std::uint32_t>((x[i][d] - lo[d]) * inv);
+      key[i] = D == 2 ? morton_key(c[0], c[1]) : morton_key(c[0], c[1], c[2]);
+    }
+    std::vector<std::uint32_t> reference(x.size());
+    std::iota(reference.begin(), reference.end(), 0u);
+    std::stable_sort(reference.begin(), reference.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return key[a] < key[b]; });
+    EXPECT_EQ(own, reference) << cell;
+    UniformGrid<D, double> grid, plain;
+    grid.build(x, 0.05);
+    const std::array<std::vector<std::uint32_t>*, 2> lent = grid.lend_scratch(x.size());
+    const std::size_t room0 = lent[0]->capacity(), room1 = lent[1]->capacity();
+    const std::uint32_t* block0 = lent[0]->data();
+    MortonOrder<D, double> borrowing;
+    std::vector<std::uint32_t> with_loan;
+    borrowing.compute(x, cell, with_loan, lent);
+    EXPECT_EQ(with_loan, own) << cell;
+    EXPECT_EQ(lent[0]->capacity(), room0);
+    EXPECT_EQ(lent[1]->capacity(), room1);
+    EXPECT_EQ(lent[0]->data(), block0);
+    grid.build(x, 0.05);
+    plain.build(x, 0.05);
+    for (std::size_t i = 0; i < x.size(); ++i) ASSERT_EQ(grid.sorted()[i], plain.sorted()[i]) << cell;
+    EXPECT_EQ(lent[0]->data(), block0);  // (the build found its room)
+  }
 }
 
 TEST(MortonOrder, StablePermutationWithLocality3d) { expect_morton_is_stable_permutation<3>(); }

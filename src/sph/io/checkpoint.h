@@ -24,22 +24,23 @@
 
 namespace sph {
 
-/// The format version this build writes and reads. Version 10 stores the floating bodies' states
-/// (RigidBodyState, after the emitters') and the frames' body rows (bodies.csv). Version 9 stores DFSPH's last
-/// constant-density solve (iterations, error, converged: the next CFL step depends on it) after the last CFL step.
-/// Version 8 stores the simulated time and the
-/// last CFL step after the step count, and each emitter's next batch time (TimeStepping::Cfl).
-/// Version 7 changes no byte but the meaning of
-/// the scene text it carries: a boundary-particle scene without Configuration.boundaryPressure
-/// now runs with the extrapolated pressure, where version 6's ran with the mirrored one, so a
-/// version 6 checkpoint would not resume the run it saved. Version 6 stores each neighbor list's capacity
-/// after the lists (NeighborLists::save) and knows the tracked modes. Version 4 records the run's identity (run id
-/// and scene fingerprint) after --checkpoint-every, and the health monitor's state
+/// The format version this build writes and reads. Version 12 changes no byte but the meaning of
+/// a DFSPH scene's boundaryPressure: the scene text of a version 11 checkpoint always carries
+/// "extrapolate" (the writer writes the key, and it was the default), which DFSPH ignored; now
+/// DFSPH follows it, so a version 11 DFSPH checkpoint would not resume the run it saved. Version 10 stores the floating
+/// bodies' states (RigidBodyState, after the emitters') and the frames' body rows (bodies.csv). Version 9 stores
+/// DFSPH's last constant-density solve (iterations, error, converged: the next CFL step depends on it) after the last
+/// CFL step. Version 8 stores the simulated time and the last CFL step after the step count, and each emitter's next
+/// batch time (TimeStepping::Cfl). Version 7 changes no byte but the meaning of the scene text it carries: a
+/// boundary-particle scene without Configuration.boundaryPressure now runs with the extrapolated pressure, where
+/// version 6's ran with the mirrored one, so a version 6 checkpoint would not resume the run it saved. Version 6 stores
+/// each neighbor list's capacity after the lists (NeighborLists::save) and knows the tracked modes. Version 4 records
+/// the run's identity (run id and scene fingerprint) after --checkpoint-every, and the health monitor's state
 /// (HealthMonitor::save_state) after the neighbor strategy's. Version 3 stores the particle fields by
 /// name and kind, in kParticleFields order, then the fields a run added (ParticleSet::save);
 /// version 2 kept the frames' times and the schedule's next tick instead of version 1's .vtu
 /// file list.
-inline constexpr std::uint32_t kCheckpointVersion = 11;
+inline constexpr std::uint32_t kCheckpointVersion = 12;
 /// The checkpoint's file name in a run's output directory.
 inline constexpr const char* kCheckpointFile = "checkpoint.sphc";
 

@@ -259,7 +259,10 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
   const std::size_t chunks = chunk_count(n);
   lists.chunks_.resize(chunks);
   lists.end_.resize(n);
-  if (room_) lists.begin_.resize(n), lists.cap_.resize(n);
+  if (room_) {
+    lists.begin_.resize(n);
+    lists.cap_.resize(n);
+  }
   chunk_entries_.resize(chunks);
   chunk_written_.assign(chunks, 0);
 

@@ -147,6 +147,7 @@ enum class BoundaryPressure {
 struct BoundaryParams {
   BoundaryHandling handling = BoundaryHandling::Penalty;
   BoundaryVolume volume = BoundaryVolume::RestFluid;
+  /// (the scene reader's default is None with DFSPH: SimulationMethod::Dfsph)
   BoundaryPressure pressure = BoundaryPressure::Extrapolate;
   /// Akinci et al. 2012's boundary viscosity sigma: nu = sigma h c0 / (2 rho_i) on approaching
   /// fluid-boundary pairs (0: free slip). It is also what damps sound waves at the walls

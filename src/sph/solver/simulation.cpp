@@ -472,13 +472,14 @@ const StepInfo& Simulation<D, R>::step() {
   double reorder_seconds = 0;
   if (params_.reorder_period > 0 && steps_ % params_.reorder_period == 0 && particles_.size() > 1) {
     Stopwatch reorder;
-    // (the sort's second copies borrowed from the fluid grid, rebuilt after the reorder anyway:
-    // 8 bytes a particle less at the peak)
+    // The lists refer to the old indices: invalidated first, so that the fluid grid, whose arrays
+    // the sort borrows for its second copies (8 bytes a particle less at the peak), is built
+    // again before anything reads it, even if the sort throws.
+    neighbors_->invalidate();
     UniformGrid<D, R>* grid = neighbors_->fluid_grid();
     morton_.compute(particles_.position, h, perm_,
                     grid ? grid->lend_scratch(particles_.size()) : std::array<std::vector<std::uint32_t>*, 2>{});
     particles_.permute(perm_);
-    neighbors_->invalidate();
     info.reordered = true;
     reorder_seconds = reorder.lap();
   }

@@ -293,31 +293,52 @@ TEST(BoundaryForces, TheExitTestFlagsAParticleForItsBoundaryPairs) {
   EXPECT_EQ(flags[0], 0);
 }
 
+/// One particle at rest 6 mm above the floor of filled_box_params' 2D box (`kernel`, the pressure
+/// force's `form`), with the floor's samples listed, its density from the density pass and its
+/// pressure set to 500 Pa. acceleration(): the force pass's, with no gravity and no wall springs,
+/// through `view` as the test has set it.
+struct FloorParticle {
+  FloorParticle(KernelKind kernel, PressureForce form)
+      : p(filled_box_params<2>(10, kernel)), b(make_boundary<2, double>(p)), s(p.kernel_radius) {
+    p.fluid.pressure_force = form;
+    ps.add(V2{0.05, 0.006}, V2{}, p.particle_mass);
+    s.set_boundary(b.position);
+    s.update(ps);
+    view = BoundaryView<2, double>{b.position, b.psi, &s.boundary_lists(), 0};
+    compute_density_pressure(ps, s.lists(), p.kernel_radius, p.fluid, view);
+    ps.pressure[0] = 500;
+  }
+  FloorParticle(const FloorParticle&) = delete;  // (view points into b and s)
+  FloorParticle& operator=(const FloorParticle&) = delete;
+  V2 acceleration() {
+    const WallContact<2, double> none(p.container, p.obstacles, p.particle_radius, p.walls, false);
+    compute_accelerations(ps, s.lists(), p.kernel_radius, p.fluid, V2{}, none, {}, 0.0, view);
+    return ps.acceleration[0];
+  }
+  SimulationParams<2> p;
+  ParticleSet<2, double> ps;
+  BoundarySet<2, double> b;
+  StandardNeighbors<2, double> s;
+  BoundaryView<2, double> view;
+};
+
 TEST(BoundaryForces, ExtrapolatedPressureAddsEachSamplesHydrostaticHead) {
   // A particle at rest next to the floor, its pressure set by hand: with the extrapolated
   // boundary pressure each sample b pushes with p_b = p_i + rho_i g . (x_b - x_i) instead of p_i,
   // so the difference between the two is exactly sum_b psi_b (g . x_ib / rho_i) grad W_ib (the
   // symmetric form's weight 1), and it points up (the samples below carry more pressure).
   for (const KernelKind kernel : {KernelKind::Cubic, KernelKind::Paper}) {
-    SimulationParams<2> p = filled_box_params<2>(10, kernel);
-    p.fluid.pressure_force = PressureForce::Symmetric;
-    ParticleSet<2, double> ps;
-    ps.add(V2{0.05, 0.006}, V2{}, p.particle_mass);
-    const BoundarySet<2, double> b = make_boundary<2, double>(p);
-    StandardNeighbors<2, double> s(p.kernel_radius);
-    s.set_boundary(b.position);
-    s.update(ps);
+    FloorParticle f(kernel, PressureForce::Symmetric);
+    const SimulationParams<2>& p = f.p;
+    ParticleSet<2, double>& ps = f.ps;
+    const BoundarySet<2, double>& b = f.b;
+    StandardNeighbors<2, double>& s = f.s;
+    BoundaryView<2, double>& view = f.view;
     const V2 g{0, -9.81};
-    BoundaryView<2, double> view{b.position, b.psi, &s.boundary_lists(), 0};
-    compute_density_pressure(ps, s.lists(), p.kernel_radius, p.fluid, view);
-    ps.pressure[0] = 500;
-    const WallContact<2, double> none(p.container, p.obstacles, p.particle_radius, p.walls, false);
-    compute_accelerations(ps, s.lists(), p.kernel_radius, p.fluid, V2{}, none, {}, 0.0, view);
-    const V2 mirrored = ps.acceleration[0];
+    const V2 mirrored = f.acceleration();
     view.extrapolate = true;
     view.extrapolation = g;
-    compute_accelerations(ps, s.lists(), p.kernel_radius, p.fluid, V2{}, none, {}, 0.0, view);
-    const V2 extrapolated = ps.acceleration[0];
+    const V2 extrapolated = f.acceleration();
     const SmoothingKernels<2, double> kernels(p.fluid, p.kernel_radius);
     V2 expected{};
     const double rho = ps.density[0];
@@ -335,11 +356,9 @@ TEST(BoundaryForces, ExtrapolatedPressureAddsEachSamplesHydrostaticHead) {
     ps.position[0] = V2{0.05, 0.094};
     s.update(ps);
     ps.pressure[0] = 0;
-    compute_accelerations(ps, s.lists(), p.kernel_radius, p.fluid, V2{}, none, {}, 0.0, view);
-    EXPECT_EQ(ps.acceleration[0][1], 0);
+    EXPECT_EQ(f.acceleration()[1], 0);
     view.clamp = false;  // negative pressure allowed: the lid's samples pull
-    compute_accelerations(ps, s.lists(), p.kernel_radius, p.fluid, V2{}, none, {}, 0.0, view);
-    EXPECT_GT(ps.acceleration[0][1], 0);
+    EXPECT_GT(f.acceleration()[1], 0);
   }
 }
 
@@ -348,24 +367,12 @@ TEST(BoundaryForces, ASampleWithoutPressureGivesHalfTheMirroredTerm) {
   // one is (p_i + p_i), in both pressure forms; with no friction, no gravity and no fluid
   // neighbour the acceleration is the samples' alone, and exactly halves.
   for (const PressureForce form : {PressureForce::Symmetric, PressureForce::Paper}) {
-    SimulationParams<2> p = filled_box_params<2>(10, KernelKind::Cubic);
-    p.fluid.pressure_force = form;
-    ParticleSet<2, double> ps;
-    ps.add(V2{0.05, 0.006}, V2{}, p.particle_mass);
-    const BoundarySet<2, double> b = make_boundary<2, double>(p);
-    StandardNeighbors<2, double> s(p.kernel_radius);
-    s.set_boundary(b.position);
-    s.update(ps);
-    BoundaryView<2, double> view{b.position, b.psi, &s.boundary_lists(), 0};
-    compute_density_pressure(ps, s.lists(), p.kernel_radius, p.fluid, view);
-    ps.pressure[0] = 500;
-    const WallContact<2, double> walls(p.container, p.obstacles, p.particle_radius, p.walls, false);
-    compute_accelerations(ps, s.lists(), p.kernel_radius, p.fluid, V2{}, walls, {}, 0.0, view);
-    const V2 mirrored = ps.acceleration[0];
-    view.sample_pressure = false;
-    compute_accelerations(ps, s.lists(), p.kernel_radius, p.fluid, V2{}, walls, {}, 0.0, view);
+    FloorParticle f(KernelKind::Cubic, form);
+    const V2 mirrored = f.acceleration();
+    f.view.sample_pressure = false;
+    const V2 without = f.acceleration();
     ASSERT_GT(mirrored[1], 0);  // (the floor pushes up)
-    for (int d = 0; d < 2; ++d) EXPECT_NEAR(ps.acceleration[0][d], 0.5 * mirrored[d], 1e-12 * mirrored[1]) << d;
+    for (int d = 0; d < 2; ++d) EXPECT_NEAR(without[d], 0.5 * mirrored[d], 1e-12 * mirrored[1]) << d;
   }
 }
 
@@ -439,7 +446,9 @@ void check_dfsph_samples(BoundaryPressure pressure) {
     for (int d = 0; d < D; ++d) EXPECT_NEAR(ps.acceleration[i][d], expected[d], 1e-12 * (1 + norm(head[i]))) << i;
     up = std::max(up, ps.acceleration[i][1]);
   }
-  if (pressure == BoundaryPressure::Extrapolate) EXPECT_GT(up, 1.0);  // (m/s^2: the floor layer is pushed up)
+  if (pressure == BoundaryPressure::Extrapolate) {
+    EXPECT_GT(up, 1.0);  // (m/s^2: the floor layer is pushed up)
+  }
 }
 
 TEST(BoundaryForces, DfsphSamplesWithoutPressure2D) { check_dfsph_samples<2>(BoundaryPressure::None); }

@@ -9,8 +9,14 @@ at 0.2 m). Runs it for 1 s with DFSPH under each Configuration.boundaryPressure,
 compressible SPH (stiffness 4000, CFL steps) under the extrapolated one, and prints the box's
 centre height (m) and vertical velocity (m/s) at 0.05, 0.2, 0.5 and 1 s.
 
-    PYTHONPATH=build/python python3 scripts/submerged_body.py
+    PYTHONPATH=build/python python3 scripts/submerged_body.py [KEY=VALUE ...]
+
+Each KEY=VALUE (VALUE JSON, as `sph run --set`) is applied to every run, e.g.
+`Configuration.cflMaxTimeStepSize=0.001` or `Obstacles[0].density=1100`.
 """
+import json
+import sys
+
 import sph
 
 SCENE = {
@@ -37,8 +43,15 @@ RUNS = [
 
 print("| run | steps | " + " | ".join(f"t = {t} s: y, v_y" for t in (0.05, 0.2, 0.5, 1.0)) + " |")
 print("| --- | ---: |" + " ---: |" * 4)
+extra = {}
+for arg in sys.argv[1:]:
+    key, _, value = arg.partition("=")
+    try:
+        extra[key] = json.loads(value)
+    except json.JSONDecodeError:
+        extra[key] = value
 for label, overrides in RUNS:
-    sim = sph.Simulation(sph.Scene.from_dict(SCENE, overrides))
+    sim = sph.Simulation(sph.Scene.from_dict(SCENE, {**overrides, **extra}))
     cells = []
     for t in (0.05, 0.2, 0.5, 1.0):
         while sim.time < t - 1e-9:

@@ -127,9 +127,15 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
   body_velocity_change_ = bodies ? boundary.body_velocity_change : nullptr;
   body_solid_.assign(n * bodies_, Vec<D, R>{});
   body_hydro_.assign(extrapolate ? n * bodies_ : 0, Vec<D, R>{});
+  if (bodies_ > 0 && boundary.body_response.size() == bodies_)
+    body_response_.assign(boundary.body_response.begin(), boundary.body_response.end());
+  else
+    body_response_.clear();
+  gravity_ = boundary.extrapolation;
   const R weight = boundary.sample_pressure ? static_cast<R>(kSampleWeight) : R(1);
   // The step's pairs within h, once: each solve iteration then reads m_j grad W_ij instead of
   // evaluating the kernel again (about half the entries of a list are within h).
+  near_body_.assign(body_response_.empty() ? 0 : n, 0);
   begin_.resize(n + 1);
   parallel_for(n, [&](std::size_t i) {
     std::uint32_t count = 0;
@@ -143,6 +149,7 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
   pair_g_.resize(begin_[n]);
   parallel_for(n, [&](std::size_t i) {
     Vec<D, R> sum{}, solid{}, hydro{};
+    bool near_body = false;
     const Vec<D, R> xi = ps.position[i];
     R squares = 0;
     int count = 0;
@@ -164,7 +171,7 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
           solid += g * w;
           if (!boundary.velocity.empty()) solid_rate_[i] += w * dot(boundary.velocity[b], g);
           const std::size_t body = bodies_ > 0 ? boundary.body[b] : 0;
-          if (body != 0) body_solid_[i * bodies_ + body - 1] += g * w;
+          if (body != 0) body_solid_[i * bodies_ + body - 1] += g * w, near_body = true;
           if (extrapolate) {
             R e = dot(boundary.extrapolation, boundary.position[b] - xi) / ps.density[i];
             if (boundary.clamp && last_s) e = std::max(e, -std::max((*last_s)[i], R(0)));
@@ -177,9 +184,26 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
     sum += solid;
     solid_[i] = solid;
     if (extrapolate) hydro_[i] = hydro;
-    beta_[i] = std::max(norm2(sum) + ps.mass[i] * squares, beta_floor_);
+    // (strong coupling: each body's answer to i's own pressure, m_i (|g_ik|^2 / M_k + t . I_k^-1 t),
+    // t = (x_i - c_k) x g_ik)
+    R coupled = 0;
+    for (std::size_t k = 0; k < body_response_.size(); ++k) {
+      const Vec<D, R>& g = body_solid_[i * bodies_ + k];
+      const Vec<3, R> t = body_moment(k, xi, g);
+      const std::array<double, 9>& inv = body_response_[k].inverse_inertia;
+      double turn = 0;
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) turn += double(t[a]) * inv[a * 3 + b] * double(t[b]);
+      coupled += static_cast<R>(body_response_[k].inverse_mass * double(norm2(g)) + turn);
+    }
+    beta_[i] = std::max(norm2(sum) + ps.mass[i] * (squares + coupled), beta_floor_);
+    if (!body_response_.empty()) near_body_[i] = near_body;
     full_[i] = count >= full_count_;
   });
+  // (strong coupling: the particles that touch a body, in order, which the bodies' sums visit)
+  body_particles_.clear();
+  for (std::size_t i = 0; i < near_body_.size(); ++i)
+    if (near_body_[i]) body_particles_.push_back(static_cast<std::uint32_t>(i));
 }
 
 template <int D, std::floating_point R>
@@ -202,9 +226,75 @@ void DfsphSolver<D, R>::accelerations(const std::vector<R>& x, std::vector<Vec<D
 }
 
 template <int D, std::floating_point R>
-void DfsphSolver<D, R>::apply(const std::vector<R>& x, std::vector<Vec<D, R>>& out, std::vector<R>& ax) {
+Vec<3, R> DfsphSolver<D, R>::body_moment(std::size_t k, const Vec<D, R>& x, const Vec<D, R>& g) const {
+  const Vec<D, R> r = x - vec_cast<R>(body_response_[k].center);
+  if constexpr (D == 2) {
+    return {{R(0), R(0), r[0] * g[1] - r[1] * g[0]}};
+  } else {
+    return {{r[1] * g[2] - r[2] * g[1], r[2] * g[0] - r[0] * g[2], r[0] * g[1] - r[1] * g[0]}};
+  }
+}
+
+template <int D, std::floating_point R>
+template <class F>
+void DfsphSolver<D, R>::body_motions(const ParticleSet<D, R>& ps, F&& force, std::vector<BodyMotion>& out) {
+  const std::size_t nb = body_response_.size();
+  out.assign(nb, BodyMotion{});
+  if (nb == 0) return;
+  constexpr std::size_t kPer = D + 3;
+  const std::size_t n = body_particles_.size(), chunks = chunk_count<kSumBlock>(n);
+  body_partial_.assign(chunks * nb * kPer, 0.0);
+  parallel_chunks<kSumBlock>(n, [&](std::size_t c, std::size_t first, std::size_t last) {
+    double* o = &body_partial_[c * nb * kPer];
+    for (std::size_t p = first; p < last; ++p)
+      for (std::size_t k = 0, i = body_particles_[p]; k < nb; ++k) {
+        const Vec<D, R> f = force(i, k);
+        if (norm2(f) == R(0)) continue;
+        const Vec<3, R> t = body_moment(k, ps.position[i], f);
+        for (int d = 0; d < D; ++d) o[k * kPer + d] += static_cast<double>(f[d]);
+        for (int a = 0; a < 3; ++a) o[k * kPer + D + a] += static_cast<double>(t[a]);
+      }
+  });
+  for (std::size_t k = 0; k < nb; ++k) {
+    double sum[kPer] = {};
+    for (std::size_t c = 0; c < chunks; ++c)
+      for (std::size_t a = 0; a < kPer; ++a) sum[a] += body_partial_[(c * nb + k) * kPer + a];
+    const auto& response = body_response_[k];
+    for (int d = 0; d < D; ++d) out[k].linear[d] = static_cast<R>(sum[d] * response.inverse_mass);
+    for (int a = 0; a < 3; ++a) {
+      double w = 0;
+      for (int b = 0; b < 3; ++b) w += response.inverse_inertia[a * 3 + b] * sum[D + b];
+      out[k].angular[a] = static_cast<R>(w);
+    }
+  }
+}
+
+template <int D, std::floating_point R>
+void DfsphSolver<D, R>::body_accelerations(const ParticleSet<D, R>& ps, const std::vector<R>& x,
+                                           std::vector<BodyMotion>& out) {
+  body_motions(
+      ps, [&](std::size_t i, std::size_t k) { return body_solid_[i * bodies_ + k] * (ps.mass[i] * x[i]); }, out);
+}
+
+template <int D, std::floating_point R>
+R DfsphSolver<D, R>::body_rate(std::size_t i, const Vec<D, R>& xi, const std::vector<BodyMotion>& u) const {
+  R rate = 0;
+  if (u.empty() || !near_body_[i]) return rate;
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    const Vec<D, R>& g = body_solid_[i * bodies_ + k];
+    rate -= dot(u[k].linear, g) + dot(u[k].angular, body_moment(k, xi, g));
+  }
+  return rate;
+}
+
+template <int D, std::floating_point R>
+void DfsphSolver<D, R>::apply(const ParticleSet<D, R>& ps, const std::vector<R>& x, std::vector<Vec<D, R>>& out,
+                              std::vector<R>& ax) {
   accelerations(x, out);
-  parallel_for(beta_.size(), [&](std::size_t i) { ax[i] = -density_rate(i, [&](std::size_t j) { return out[j]; }); });
+  body_accelerations(ps, x, body_push_);
+  parallel_for(beta_.size(), [&](std::size_t i) {
+    ax[i] = -density_rate(i, [&](std::size_t j) { return out[j]; }) - body_rate(i, ps.position[i], body_push_);
+  });
 }
 
 template <int D, std::floating_point R>
@@ -238,6 +328,21 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
       if (body_acceleration_)
         for (std::size_t k = 0; k < bodies_; ++k) body_acceleration_[i * bodies_ + k] += body_hydro_[i * bodies_ + k];
     });
+  // Strong coupling, density solve: each body's velocity change in the step from all but the
+  // pressure solved for (the extrapolated samples' push and the friction's reaction, the divergence
+  // solve's change, gravity), which its samples' velocities do not hold yet.
+  body_change_.clear();
+  if (kDensity) {
+    body_motions(
+        ps,
+        [&](std::size_t i, std::size_t k) {
+          Vec<D, R> change = body_acceleration_[i * bodies_ + k] * dt;
+          if (body_velocity_change_) change += body_velocity_change_[i * bodies_ + k];
+          return change * (-ps.mass[i]);
+        },
+        body_change_);
+    for (BodyMotion& m : body_change_) m.linear += gravity_ * dt;
+  }
   // The right-hand side b (an error over scale), and the warm start.
   parallel_for(n, [&](std::size_t i) {
     R err;
@@ -245,7 +350,8 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
     const R moving = solid_rate_.empty() ? R(0) : solid_rate_[i];
     if constexpr (kDensity)
       err = ps.density[i] - rho0 +
-            dt * (density_rate(i, [&](std::size_t j) { return ps.velocity[j] + ps.acceleration[j] * dt; }) - moving);
+            dt * (density_rate(i, [&](std::size_t j) { return ps.velocity[j] + ps.acceleration[j] * dt; }) - moving +
+                  body_rate(i, ps.position[i], body_change_));
     else
       err = density_rate(i, [&](std::size_t j) { return ps.velocity[j]; }) - moving;
     // (the divergence solve leaves out the particles without a full neighbourhood: at a free
@@ -258,7 +364,7 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
 
   // The error of the current s: the average compression (as the papers measure it).
   const auto compression = [&](std::size_t i) { return static_cast<double>(std::max(scale * (b_[i] - as_[i]), R(0))); };
-  apply(s_, acc_s_, as_);
+  apply(ps, s_, acc_s_, as_);
   double error = sph::chunked_sum(n, partial_, compression);
   int iterations = 0;
   const auto finished = [&] {
@@ -273,6 +379,7 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
   if (!finished()) parallel_for(n, [&](std::size_t i) { p_[i] = step_of(i); });
   while (!finished()) {
     accelerations(p_, acc_p_);
+    body_accelerations(ps, p_, body_push_);
     ++iterations;
     partial_.assign(chunk_count<kSumBlock>(n), 0.0);
     parallel_chunks<kSumBlock>(n, [&](std::size_t c, std::size_t first, std::size_t last) {
@@ -280,7 +387,7 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
       for (std::size_t i = first; i < last; ++i) {
         s_[i] += p_[i];
         acc_s_[i] += acc_p_[i];
-        as_[i] += -density_rate(i, [&](std::size_t j) { return acc_p_[j]; });
+        as_[i] += -density_rate(i, [&](std::size_t j) { return acc_p_[j]; }) - body_rate(i, ps.position[i], body_push_);
         sum += compression(i);
         p_[i] = step_of(i);
       }

@@ -93,7 +93,26 @@ class DfsphSolver {
   /// out = a(x): the pressure accelerations of a field x.
   void accelerations(const std::vector<R>& x, std::vector<Vec<D, R>>& out) const;
   /// out = a(x), then ax = A x = -J out.
-  void apply(const std::vector<R>& x, std::vector<Vec<D, R>>& out, std::vector<R>& ax);
+  void apply(const ParticleSet<D, R>& ps, const std::vector<R>& x, std::vector<Vec<D, R>>& out, std::vector<R>& ax);
+  /// Body k's moment arm at x: x - c_k, and (2D: z only) the moment r x g of g about c_k.
+  Vec<3, R> body_moment(std::size_t k, const Vec<D, R>& x, const Vec<D, R>& g) const;
+  /// A body's linear and angular velocity, or their changes (strong coupling).
+  struct BodyMotion {
+    Vec<D, R> linear{};
+    Vec<3, R> angular{};
+  };
+  /// Strong coupling: out[k] = body k's linear and angular velocity change under the forces
+  /// force(i, k) (N s: particle i's on body k, acting along a line through x_i), summed in fixed
+  /// blocks (the same for any thread count). Empty without strong coupling.
+  template <class F>
+  void body_motions(const ParticleSet<D, R>& ps, F&& force, std::vector<BodyMotion>& out);
+  /// out = body k's accelerations under the pressure field x: the reaction to its samples' push
+  /// on the fluid, force m_i x_i g_ik with g_ik = sum_{b of k} psi_b grad W_ib.
+  void body_accelerations(const ParticleSet<D, R>& ps, const std::vector<R>& x, std::vector<BodyMotion>& out);
+  /// The bodies' share of particle i's density rate when they move with u (one per body):
+  /// -sum_k (u_k.linear . g_ik + u_k.angular . ((x_i - c_k) x g_ik)) (the force g_ik acts along
+  /// lines through x_i: its moment about c_k is the same taken at x_i as at the samples).
+  R body_rate(std::size_t i, const Vec<D, R>& xi, const std::vector<BodyMotion>& u) const;
   /// (J v)_i: the density rate of particle i under the velocities v(j), on the step's pairs.
   template <class V>
   R density_rate(std::size_t i, V&& v) const;
@@ -125,7 +144,16 @@ class DfsphSolver {
   std::vector<Vec<D, R>> body_solid_;
   Vec<D, R>* body_acceleration_ = nullptr;
   Vec<D, R>* body_velocity_change_ = nullptr;
-  std::vector<R> b_, s_, p_, as_;  // b, s, the iteration's ds, A s
+  // Strong coupling (BoundaryView::body_response): how each body answers a force; the bodies'
+  // accelerations under the iteration's pressure step; the density solve's prediction of each
+  // body's velocity change from all but its pressure; gravity.
+  std::vector<typename BoundaryView<D, R>::BodyResponse> body_response_;
+  std::vector<BodyMotion> body_push_, body_change_;
+  Vec<D, R> gravity_{};
+  std::vector<double> body_partial_;
+  std::vector<std::uint8_t> near_body_;        // per particle: a body's sample within h
+  std::vector<std::uint32_t> body_particles_;  // the particles near a body, in order
+  std::vector<R> b_, s_, p_, as_;              // b, s, the iteration's ds, A s
   std::vector<Vec<D, R>> acc_s_, acc_p_;
   std::vector<double> partial_;  // per-chunk sums
 };

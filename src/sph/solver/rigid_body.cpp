@@ -277,6 +277,20 @@ void add_body_contact(const ContactBox<D>& a, const ContactBox<D>& b, double ome
 }
 
 template <int D>
+std::array<double, 9> world_inverse_inertia(const RigidBodyState<D>& s, const MassProperties<D>& mp) {
+  std::array<double, 9> out{};
+  if constexpr (D == 2) {
+    out[8] = 1.0 / mp.inertia[2];
+  } else {
+    const std::array<double, 9> r = principal_frame(s, mp);
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b)
+        for (int k = 0; k < 3; ++k) out[a * 3 + b] += r[a * 3 + k] * r[b * 3 + k] / mp.inertia[k];
+  }
+  return out;
+}
+
+template <int D>
 void advance_body(RigidBodyState<D>& s, const MassProperties<D>& mp, const BodyLoad<D>& load,
                   const Vec<D, double>& gravity, double dt) {
   s.velocity += load.impulse * (1.0 / mp.mass) + gravity * dt;
@@ -317,6 +331,8 @@ template MassProperties<2> shape_mass_properties<2>(const ObstacleShape<2>&, dou
 template MassProperties<3> shape_mass_properties<3>(const ObstacleShape<3>&, double);
 template std::array<double, 9> principal_frame<2>(const RigidBodyState<2>&, const MassProperties<2>&);
 template std::array<double, 9> principal_frame<3>(const RigidBodyState<3>&, const MassProperties<3>&);
+template std::array<double, 9> world_inverse_inertia<2>(const RigidBodyState<2>&, const MassProperties<2>&);
+template std::array<double, 9> world_inverse_inertia<3>(const RigidBodyState<3>&, const MassProperties<3>&);
 template double container_contact_energy<2>(const Box<2>&, const Box<2>&, const RigidBodyState<2>&,
                                             const MassProperties<2>&, double, const ObstacleShape<2>*);
 template double container_contact_energy<3>(const Box<3>&, const Box<3>&, const RigidBodyState<3>&,

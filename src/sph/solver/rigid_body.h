@@ -69,6 +69,11 @@ MassProperties<D> obstacle_mass_properties(const SimulationParams<D>& p, std::si
 template <int D>
 std::array<double, 9> principal_frame(const RigidBodyState<D>& s, const MassProperties<D>& mp);
 
+/// The inverse of the body's inertia tensor in the world's frame, R I^-1 R^T (row-major 3 x 3; R
+/// its principal_frame). 2D: only the z row and column are set (a 2D body turns about z only).
+template <int D>
+std::array<double, 9> world_inverse_inertia(const RigidBodyState<D>& s, const MassProperties<D>& mp);
+
 /// The state at t = 0: the body where the scene puts it (its centre of mass at `center`), at its
 /// initial velocities.
 template <int D>
@@ -171,6 +176,8 @@ extern template MassProperties<2> shape_mass_properties<2>(const ObstacleShape<2
 extern template MassProperties<3> shape_mass_properties<3>(const ObstacleShape<3>&, double);
 extern template std::array<double, 9> principal_frame<2>(const RigidBodyState<2>&, const MassProperties<2>&);
 extern template std::array<double, 9> principal_frame<3>(const RigidBodyState<3>&, const MassProperties<3>&);
+extern template std::array<double, 9> world_inverse_inertia<2>(const RigidBodyState<2>&, const MassProperties<2>&);
+extern template std::array<double, 9> world_inverse_inertia<3>(const RigidBodyState<3>&, const MassProperties<3>&);
 extern template double container_contact_energy<2>(const Box<2>&, const Box<2>&, const RigidBodyState<2>&,
                                                    const MassProperties<2>&, double, const ObstacleShape<2>*);
 extern template double container_contact_energy<3>(const Box<3>&, const Box<3>&, const RigidBodyState<3>&,

@@ -519,6 +519,13 @@ const StepInfo& Simulation<D, R>::step() {
     solid.bodies = bodies_.size();
     solid.body_acceleration = body_acceleration_.data();
     solid.body_velocity_change = dfsph_ ? body_velocity_change_.data() : nullptr;
+    if (dfsph_) {
+      body_response_.resize(bodies_.size());
+      for (std::size_t k = 0; k < bodies_.size(); ++k)
+        body_response_[k] = {1.0 / body_mass_[k].mass, world_inverse_inertia(bodies_[k], body_mass_[k]),
+                             bodies_[k].position};
+      solid.body_response = body_response_;
+    }
   }
   if (auditor_) {
     info.audited = true;

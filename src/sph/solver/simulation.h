@@ -213,6 +213,7 @@ class Simulation {
   std::vector<std::uint16_t> obstacle_body_, sample_body_;
   std::vector<RigidBodyState<D>> bodies_;
   std::vector<MassProperties<D>> body_mass_;
+  std::vector<typename BoundaryView<D, R>::BodyResponse> body_response_;  // DFSPH's strong coupling
   std::vector<BodyLoad<D>> body_force_;  // the last step's fluid force and moment on each body
   std::vector<BodyLoad<D>> body_loads_;  // each body's impulses in the step (kept: no allocation per step)
   double contact_rate_ = 0;              // body_contact_rate() of the run's longest step, 1/s

@@ -2,6 +2,7 @@
 /// \file The WCSPH operators of the paper (Section 3), as loops that gather into particle i.
 
 #include <algorithm>
+#include <array>
 #include <limits>
 #include <span>
 #include <vector>
@@ -43,6 +44,17 @@ struct BoundaryView {
   std::size_t bodies = 0;
   Vec<D, R>* body_acceleration = nullptr;
   Vec<D, R>* body_velocity_change = nullptr;
+  /// DFSPH: how each floating body answers a force, in its pose of the step's start: 1 / its mass,
+  /// its inertia tensor's inverse in the world's frame (row-major 3 x 3) and its centre of mass.
+  /// Empty: the solves take the bodies as moving at their velocities of the step's start (they
+  /// answer after the step). Else the solves also predict each body's motion under the pressure
+  /// they solve for (docs/physics.md, "Floating bodies").
+  struct BodyResponse {
+    double inverse_mass = 0;
+    std::array<double, 9> inverse_inertia{};
+    Vec<D, double> center{};
+  };
+  std::span<const BodyResponse> body_response{};
   /// Particle i's entries of body_acceleration (null when nothing is recorded).
   Vec<D, R>* body_row(std::size_t i) const { return body_acceleration ? body_acceleration + i * bodies : nullptr; }
   bool active() const { return lists != nullptr && lists->particle_count() > 0 && !position.empty(); }

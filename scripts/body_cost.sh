@@ -2,11 +2,12 @@
 # What a floating body's two-way coupling costs a step (docs/performance.md, "Floating bodies'
 # coupling"): a 2D box of density 500 dropped onto water (4,800 particles, DFSPH, boundary
 # particles, fixed 2 ms steps, 250 steps) against the same box on a prescribed oscillation, RUNS
-# times each (default 3), alternating; prints each run's ms/step and the phases' mean times.
-#   bash scripts/body_cost.sh [SPH] [RUNS]
+# times each (default 3), alternating; prints each run's ms/step and the phases' mean times. With
+# a second binary OTHER, each run of each scene is made with both, one after the other.
+#   bash scripts/body_cost.sh [SPH] [RUNS] [OTHER]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-sph=${1:-build/sph} runs=${2:-3}
+sph=${1:-build/sph} runs=${2:-3} other=${3:-}
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 scene() {  # obstacle JSON
@@ -25,8 +26,10 @@ scene '{ "start": [0.4, 0.42], "end": [0.8, 0.62], "dynamic": true, "density": 5
 scene '{ "start": [0.4, 0.42], "end": [0.8, 0.62], "motion": { "type": "oscillation", "direction": [0, 1], "amplitude": 0.01, "period": 1.0 } }' >"$dir/prescribed.json"
 for k in $(seq "$runs"); do
   for c in floating prescribed; do
-    OMP_WAIT_POLICY=passive "$sph" run "$dir/$c.json" -o "$dir/$c" --overwrite --no-progress --threads 2 2>&1 |
-      grep -o "done.*ms/step)" | sed "s/^/$c run $k: /"
+    for b in "$sph" ${other:+"$other"}; do
+      OMP_WAIT_POLICY=passive "$b" run "$dir/$c.json" -o "$dir/$c" --overwrite --no-progress --threads 2 2>&1 |
+        grep -o "done.*ms/step)" | sed "s|^|$c run $k${other:+ ($b)}: |"
+    done
   done
 done
 for c in floating prescribed; do

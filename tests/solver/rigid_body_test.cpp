@@ -93,6 +93,40 @@ TEST(RigidBody, ATorqueFreeTopKeepsItsAngularMomentumAndEnergy) {
   EXPECT_LT(std::abs(q[0]), 0.99);
 }
 
+TEST(RigidBody, TheWorldInverseInertiaTurnsAnImpulseAsTheStepDoes) {
+  // An asymmetric box turned to a general orientation: the step's change of w under an angular
+  // impulse L (no spin, so no gyroscopic term) is world_inverse_inertia L, and I_w times it, with
+  // I_w = R diag(I) R^T from the quaternion, gives L back.
+  const Box<3> box{{{0, 0, 0}}, {{0.1, 0.2, 0.3}}};
+  const MassProperties<3> mp = box_mass_properties<3>(box, 800);
+  RigidBodyState<3> s = initial_body_state(center_of(box), BodyParams<3>{true, 800, {}, {{1.0, 2.0, 0.5}}});
+  for (int k = 0; k < 700; ++k) advance_body(s, mp, BodyLoad<3>{}, Vec<3, double>{}, 1e-3);
+  ASSERT_LT(std::abs(s.orientation[0]), 0.9);
+  s.angular_velocity = {};
+  BodyLoad<3> load;
+  load.angular_impulse = {{0.3, -0.2, 0.5}};
+  RigidBodyState<3> after = s;
+  advance_velocities(after, mp, load, Vec<3, double>{}, 1e-3);
+  const std::array<double, 9> inv = world_inverse_inertia(s, mp);
+  const std::array<double, 9> r = quaternion_matrix(s.orientation);
+  for (int a = 0; a < 3; ++a) {
+    double w = 0, l = 0;
+    for (int b = 0; b < 3; ++b) {
+      w += inv[static_cast<std::size_t>(3 * a + b)] * load.angular_impulse[b];
+      for (int k = 0; k < 3; ++k)  // (I_w dw)_a
+        l += r[static_cast<std::size_t>(3 * a + k)] * mp.inertia[k] * r[static_cast<std::size_t>(3 * b + k)] *
+             after.angular_velocity[b];
+    }
+    EXPECT_NEAR(after.angular_velocity[a], w, 1e-12 * std::sqrt(norm2(after.angular_velocity))) << a;
+    EXPECT_NEAR(l, load.angular_impulse[a], 1e-12) << a;
+  }
+  // 2D: about z only.
+  const MassProperties<2> flat = box_mass_properties<2>(Box<2>{{{0, 0}}, {{0.4, 0.2}}}, 500);
+  const std::array<double, 9> inv2 = world_inverse_inertia(RigidBodyState<2>{}, flat);
+  EXPECT_DOUBLE_EQ(inv2[8], 1 / flat.inertia[2]);
+  for (int k = 0; k < 8; ++k) EXPECT_EQ(inv2[static_cast<std::size_t>(k)], 0) << k;
+}
+
 TEST(RigidBody, TheContainerHoldsARestingBoxAtItsSpringsSag) {
   // A box on the floor of a container, stepped at the contact's own longest step: it comes to
   // rest sunk by g / (n w^2), n = 2 corners on the floor in 2D.

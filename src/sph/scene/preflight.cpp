@@ -98,9 +98,11 @@ void check_obstacles_inside(const ReadContext& ctx, const SimulationParams<D>& s
 }
 
 /// A floating body (Obstacles[].dynamic) much lighter than the fluid draws a warning: the
-/// coupling, explicit between the fluid's step and the body's, grows unstable as the body's mass
-/// falls below the fluid it displaces (SPlisHSPlasH's Akinci coupling has the same limit). (Like
-/// every obstacle it starts inside the container: the scene reader refuses one that does not.)
+/// coupling, explicit between the fluid's step and the body's with weakly compressible SPH
+/// (SPlisHSPlasH's Akinci coupling has the same limit), grows unstable as the body's mass falls
+/// below the fluid it displaces; DFSPH's solves take the body's answer to their pressure, but its
+/// friction and viscosity stay explicit. (Like every obstacle it starts inside the container: the
+/// scene reader refuses one that does not.)
 template <int D>
 void check_bodies(SceneDesc& desc, const SimulationParams<D>& sim) {
   for (std::size_t k = 0; k < sim.obstacles.size(); ++k) {

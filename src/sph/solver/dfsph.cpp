@@ -127,11 +127,9 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
   body_velocity_change_ = bodies ? boundary.body_velocity_change : nullptr;
   body_solid_.assign(n * bodies_, Vec<D, R>{});
   body_hydro_.assign(extrapolate ? n * bodies_ : 0, Vec<D, R>{});
-  if (bodies_ > 0 && boundary.body_response.size() == bodies_)
-    body_response_.assign(boundary.body_response.begin(), boundary.body_response.end());
-  else
-    body_response_.clear();
-  gravity_ = boundary.extrapolation;
+  SPH_CHECK(bodies_ == 0 || boundary.body_response.empty() || boundary.body_response.size() == bodies_,
+            "DFSPH: one response per floating body");
+  body_response_ = bodies_ > 0 ? boundary.body_response : std::span<const typename BoundaryView<D, R>::BodyResponse>{};
   const R weight = boundary.sample_pressure ? static_cast<R>(kSampleWeight) : R(1);
   // The step's pairs within h, once: each solve iteration then reads m_j grad W_ij instead of
   // evaluating the kernel again (about half the entries of a list are within h).
@@ -225,6 +223,9 @@ void DfsphSolver<D, R>::accelerations(const std::vector<R>& x, std::vector<Vec<D
   });
 }
 
+/// Up to this many blocks of kSumBlock particles near the bodies, their sums run on one thread.
+constexpr std::size_t kSerialBodyBlocks = 4;
+
 template <int D, std::floating_point R>
 Vec<3, R> DfsphSolver<D, R>::body_moment(std::size_t k, const Vec<D, R>& x, const Vec<D, R>& g) const {
   const Vec<D, R> r = x - vec_cast<R>(body_response_[k].center);
@@ -244,7 +245,7 @@ void DfsphSolver<D, R>::body_motions(const ParticleSet<D, R>& ps, F&& force, std
   constexpr std::size_t kPer = D + 3;
   const std::size_t n = body_particles_.size(), chunks = chunk_count<kSumBlock>(n);
   body_partial_.assign(chunks * nb * kPer, 0.0);
-  parallel_chunks<kSumBlock>(n, [&](std::size_t c, std::size_t first, std::size_t last) {
+  const auto block = [&](std::size_t c, std::size_t first, std::size_t last) {
     double* o = &body_partial_[c * nb * kPer];
     for (std::size_t p = first; p < last; ++p)
       for (std::size_t k = 0, i = body_particles_[p]; k < nb; ++k) {
@@ -254,7 +255,15 @@ void DfsphSolver<D, R>::body_motions(const ParticleSet<D, R>& ps, F&& force, std
         for (int d = 0; d < D; ++d) o[k * kPer + d] += static_cast<double>(f[d]);
         for (int a = 0; a < 3; ++a) o[k * kPer + D + a] += static_cast<double>(t[a]);
       }
-  });
+  };
+  // (a few blocks, as a body's neighbourhood usually is, are summed on this thread: waking the
+  // others for each Jacobi iteration cost more than the sums; the blocks and their order are the
+  // same either way)
+  if (chunks <= kSerialBodyBlocks) {
+    for (std::size_t c = 0; c < chunks; ++c) block(c, c * kSumBlock, std::min(n, (c + 1) * kSumBlock));
+  } else {
+    parallel_chunks<kSumBlock>(n, block);
+  }
   for (std::size_t k = 0; k < nb; ++k) {
     double sum[kPer] = {};
     for (std::size_t c = 0; c < chunks; ++c)
@@ -293,7 +302,8 @@ void DfsphSolver<D, R>::apply(const ParticleSet<D, R>& ps, const std::vector<R>&
   accelerations(x, out);
   body_accelerations(ps, x, body_push_);
   parallel_for(beta_.size(), [&](std::size_t i) {
-    ax[i] = -density_rate(i, [&](std::size_t j) { return out[j]; }) - body_rate(i, ps.position[i], body_push_);
+    ax[i] = -density_rate(i, [&](std::size_t j) { return out[j]; });
+    if (!body_push_.empty() && near_body_[i]) ax[i] -= body_rate(i, ps.position[i], body_push_);
   });
 }
 
@@ -330,7 +340,8 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
     });
   // Strong coupling, density solve: each body's velocity change in the step from all but the
   // pressure solved for (the extrapolated samples' push and the friction's reaction, the divergence
-  // solve's change, gravity), which its samples' velocities do not hold yet.
+  // solve's change; gravity, contacts and the gyroscopic term from its response), which its
+  // samples' velocities do not hold yet.
   body_change_.clear();
   if (kDensity) {
     body_motions(
@@ -341,7 +352,10 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
           return change * (-ps.mass[i]);
         },
         body_change_);
-    for (BodyMotion& m : body_change_) m.linear += gravity_ * dt;
+    for (std::size_t k = 0; k < body_change_.size(); ++k) {
+      body_change_[k].linear += vec_cast<R>(body_response_[k].velocity_change);
+      body_change_[k].angular += vec_cast<R>(body_response_[k].angular_velocity_change);
+    }
   }
   // The right-hand side b (an error over scale), and the warm start.
   parallel_for(n, [&](std::size_t i) {
@@ -377,9 +391,10 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
   // fixed blocks) and the next iteration's ds (which no other particle reads in that pass).
   const auto step_of = [&](std::size_t i) { return std::max(b_[i] - as_[i], R(0)) / beta_[i]; };
   if (!finished()) parallel_for(n, [&](std::size_t i) { p_[i] = step_of(i); });
+  const bool coupled = !body_response_.empty();
   while (!finished()) {
     accelerations(p_, acc_p_);
-    body_accelerations(ps, p_, body_push_);
+    if (coupled) body_accelerations(ps, p_, body_push_);
     ++iterations;
     partial_.assign(chunk_count<kSumBlock>(n), 0.0);
     parallel_chunks<kSumBlock>(n, [&](std::size_t c, std::size_t first, std::size_t last) {
@@ -387,7 +402,8 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
       for (std::size_t i = first; i < last; ++i) {
         s_[i] += p_[i];
         acc_s_[i] += acc_p_[i];
-        as_[i] += -density_rate(i, [&](std::size_t j) { return acc_p_[j]; }) - body_rate(i, ps.position[i], body_push_);
+        as_[i] += -density_rate(i, [&](std::size_t j) { return acc_p_[j]; });
+        if (coupled && near_body_[i]) as_[i] -= body_rate(i, ps.position[i], body_push_);
         sum += compression(i);
         p_[i] = step_of(i);
       }

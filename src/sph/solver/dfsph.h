@@ -18,7 +18,11 @@
 /// the operator A s = -J a(s) is symmetric positive semi-definite (all particles have the same
 /// mass: A = J M^-1 J^T m), and its diagonal is DFSPH's factor
 ///   beta_i = |sum_j m_j grad W_ij + sum_b w psi_b grad W_ib|^2 + m_i sum_j m_j |grad W_ij|^2
-/// (the papers' alpha_i = rho_i / beta_i).
+/// (the papers' alpha_i = rho_i / beta_i). Floating bodies (BoundaryView::body_response, strong
+/// coupling) are more unknowns' worth of M: body k moves under s by A_k = (1 / m_k) sum_i m_i s_i
+/// g_ik and alpha_k = I_k^-1 sum_i m_i s_i (x_i - c_k) x g_ik (g_ik = sum_{b of k} w psi_b grad
+/// W_ib), which J sees through its samples' velocities, and beta_i gains
+/// m_i (|g_ik|^2 / m_k + t . I_k^-1 t), t = (x_i - c_k) x g_ik.
 ///  - The constant-density solve (after the non-pressure forces, with v* = v + dt a): the
 ///    predicted error e_i = rho_i + dt (J v*)_i - rho0 must vanish, dt^2 A s = e, and the
 ///    accelerations a(s) are added to a.
@@ -147,9 +151,8 @@ class DfsphSolver {
   // Strong coupling (BoundaryView::body_response): how each body answers a force; the bodies'
   // accelerations under the iteration's pressure step; the density solve's prediction of each
   // body's velocity change from all but its pressure; gravity.
-  std::vector<typename BoundaryView<D, R>::BodyResponse> body_response_;
+  std::span<const typename BoundaryView<D, R>::BodyResponse> body_response_;
   std::vector<BodyMotion> body_push_, body_change_;
-  Vec<D, R> gravity_{};
   std::vector<double> body_partial_;
   std::vector<std::uint8_t> near_body_;        // per particle: a body's sample within h
   std::vector<std::uint32_t> body_particles_;  // the particles near a body, in order

@@ -291,8 +291,8 @@ std::array<double, 9> world_inverse_inertia(const RigidBodyState<D>& s, const Ma
 }
 
 template <int D>
-void advance_body(RigidBodyState<D>& s, const MassProperties<D>& mp, const BodyLoad<D>& load,
-                  const Vec<D, double>& gravity, double dt) {
+void advance_velocities(RigidBodyState<D>& s, const MassProperties<D>& mp, const BodyLoad<D>& load,
+                        const Vec<D, double>& gravity, double dt) {
   s.velocity += load.impulse * (1.0 / mp.mass) + gravity * dt;
   // The angular momentum's change in the world's frame, I_w = R I R^T (R to the principal axes).
   const std::array<double, 9> r = principal_frame(s, mp);
@@ -306,6 +306,12 @@ void advance_body(RigidBodyState<D>& s, const MassProperties<D>& mp, const BodyL
   const Vec<3, double> momentum = times(r, spin);  // I_w w
   s.angular_velocity += inertia_inverse(load.angular_impulse - cross(s.angular_velocity, momentum) * dt);
   if constexpr (D == 2) s.angular_velocity[0] = s.angular_velocity[1] = 0;
+}
+
+template <int D>
+void advance_body(RigidBodyState<D>& s, const MassProperties<D>& mp, const BodyLoad<D>& load,
+                  const Vec<D, double>& gravity, double dt) {
+  advance_velocities(s, mp, load, gravity, dt);
   s.position += s.velocity * dt;
   // q <- exp(dt w / 2) q: exact for a constant w, and unit length kept.
   const double rate = std::sqrt(norm2(s.angular_velocity));
@@ -347,6 +353,10 @@ template void add_body_contact<2>(const ContactBox<2>&, const ContactBox<2>&, do
                                   BodyLoad<2>*);
 template void add_body_contact<3>(const ContactBox<3>&, const ContactBox<3>&, double, double, BodyLoad<3>&,
                                   BodyLoad<3>*);
+template void advance_velocities<2>(RigidBodyState<2>&, const MassProperties<2>&, const BodyLoad<2>&,
+                                    const Vec<2, double>&, double);
+template void advance_velocities<3>(RigidBodyState<3>&, const MassProperties<3>&, const BodyLoad<3>&,
+                                    const Vec<3, double>&, double);
 template void advance_body<2>(RigidBodyState<2>&, const MassProperties<2>&, const BodyLoad<2>&, const Vec<2, double>&,
                               double);
 template void advance_body<3>(RigidBodyState<3>&, const MassProperties<3>&, const BodyLoad<3>&, const Vec<3, double>&,

@@ -151,6 +151,10 @@ double body_contact_rate(double max_dt);
 template <int D>
 void advance_body(RigidBodyState<D>& s, const MassProperties<D>& mp, const BodyLoad<D>& load,
                   const Vec<D, double>& gravity, double dt);
+/// The velocities' half of advance_body: v and w as it changes them, x and q left.
+template <int D>
+void advance_velocities(RigidBodyState<D>& s, const MassProperties<D>& mp, const BodyLoad<D>& load,
+                        const Vec<D, double>& gravity, double dt);
 
 /// The rotation matrix of a unit quaternion (row-major 3 x 3).
 std::array<double, 9> quaternion_matrix(const std::array<double, 4>& q);
@@ -198,5 +202,9 @@ extern template void advance_body<2>(RigidBodyState<2>&, const MassProperties<2>
                                      const Vec<2, double>&, double);
 extern template void advance_body<3>(RigidBodyState<3>&, const MassProperties<3>&, const BodyLoad<3>&,
                                      const Vec<3, double>&, double);
+extern template void advance_velocities<2>(RigidBodyState<2>&, const MassProperties<2>&, const BodyLoad<2>&,
+                                           const Vec<2, double>&, double);
+extern template void advance_velocities<3>(RigidBodyState<3>&, const MassProperties<3>&, const BodyLoad<3>&,
+                                           const Vec<3, double>&, double);
 
 }  // namespace sph

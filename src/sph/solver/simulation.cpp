@@ -217,6 +217,47 @@ void Simulation<D, R>::place_obstacles() {
 }
 
 template <int D, std::floating_point R>
+void Simulation<D, R>::add_contacts(double dt, std::vector<BodyLoad<D>>& loads) const {
+  const std::size_t nb = bodies_.size();
+  // Each body against the container, then between bodies (each pair once, in a fixed order) and
+  // with the obstacles that do not float (they do not give way), all from the states at the
+  // step's start.
+  for (std::size_t s = 0; s < nb; ++s) {
+    const std::size_t k = body_obstacle_[s];
+    add_container_contact(params_.container, params_.obstacles[k], bodies_[s], body_mass_[s], contact_rate_, dt,
+                          loads[s], obstacle_shape(params_, k));
+  }
+  const auto contact_box = [&](std::size_t k) {
+    const std::size_t s = obstacle_body_[k];
+    return ContactBox<D>{params_.obstacles[k], pose_now(k), s != 0 ? body_mass_[s - 1].mass : 0.0,
+                         obstacle_shape(params_, k)};
+  };
+  for (std::size_t s = 0; s < nb; ++s) {
+    const ContactBox<D> a = contact_box(body_obstacle_[s]);
+    for (std::size_t t = s + 1; t < nb; ++t)
+      add_body_contact(a, contact_box(body_obstacle_[t]), contact_rate_, dt, loads[s], &loads[t]);
+    for (std::size_t k = 0; k < params_.obstacles.size(); ++k)
+      if (obstacle_body_[k] == 0) add_body_contact<D>(a, contact_box(k), contact_rate_, dt, loads[s], nullptr);
+  }
+}
+
+template <int D, std::floating_point R>
+void Simulation<D, R>::predict_bodies(double dt) {
+  // DFSPH's strong coupling: what the step gives each body besides the fluid (gravity, its
+  // contacts, the gyroscopic term), for the density solve's prediction.
+  if (body_response_.empty()) return;
+  std::vector<BodyLoad<D>>& loads = body_loads_;
+  loads.assign(bodies_.size(), BodyLoad<D>{});
+  add_contacts(dt, loads);
+  for (std::size_t s = 0; s < bodies_.size(); ++s) {
+    RigidBodyState<D> after = bodies_[s];
+    advance_velocities(after, body_mass_[s], loads[s], params_.gravity, dt);
+    body_response_[s].velocity_change = after.velocity - bodies_[s].velocity;
+    body_response_[s].angular_velocity_change = after.angular_velocity - bodies_[s].angular_velocity;
+  }
+}
+
+template <int D, std::floating_point R>
 void Simulation<D, R>::advance_bodies(double dt) {
   const std::size_t nb = bodies_.size();
   if (nb == 0) return;
@@ -254,24 +295,8 @@ void Simulation<D, R>::advance_bodies(double dt) {
     }
     body_force_[s].impulse = load.impulse * (1.0 / dt);
     body_force_[s].angular_impulse = load.angular_impulse * (1.0 / dt);
-    const std::size_t k = body_obstacle_[s];
-    add_container_contact(params_.container, params_.obstacles[k], bodies_[s], body_mass_[s], contact_rate_, dt, load,
-                          obstacle_shape(params_, k));
   }
-  // Contacts between bodies (each pair once, in a fixed order), and with the obstacles that do not
-  // float (they do not give way), all from the states at the step's start.
-  const auto contact_box = [&](std::size_t k) {
-    const std::size_t s = obstacle_body_[k];
-    return ContactBox<D>{params_.obstacles[k], pose_now(k), s != 0 ? body_mass_[s - 1].mass : 0.0,
-                         obstacle_shape(params_, k)};
-  };
-  for (std::size_t s = 0; s < nb; ++s) {
-    const ContactBox<D> a = contact_box(body_obstacle_[s]);
-    for (std::size_t t = s + 1; t < nb; ++t)
-      add_body_contact(a, contact_box(body_obstacle_[t]), contact_rate_, dt, loads[s], &loads[t]);
-    for (std::size_t k = 0; k < params_.obstacles.size(); ++k)
-      if (obstacle_body_[k] == 0) add_body_contact<D>(a, contact_box(k), contact_rate_, dt, loads[s], nullptr);
-  }
+  add_contacts(dt, loads);
   for (std::size_t s = 0; s < nb; ++s) {
     const std::size_t k = body_obstacle_[s];
     advance_body(bodies_[s], body_mass_[s], loads[s], params_.gravity, dt);
@@ -562,6 +587,7 @@ const StepInfo& Simulation<D, R>::step() {
   // The paper's Section 6: particles near a moving body rebuild their lists next step, whatever
   // Eq. 7 predicts (the body's push is not in its linear prediction).
   if (params_.neighbors == NeighborMode::Adaptive && params_.flag_near_moving) flag_near_moving_obstacles(st.dt);
+  predict_bodies(st.dt);
   const WallContact<D, R> walls(params_.container, params_.obstacles, static_cast<R>(params_.particle_radius),
                                 params_.walls, params_.boundary.handling == BoundaryHandling::Penalty, poses_, moving_,
                                 obstacle_body_, params_.shapes);

@@ -185,6 +185,11 @@ class Simulation {
   /// contact and the contacts between bodies and with the other obstacles; then each body takes
   /// its step.
   void advance_bodies(double dt);
+  /// Adds each floating body's contact impulses over dt (the container, the other bodies, the
+  /// obstacles that do not float) to loads[s], from the states at the step's start.
+  void add_contacts(double dt, std::vector<BodyLoad<D>>& loads) const;
+  /// DFSPH's strong coupling: sets body_response_'s velocity changes of the step but the fluid's.
+  void predict_bodies(double dt);
   /// Adaptive mode (SimulationParams::flag_near_moving): flags for a list rebuild every particle
   /// within h plus its travel in a step of dt of a moving obstacle.
   void flag_near_moving_obstacles(double dt);

@@ -45,14 +45,18 @@ struct BoundaryView {
   Vec<D, R>* body_acceleration = nullptr;
   Vec<D, R>* body_velocity_change = nullptr;
   /// DFSPH: how each floating body answers a force, in its pose of the step's start: 1 / its mass,
-  /// its inertia tensor's inverse in the world's frame (row-major 3 x 3) and its centre of mass.
-  /// Empty: the solves take the bodies as moving at their velocities of the step's start (they
-  /// answer after the step). Else the solves also predict each body's motion under the pressure
-  /// they solve for (docs/physics.md, "Floating bodies").
+  /// its inertia tensor's inverse in the world's frame (row-major 3 x 3) and its centre of mass;
+  /// and what the step changes its velocities by besides the fluid (gravity, contacts, the
+  /// gyroscopic term; set once the step's dt is known, before the density solve). Empty: the
+  /// solves take the bodies as moving at their velocities of the step's start (they answer after
+  /// the step). Else (one per body) the solves also predict each body's motion under the pressure
+  /// they solve for (docs/physics.md, "Floating bodies"). The solver reads it during the solves.
   struct BodyResponse {
     double inverse_mass = 0;
     std::array<double, 9> inverse_inertia{};
     Vec<D, double> center{};
+    Vec<D, double> velocity_change{};
+    Vec<3, double> angular_velocity_change{};
   };
   std::span<const BodyResponse> body_response{};
   /// Particle i's entries of body_acceleration (null when nothing is recorded).

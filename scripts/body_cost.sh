@@ -26,18 +26,24 @@ scene '{ "start": [0.4, 0.42], "end": [0.8, 0.62], "dynamic": true, "density": 5
 scene '{ "start": [0.4, 0.42], "end": [0.8, 0.62], "motion": { "type": "oscillation", "direction": [0, 1], "amplitude": 0.01, "period": 1.0 } }' >"$dir/prescribed.json"
 for k in $(seq "$runs"); do
   for c in floating prescribed; do
+    n=0
     for b in "$sph" ${other:+"$other"}; do
-      OMP_WAIT_POLICY=passive "$b" run "$dir/$c.json" -o "$dir/$c" --overwrite --no-progress --threads 2 2>&1 |
+      n=$((n + 1))
+      OMP_WAIT_POLICY=passive "$b" run "$dir/$c.json" -o "$dir/$c-$n" --overwrite --no-progress --threads 2 2>&1 |
         grep -o "done.*ms/step)" | sed "s|^|$c run $k${other:+ ($b)}: |"
     done
   done
 done
-for c in floating prescribed; do
-  python3 - "$dir/$c/stats.csv" "$c" <<'PY'
+n=0
+for b in "$sph" ${other:+"$other"}; do
+  n=$((n + 1))
+  for c in floating prescribed; do
+    python3 - "$dir/$c-$n/stats.csv" "$c${other:+ ($b)}" <<'PY'
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 mean = lambda k: sum(float(r[k]) for r in rows) / len(rows)
 print(f"{sys.argv[2]} (last run): forces {1e3 * mean('t_forces'):.2f} ms, integrate {1e3 * mean('t_integrate'):.2f} ms, "
       f"solves {1e3 * mean('t_solve'):.2f} ms ({mean('solver_iterations'):.1f} iterations)")
 PY
+  done
 done

@@ -517,8 +517,13 @@ std::pair<double, double> dfsph_body_compression(BoundaryPressure pressure, bool
     sample_start[k][0] = -2 * r[1], sample_start[k][1] = 2 * r[0];
   }
   view.velocity = sample_start;
+  // What the step gives the box besides the fluid (DfsphSolver takes it from the response): gravity,
+  // and a push and a turn as a contact would give.
+  Vec<D, double> push{};
+  push[0] = 0.02;
+  const Vec<3, double> turn{{0, 0, -0.3}};
   const typename BoundaryView<D, double>::BodyResponse response{1 / mp.mass, world_inverse_inertia(state, mp),
-                                                                mp.center, g * dt, Vec<3, double>{}};
+                                                                mp.center, g * dt + push, turn};
   view.body = body;
   view.bodies = 1;
   view.body_acceleration = reaction.data();
@@ -535,7 +540,7 @@ std::pair<double, double> dfsph_body_compression(BoundaryPressure pressure, bool
   EXPECT_TRUE(stats.converged);
   // The box's velocities after the step: gravity and the reactions to what its samples gave the
   // fluid (an acceleration over the step, and the divergence solve's velocity change).
-  Vec<D, double> impulse = g * (mp.mass * dt);
+  Vec<D, double> impulse = response.velocity_change * mp.mass;
   Vec<3, double> angular_impulse{};
   double divergence_share = 0;
   for (std::size_t i = 0; i < ps.size(); ++i) {
@@ -546,7 +551,7 @@ std::pair<double, double> dfsph_body_compression(BoundaryPressure pressure, bool
   }
   EXPECT_GT(divergence_share, 1e-3 * mp.mass);  // (kg m/s: the divergence solve pushed the box)
   const Vec<D, double> body_v = impulse * (1 / mp.mass);
-  Vec<3, double> body_w = state.angular_velocity;
+  Vec<3, double> body_w = state.angular_velocity + turn;
   for (int a = 0; a < 3; ++a)
     for (int c = 0; c < 3; ++c) body_w[a] += response.inverse_inertia[a * 3 + c] * angular_impulse[c];
   const auto sample_velocity = [&](std::size_t k) {
@@ -589,11 +594,17 @@ void check_dfsph_body_coupling(BoundaryPressure pressure) {
   const auto [coupled, coupled_turn] = dfsph_body_compression<D>(pressure, true);
   const auto [uncoupled, uncoupled_turn] = dfsph_body_compression<D>(pressure, false);
   EXPECT_LE(coupled, tolerance) << D << "D: " << coupled_turn << " rad/s";
-  // (the box taken as moving at its first velocity falls into the fluid: the same check fails)
-  EXPECT_GT(uncoupled, 10 * tolerance) << D << "D: " << uncoupled_turn << " rad/s";
+  // (the box taken as moving at its first velocity falls into the fluid: the same check fails;
+  // without a sample pressure, w = 1, the fluid's hold on the box is weaker and the two differ less)
+  if (pressure != BoundaryPressure::None) {
+    EXPECT_GT(uncoupled, 10 * tolerance) << D << "D: " << uncoupled_turn << " rad/s";
+  }
 }
 
 TEST(BoundaryForces, DfsphPredictsAFloatingBodysAnswer2D) { check_dfsph_body_coupling<2>(BoundaryPressure::Mirror); }
+TEST(BoundaryForces, DfsphWithoutSamplePressurePredictsAFloatingBodysAnswer2D) {
+  check_dfsph_body_coupling<2>(BoundaryPressure::None);
+}
 TEST(BoundaryForces, DfsphWithExtrapolatedSamplesPredictsAFloatingBodysAnswer2D) {
   check_dfsph_body_coupling<2>(BoundaryPressure::Extrapolate);
 }

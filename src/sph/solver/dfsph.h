@@ -111,7 +111,7 @@ class DfsphSolver {
   template <class F>
   void body_motions(const ParticleSet<D, R>& ps, F&& force, std::vector<BodyMotion>& out);
   /// out = body k's accelerations under the pressure field x: the reaction to its samples' push
-  /// on the fluid, force m_i x_i g_ik with g_ik = sum_{b of k} psi_b grad W_ib.
+  /// on the fluid, force m_i x_i g_ik with g_ik = sum_{b of k} w psi_b grad W_ib.
   void body_accelerations(const ParticleSet<D, R>& ps, const std::vector<R>& x, std::vector<BodyMotion>& out);
   /// The bodies' share of particle i's density rate when they move with u (one per body):
   /// -sum_k (u_k.linear . g_ik + u_k.angular . ((x_i - c_k) x g_ik)) (the force g_ik acts along
@@ -150,7 +150,7 @@ class DfsphSolver {
   Vec<D, R>* body_velocity_change_ = nullptr;
   // Strong coupling (BoundaryView::body_response): how each body answers a force; the bodies'
   // accelerations under the iteration's pressure step; the density solve's prediction of each
-  // body's velocity change from all but its pressure; gravity.
+  // body's velocity change from all but its pressure.
   std::span<const typename BoundaryView<D, R>::BodyResponse> body_response_;
   std::vector<BodyMotion> body_push_, body_change_;
   std::vector<double> body_partial_;

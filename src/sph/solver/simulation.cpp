@@ -587,7 +587,7 @@ const StepInfo& Simulation<D, R>::step() {
   // The paper's Section 6: particles near a moving body rebuild their lists next step, whatever
   // Eq. 7 predicts (the body's push is not in its linear prediction).
   if (params_.neighbors == NeighborMode::Adaptive && params_.flag_near_moving) flag_near_moving_obstacles(st.dt);
-  predict_bodies(st.dt);
+  predict_bodies(static_cast<double>(dt));  // (the dt the bodies advance by)
   const WallContact<D, R> walls(params_.container, params_.obstacles, static_cast<R>(params_.particle_radius),
                                 params_.walls, params_.boundary.handling == BoundaryHandling::Penalty, poses_, moving_,
                                 obstacle_body_, params_.shapes);

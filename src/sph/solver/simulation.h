@@ -2,6 +2,7 @@
 /// \file Simulation<D,R>: one WCSPH run (paper Algorithm 1, or 2 through the neighbor policy).
 
 #include <memory>
+#include <span>
 #include <vector>
 
 #include <sph/core/particle_set.h>
@@ -134,6 +135,9 @@ class Simulation {
   const std::vector<std::size_t>& body_obstacles() const { return body_obstacle_; }
   const std::vector<RigidBodyState<D>>& bodies() const { return bodies_; }
   const std::vector<MassProperties<D>>& body_masses() const { return body_mass_; }
+  /// DFSPH's strong coupling: each floating body's response of the last step (BoundaryView::
+  /// body_response; empty with WCSPH).
+  std::span<const typename BoundaryView<D, R>::BodyResponse> body_responses() const { return body_response_; }
   const std::vector<BodyLoad<D>>& body_fluid_forces() const { return body_force_; }
 
   /// Total kinetic energy, J (J/m in 2D). Deterministic for any thread count. (This and the

@@ -6,6 +6,7 @@
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 #include <sph/solver/gradient_correction.h>
+#include <sph/solver/rigid_body.h>
 
 namespace sph {
 
@@ -228,12 +229,9 @@ constexpr std::size_t kSerialBodyBlocks = 4;
 
 template <int D, std::floating_point R>
 Vec<3, R> DfsphSolver<D, R>::body_moment(std::size_t k, const Vec<D, R>& x, const Vec<D, R>& g) const {
-  const Vec<D, R> r = x - vec_cast<R>(body_response_[k].center);
-  if constexpr (D == 2) {
-    return {{R(0), R(0), r[0] * g[1] - r[1] * g[0]}};
-  } else {
-    return {{r[1] * g[2] - r[2] * g[1], r[2] * g[0] - r[0] * g[2], r[0] * g[1] - r[1] * g[0]}};
-  }
+  Vec<3, R> moment{};
+  add_moment<D>(moment, x, vec_cast<R>(body_response_[k].center), g);
+  return moment;
 }
 
 template <int D, std::floating_point R>
@@ -302,8 +300,7 @@ void DfsphSolver<D, R>::apply(const ParticleSet<D, R>& ps, const std::vector<R>&
   accelerations(x, out);
   body_accelerations(ps, x, body_push_);
   parallel_for(beta_.size(), [&](std::size_t i) {
-    ax[i] = -density_rate(i, [&](std::size_t j) { return out[j]; });
-    if (!body_push_.empty() && near_body_[i]) ax[i] -= body_rate(i, ps.position[i], body_push_);
+    ax[i] = -density_rate(i, [&](std::size_t j) { return out[j]; }) - body_rate(i, ps.position[i], body_push_);
   });
 }
 
@@ -391,10 +388,9 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
   // fixed blocks) and the next iteration's ds (which no other particle reads in that pass).
   const auto step_of = [&](std::size_t i) { return std::max(b_[i] - as_[i], R(0)) / beta_[i]; };
   if (!finished()) parallel_for(n, [&](std::size_t i) { p_[i] = step_of(i); });
-  const bool coupled = !body_response_.empty();
   while (!finished()) {
     accelerations(p_, acc_p_);
-    if (coupled) body_accelerations(ps, p_, body_push_);
+    body_accelerations(ps, p_, body_push_);
     ++iterations;
     partial_.assign(chunk_count<kSumBlock>(n), 0.0);
     parallel_chunks<kSumBlock>(n, [&](std::size_t c, std::size_t first, std::size_t last) {
@@ -403,7 +399,7 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
         s_[i] += p_[i];
         acc_s_[i] += acc_p_[i];
         as_[i] += -density_rate(i, [&](std::size_t j) { return acc_p_[j]; });
-        if (coupled && near_body_[i]) as_[i] -= body_rate(i, ps.position[i], body_push_);
+        as_[i] -= body_rate(i, ps.position[i], body_push_);  // (0 away from the bodies)
         sum += compression(i);
         p_[i] = step_of(i);
       }

@@ -98,7 +98,7 @@ class DfsphSolver {
   void accelerations(const std::vector<R>& x, std::vector<Vec<D, R>>& out) const;
   /// out = a(x), then ax = A x = -J out.
   void apply(const ParticleSet<D, R>& ps, const std::vector<R>& x, std::vector<Vec<D, R>>& out, std::vector<R>& ax);
-  /// Body k's moment arm at x: x - c_k, and (2D: z only) the moment r x g of g about c_k.
+  /// The moment (x - c_k) x g of g at x about body k's centre (2D: z only; add_moment).
   Vec<3, R> body_moment(std::size_t k, const Vec<D, R>& x, const Vec<D, R>& g) const;
   /// A body's linear and angular velocity, or their changes (strong coupling).
   struct BodyMotion {

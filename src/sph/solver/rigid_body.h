@@ -160,9 +160,9 @@ void advance_velocities(RigidBodyState<D>& s, const MassProperties<D>& mp, const
 std::array<double, 9> quaternion_matrix(const std::array<double, 4>& q);
 
 /// Adds m (x - c) x f to `moment` (2D: its z component), the moment about c of f at x.
-template <int D>
-void add_moment(Vec<3, double>& moment, const Vec<D, double>& x, const Vec<D, double>& c, const Vec<D, double>& f) {
-  const Vec<D, double> r = x - c;
+template <int D, class T>
+void add_moment(Vec<3, T>& moment, const Vec<D, T>& x, const Vec<D, T>& c, const Vec<D, T>& f) {
+  const Vec<D, T> r = x - c;
   if constexpr (D == 2) {
     moment[2] += r[0] * f[1] - r[1] * f[0];
   } else {

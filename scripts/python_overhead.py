@@ -14,8 +14,9 @@ steps include).
 
     PYTHONPATH=build/python GOMP_SPINCOUNT=1000 python3 scripts/python_overhead.py [--steps 400] [--repeats 7] [--threads 1]
 
-(GOMP_SPINCOUNT=1000 is what sph run sets for itself when neither it nor OMP_WAIT_POLICY is set;
-libgomp reads it when it loads, so the module takes it from the environment.)
+(With GOMP_SPINCOUNT set, sph run keeps it, and both sides spin alike; with neither it nor
+OMP_WAIT_POLICY set, sph run calibrates its own count, about 30 us of spinning. libgomp reads it
+when it loads, so the module takes it from the environment.)
 """
 import argparse
 import csv

@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include <sph/core/error.h>
+#include <sph/core/parallel.h>
 #include <sph/core/version.h>
 
 #include "commands.h"
@@ -46,14 +47,15 @@ std::string first_unknown_option(CLI::App& app, int argc, char** argv) {
 
 /// OpenMP threads that spin long while they wait (libgomp's default) make every step 10 to 80
 /// times slower as soon as another program competes for the cores; threads that sleep at once
-/// (OMP_WAIT_POLICY=passive) make small scenes 2.5 times slower on idle cores. A short spin
-/// (GOMP_SPINCOUNT=1000) is as fast as spinning on idle cores and bounded under contention
-/// (docs/performance.md, Threads). libgomp reads these once, when it loads, before main: the
-/// only way to choose a default is to restart the program with it set. A setting the user made
-/// (either variable) is kept.
+/// (OMP_WAIT_POLICY=passive) make small scenes 2.5 times slower on idle cores. A short spin, of
+/// about kSpinMicroseconds (GOMP_SPINCOUNT calibrated on this CPU), is nearly as fast as spinning
+/// on idle cores and bounded under contention (docs/performance.md, Threads). libgomp reads these
+/// once, when it loads, before main: the only way to choose a default is to restart the program
+/// with it set. A setting the user made (either variable) is kept.
 static void default_to_short_spin(char** argv) {
   if (std::getenv("OMP_WAIT_POLICY") != nullptr || std::getenv("GOMP_SPINCOUNT") != nullptr) return;
-  if (setenv("GOMP_SPINCOUNT", "1000", 1) != 0) return;
+  const std::string count = std::to_string(sph::spin_count_lasting(sph::kSpinMicroseconds));
+  if (setenv("GOMP_SPINCOUNT", count.c_str(), 1) != 0) return;
   execv("/proc/self/exe", argv);  // returns only if it failed: then run with libgomp's default
 }
 

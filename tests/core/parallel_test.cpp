@@ -105,5 +105,24 @@ TEST(BalanceLoops, RefusesAWorkListOfTheWrongLength) {
   EXPECT_ANY_THROW(balance_loops(10 * kChunkSize, work));
 }
 
+TEST(SpinCount, IsAWholeHundredWithinItsBoundsAndGrowsWithTheTime) {
+  // (calibrated by timing pauses: the two durations are a thousand times apart, far beyond what
+  // a busy machine changes in the fastest of three timings)
+  const long brief = spin_count_lasting(kSpinMicroseconds);
+  const long nothing = spin_count_lasting(0);
+  const long long_one = spin_count_lasting(1000 * kSpinMicroseconds);
+  for (long c : {brief, nothing, long_one}) {
+    EXPECT_GE(c, 100);
+    EXPECT_LE(c, 100000);
+    EXPECT_EQ(c % 100, 0);
+  }
+#if defined(__x86_64__) || defined(__i386__)
+  EXPECT_EQ(nothing, 100);
+  EXPECT_GT(long_one, brief);
+#else
+  EXPECT_EQ(brief, 1000);  // (no pause to time)
+#endif
+}
+
 }  // namespace
 }  // namespace sph

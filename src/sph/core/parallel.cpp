@@ -1,4 +1,10 @@
 #include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
 
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
@@ -21,6 +27,24 @@ int num_threads() {
   return omp_get_max_threads();
 #else
   return 1;
+#endif
+}
+
+long spin_count_lasting(double microseconds) {
+#if defined(__x86_64__) || defined(__i386__)
+  constexpr int kPauses = 4096;
+  double best = 0;  // ns per pause
+  for (int run = 0; run < 3; ++run) {
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < kPauses; ++i) _mm_pause();
+    const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count();
+    if (run == 0 || ns < best) best = ns;
+  }
+  const double count = microseconds * 1e3 / std::max(best / kPauses, 0.1);
+  return std::clamp(std::lround(count / 100) * 100, 100L, 100000L);
+#else
+  (void)microseconds;
+  return 1000;
 #endif
 }
 

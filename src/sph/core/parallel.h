@@ -16,6 +16,19 @@ void set_num_threads(int n);
 /// The number of worker threads parallel loops use.
 int num_threads();
 
+/// How long idle OpenMP threads spin before they sleep when sph chooses (apps/sph/main.cpp):
+/// long enough to bridge the serial stretches of a small scene's step (a sleeping thread takes
+/// tens of microseconds to wake on a virtual machine), short enough that a program competing
+/// for the cores loses little (docs/performance.md, "How idle threads wait").
+inline constexpr double kSpinMicroseconds = 30;
+
+/// libgomp's GOMP_SPINCOUNT that spins about `microseconds` on this CPU, rounded to a hundred
+/// (at least 100, at most 100,000). Each of libgomp's spin iterations is one `pause`, whose cost
+/// differs ten times and more between CPUs (10 ns on one machine of this project, about 30 ns on
+/// another): the count is calibrated by timing pauses (the fastest of three runs of 4,096,
+/// about 0.1-1 ms in all). 1,000 where there is no `pause` to time (not x86).
+long spin_count_lasting(double microseconds);
+
 /// The calling thread's index in [0, num_threads()) inside a parallel loop (0 outside one).
 /// Only for per-thread scratch: results must never depend on which thread ran what.
 int thread_index();

@@ -290,7 +290,7 @@ void RunOutput<D, R>::finish(const Simulation<D, R>& sim, const std::string& sta
   s["precision"] = std::is_same_v<R, float> ? "float" : "double";
   s["neighbors"] = info_.mode;
   s["threads"] = info_.threads;
-  // How idle OpenMP threads wait (sph sets GOMP_SPINCOUNT=1000 unless the user chose).
+  // How idle OpenMP threads wait (sph sets a calibrated GOMP_SPINCOUNT unless the user chose).
   std::string wait;
   for (const char* var : {"OMP_WAIT_POLICY", "GOMP_SPINCOUNT"})
     if (const char* v = std::getenv(var)) wait += (wait.empty() ? "" : " ") + std::string(var) + "=" + v;

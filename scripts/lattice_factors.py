@@ -1,0 +1,69 @@
+#!/usr/bin/env python3
+"""What a kernel gives on the initial lattice (docs/validation.md, "DFSPH": why the 3D tank's
+pressure misses rho0 g d).
+
+    python3 scripts/lattice_factors.py [KERNEL_RADIUS_IN_SPACINGS ...]   (default: 2.0 2.15 2.5 3.0)
+
+For each dimension (2, 3), each kernel (cubic spline, Wendland C2, spiky) and each support h in
+particle spacings, on the square (cubic) lattice of spacing 1 with one particle at the origin:
+- "sum": sum_j V W(r_j) with V = 1, the self term included (sph's default mass is rho0 V / sum,
+  so that a lattice particle has exactly rho0; spiky, the paper's pressure kernel, is not a
+  density kernel);
+- "gradient": sum_j V |W'(r_j)| x_j^2 / r_j, the lattice's factor on the gradient of a linear
+  field (1 in the continuum). A symmetric pressure force on the lattice balances gravity with
+  p = rho0 g d / gradient, so a resting tank on its initial lattice reads p / (rho0 g d) =
+  1 / gradient in its interior.
+"""
+import itertools
+import math
+import sys
+
+import numpy as np
+
+
+def sigma(kind, h, dim):
+    if kind == "cubic":
+        return 8 / (math.pi * h**3) if dim == 3 else 40 / (7 * math.pi * h**2)
+    if kind == "wendland":
+        return 21 / (2 * math.pi * h**3) if dim == 3 else 7 / (math.pi * h**2)
+    return 15 / (math.pi * h**6) if dim == 3 else 10 / (math.pi * h**5)  # spiky
+
+
+def kernel(kind, r, h, dim):
+    q = r / h
+    s = sigma(kind, h, dim)
+    if kind == "cubic":
+        return np.where(q <= 0.5, s * (6 * q**3 - 6 * q**2 + 1), np.where(q <= 1, 2 * s * (1 - q) ** 3, 0.0))
+    if kind == "wendland":
+        return np.where(q < 1, s * (1 - q) ** 4 * (1 + 4 * q), 0.0)
+    return np.where(r < h, s * (h - r) ** 3, 0.0)
+
+
+def derivative(kind, r, h, dim):
+    q = r / h
+    s = sigma(kind, h, dim)
+    if kind == "cubic":
+        return np.where(q <= 0.5, s * (18 * q**2 - 12 * q) / h, np.where(q <= 1, -6 * s * (1 - q) ** 2 / h, 0.0))
+    if kind == "wendland":
+        return np.where(q < 1, -20 * s * q * (1 - q) ** 3 / h, 0.0)
+    return np.where(r < h, -3 * s * (h - r) ** 2, 0.0)
+
+
+def main():
+    supports = [float(a) for a in sys.argv[1:]] or [2.0, 2.15, 2.5, 3.0]
+    print("| dimension | h (spacings) | kernel | sum | gradient | 1 / gradient |")
+    print("| ---: | ---: | --- | ---: | ---: | ---: |")
+    for dim in (2, 3):
+        for h in supports:
+            n = int(math.ceil(h)) + 1
+            points = np.array([p for p in itertools.product(range(-n, n + 1), repeat=dim) if any(p)], float)
+            r = np.linalg.norm(points, axis=1)
+            for kind in ("cubic", "wendland", "spiky"):
+                total = float(np.sum(kernel(kind, r, h, dim)) + kernel(kind, np.array(0.0), h, dim))
+                grad = float(np.sum(-derivative(kind, r, h, dim) * points[:, 0] ** 2 / r))
+                shown = f"{total:.4f}" if kind != "spiky" else "-"  # (the paper's density is poly6's)
+                print(f"| {dim} | {h:g} | {kind} | {shown} | {grad:.4f} | {1 / grad:.4f} |")
+
+
+if __name__ == "__main__":
+    main()

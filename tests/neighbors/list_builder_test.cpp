@@ -192,6 +192,39 @@ TEST(FastLists, RebuildSomeLeavesUnmarkedChunksUntouchedAndAppends) {
   }
 }
 
+// balance_loops' work: each chunk's entries, counted for lists laid one after the other (from
+// their chunk's last end) and for lists with room of their own (list by list), after a build and
+// after a partial rebuild that appends particles (a last chunk that is not full).
+TEST(NeighborListsStorage, ChunkEntriesAreEachChunksListSizes) {
+  for (bool room : {false, true}) {
+    SCOPED_TRACE(room ? "with room" : "without room");
+    auto x = jittered_lattice<3, double>(12, 0.025, 0.0025, 5, true);  // 1,728 points: 7 chunks
+    const double r = 0.05;
+    UniformGrid<3, double> grid;
+    grid.build(x, r);
+    ListBuilder<3, double> b;
+    b.keep_room(room);
+    NeighborLists lists;
+    b.build(grid, x, r, lists);
+    const auto expect_sizes = [&] {
+      std::vector<std::uint64_t> work(chunk_count(lists.particle_count()), 5), want(work);
+      for (std::size_t i = 0; i < lists.particle_count(); ++i) want[i / kChunkSize] += lists.of(i).size();
+      lists.add_chunk_entries(work);
+      EXPECT_EQ(work, want);
+      EXPECT_EQ(std::accumulate(want.begin(), want.end(), std::uint64_t{0}), 5 * want.size() + lists.entry_count());
+    };
+    expect_sizes();
+    for (int k = 0; k < 40; ++k) x.push_back(Vec<3, double>{0.1 + 0.01 * k, 0.1, 0.1});
+    std::vector<std::uint8_t> flags(x.size(), 0);
+    flags[300] = flags[1000] = 1;
+    x[300][0] += 0.01;
+    grid.build(x, r);
+    b.rebuild_some(grid, x, r, flags, lists);
+    ASSERT_EQ(lists.particle_count(), x.size());
+    expect_sizes();
+  }
+}
+
 template <int D>
 void expect_morton_is_stable_permutation() {
   auto x = jittered_lattice<D, double>(D == 3 ? 20 : 90, 0.025, 0.0025, 11, true);

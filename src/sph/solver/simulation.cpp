@@ -750,6 +750,28 @@ double Simulation<D, R>::max_speed() const {
 }
 
 template <int D, std::floating_point R>
+std::pair<double, double> Simulation<D, R>::kinetic_energy_and_max_speed() const {
+  // kinetic_energy()'s blocks and order (chunked_sum's), and each block's largest |v|^2 beside.
+  const std::size_t n = particles_.size(), blocks = chunk_count<kSumBlock>(n);
+  partial_.assign(2 * blocks, 0.0);
+  parallel_chunks<kSumBlock>(n, [&](std::size_t c, std::size_t b, std::size_t e) {
+    double s = 0;
+    R m = 0;
+    for (std::size_t i = b; i < e; ++i) {
+      const R v2 = norm2(particles_.velocity[i]);
+      s += 0.5 * static_cast<double>(particles_.mass[i]) * static_cast<double>(v2);
+      m = std::max(m, v2);
+    }
+    partial_[c] = s;
+    partial_[blocks + c] = static_cast<double>(m);
+  });
+  double energy = 0, fastest = 0;
+  for (std::size_t c = 0; c < blocks; ++c) energy += partial_[c];
+  for (std::size_t c = 0; c < blocks; ++c) fastest = std::max(fastest, partial_[blocks + c]);
+  return {energy, std::sqrt(fastest)};
+}
+
+template <int D, std::floating_point R>
 Vec<D, double> Simulation<D, R>::momentum() const {
   Vec<D, double> p{};
   for (int d = 0; d < D; ++d)

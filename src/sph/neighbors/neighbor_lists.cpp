@@ -11,8 +11,7 @@ namespace sph {
 void NeighborLists::add_chunk_entries(std::span<std::uint64_t> work) const {
   SPH_CHECK(work.size() == chunk_count(particle_count()), "one work figure per chunk of the lists' particles");
   if (begin_.empty()) {  // (lists one after the other from the chunk's start: its last list's end)
-    for (std::size_t c = 0; c < work.size(); ++c)
-      work[c] += end_[std::min(particle_count(), (c + 1) * kChunkSize) - 1];
+    for (std::size_t c = 0; c < work.size(); ++c) work[c] += end_[std::min(particle_count(), (c + 1) * kChunkSize) - 1];
     return;
   }
   parallel_chunks(particle_count(), [&](std::size_t c, std::size_t b, std::size_t e) {

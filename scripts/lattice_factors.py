@@ -10,9 +10,11 @@ particle spacings, on the square (cubic) lattice of spacing 1 with one particle 
   so that a lattice particle has exactly rho0; spiky, the paper's pressure kernel, is not a
   density kernel);
 - "gradient": sum_j V |W'(r_j)| x_j^2 / r_j, the lattice's factor on the gradient of a linear
-  field (1 in the continuum). A symmetric pressure force on the lattice balances gravity with
-  p = rho0 g d / gradient, so a resting tank on its initial lattice reads p / (rho0 g d) =
-  1 / gradient in its interior.
+  field (1 in the continuum);
+- "sum / gradient": what a resting tank on its initial lattice reads as p / (rho0 g d) in its
+  interior. With the default mass m = rho0 V / sum, a symmetric pressure force
+  -sum_j m (p_i + p_j) / rho0^2 grad W_ij on a linear p of gradient G is G (m / V) gradient /
+  rho0^2 = G gradient / (rho0 sum), which balances g where G = rho0 g sum / gradient.
 """
 import itertools
 import math
@@ -51,7 +53,7 @@ def derivative(kind, r, h, dim):
 
 def main():
     supports = [float(a) for a in sys.argv[1:]] or [2.0, 2.15, 2.5, 3.0]
-    print("| dimension | h (spacings) | kernel | sum | gradient | 1 / gradient |")
+    print("| dimension | h (spacings) | kernel | sum | gradient | sum / gradient |")
     print("| ---: | ---: | --- | ---: | ---: | ---: |")
     for dim in (2, 3):
         for h in supports:
@@ -61,8 +63,10 @@ def main():
             for kind in ("cubic", "wendland", "spiky"):
                 total = float(np.sum(kernel(kind, r, h, dim)) + kernel(kind, np.array(0.0), h, dim))
                 grad = float(np.sum(-derivative(kind, r, h, dim) * points[:, 0] ** 2 / r))
-                shown = f"{total:.4f}" if kind != "spiky" else "-"  # (the paper's density is poly6's)
-                print(f"| {dim} | {h:g} | {kind} | {shown} | {grad:.4f} | {1 / grad:.4f} |")
+                if kind == "spiky":  # (the paper's density is poly6's: no sum, no ratio)
+                    print(f"| {dim} | {h:g} | {kind} | - | {grad:.4f} | - |")
+                else:
+                    print(f"| {dim} | {h:g} | {kind} | {total:.4f} | {grad:.4f} | {total / grad:.4f} |")
 
 
 if __name__ == "__main__":

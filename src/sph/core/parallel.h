@@ -24,9 +24,10 @@ inline constexpr double kSpinMicroseconds = 30;
 
 /// libgomp's GOMP_SPINCOUNT that spins about `microseconds` on this CPU, rounded to a hundred
 /// (at least 100, at most 100,000). Each of libgomp's spin iterations is one `pause`, whose cost
-/// differs ten times and more between CPUs (10 ns on one machine of this project, about 30 ns on
-/// another): the count is calibrated by timing pauses (the fastest of three runs of 4,096,
-/// about 0.1-1 ms in all). 1,000 where there is no `pause` to time (not x86).
+/// differs ten times and more between CPUs (10 ns on the Intel Xeon this project measured on
+/// 2026-12-05, where the fixed count of 1,000 that served on an AMD EPYC spun only 10 us): the
+/// count is calibrated by timing pauses (the fastest of three runs of 4,096, about 0.1-1 ms in
+/// all). 1,000 where there is no `pause` to time (not x86).
 long spin_count_lasting(double microseconds);
 
 /// The calling thread's index in [0, num_threads()) inside a parallel loop (0 outside one).

@@ -26,8 +26,9 @@ inline constexpr double kSpinMicroseconds = 30;
 /// (at least 100, at most 100,000). Each of libgomp's spin iterations is one `pause`, whose cost
 /// differs ten times and more between CPUs (10 ns on the Intel Xeon this project measured on
 /// 2026-12-05, where the fixed count of 1,000 that served on an AMD EPYC spun only 10 us): the
-/// count is calibrated by timing pauses (the fastest of three runs of 4,096, about 0.1-1 ms in
-/// all). 1,000 where there is no `pause` to time (not x86).
+/// count is calibrated by timing libgomp's spin iteration (a relaxed load, then a pause; the
+/// fastest of three runs of 4,096, about 0.1-1 ms in all). 1,000 where there is no `pause` to
+/// time (not x86).
 long spin_count_lasting(double microseconds);
 
 /// The calling thread's index in [0, num_threads()) inside a parallel loop (0 outside one).

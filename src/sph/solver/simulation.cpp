@@ -729,29 +729,18 @@ HealthStats Simulation<D, R>::reduce_health() const {
 
 template <int D, std::floating_point R>
 double Simulation<D, R>::kinetic_energy() const {
-  return chunked_sum(particles_.size(), partial_, [&](std::size_t i) {
-    return 0.5 * static_cast<double>(particles_.mass[i]) * static_cast<double>(norm2(particles_.velocity[i]));
-  });
+  return kinetic_energy_and_max_speed().first;
 }
 
 template <int D, std::floating_point R>
 double Simulation<D, R>::max_speed() const {
-  // Per-chunk maxima (a max is exact: the same for any thread count).
-  const std::size_t n = particles_.size();
-  partial_.assign(chunk_count(n), 0.0);
-  parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
-    R m = 0;
-    for (std::size_t i = b; i < e; ++i) m = std::max(m, norm2(particles_.velocity[i]));
-    partial_[c] = static_cast<double>(m);
-  });
-  double m = 0;
-  for (double p : partial_) m = std::max(m, p);
-  return std::sqrt(m);
+  return kinetic_energy_and_max_speed().second;
 }
 
 template <int D, std::floating_point R>
 std::pair<double, double> Simulation<D, R>::kinetic_energy_and_max_speed() const {
-  // kinetic_energy()'s blocks and order (chunked_sum's), and each block's largest |v|^2 beside.
+  // chunked_sum's blocks and order for the energy, and each block's largest |v|^2 beside (a max is
+  // exact: the same for any thread count).
   const std::size_t n = particles_.size(), blocks = chunk_count<kSumBlock>(n);
   partial_.assign(2 * blocks, 0.0);
   parallel_chunks<kSumBlock>(n, [&](std::size_t c, std::size_t b, std::size_t e) {

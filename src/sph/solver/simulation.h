@@ -146,8 +146,7 @@ class Simulation {
   double kinetic_energy() const;
   /// Largest particle speed, m/s.
   double max_speed() const;
-  /// kinetic_energy() and max_speed() in one parallel pass (each the same bit for bit): what a
-  /// step's stats row takes, for one parallel loop instead of two.
+  /// kinetic_energy() and max_speed() in one parallel pass: what a step's stats row takes.
   std::pair<double, double> kinetic_energy_and_max_speed() const;
   /// Total linear momentum, kg m/s. Deterministic for any thread count.
   Vec<D, double> momentum() const;

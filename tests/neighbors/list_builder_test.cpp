@@ -66,6 +66,67 @@ TEST(FastLists, VectorAndScalarKernelsAgree3dFloatShuffled) { expect_kernels_agr
 TEST(FastLists, VectorAndScalarKernelsAgree2dDouble) { expect_kernels_agree<2, double>(60, 2.0, true); }
 TEST(FastLists, VectorAndScalarKernelsAgree2dFloat) { expect_kernels_agree<2, float>(60, 2.5, false); }
 
+/// Records the lists it is shown and keeps every other entry of each.
+struct EveryOtherFilter final : ListFilter {
+  mutable std::vector<std::vector<std::uint32_t>> shown;
+  std::uint32_t keep(std::size_t i, std::uint32_t* list, std::uint32_t len) const override {
+    shown[i].assign(list, list + len);
+    std::uint32_t kept = 0;
+    for (std::uint32_t k = 0; k < len; k += 2) list[kept++] = list[k];
+    return kept;
+  }
+};
+
+template <int D, class R>
+void expect_split_lists(bool vector, bool filtered) {
+  const auto x = jittered_lattice<D, R>(D == 3 ? 12 : 40, 0.025, 0.45 * 0.025, 11, true);
+  const R r = static_cast<R>(2.6 * 0.025), inner = static_cast<R>(1.9 * 0.025);
+  UniformGrid<D, R> grid;
+  grid.build(x, r);
+  ListBuilder<D, R> plain, split;
+  plain.use_vector_kernel(vector);
+  split.use_vector_kernel(vector);
+  split.split_at(inner);
+  EveryOtherFilter filter;
+  filter.shown.resize(x.size());
+  if (filtered) split.set_filter(&filter);
+  NeighborLists a, b;
+  plain.build(grid, x, r, a);
+  split.build(grid, x, r, b);
+  ASSERT_EQ(b.particle_count(), x.size());
+  std::size_t inner_entries = 0, outer_entries = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    // The plain list's entries closer than `inner`, then the others, each in the plain list's order.
+    std::vector<std::uint32_t> near, far;
+    for (const std::uint32_t j : a.of(i)) (norm2(x[i] - x[j]) < inner * inner ? near : far).push_back(j);
+    inner_entries += near.size();
+    outer_entries += far.size();
+    if (filtered) {
+      ASSERT_EQ(filter.shown[i], far) << "the filter sees the entries beyond the inner radius, particle " << i;
+      std::vector<std::uint32_t> kept;
+      for (std::size_t k = 0; k < far.size(); k += 2) kept.push_back(far[k]);
+      far = kept;
+    }
+    std::vector<std::uint32_t> want = near;
+    want.insert(want.end(), far.begin(), far.end());
+    ASSERT_EQ(std::vector<std::uint32_t>(b.of(i).begin(), b.of(i).end()), want) << "particle " << i;
+  }
+  EXPECT_GT(inner_entries, x.size());  // both parts are there to order
+  EXPECT_GT(outer_entries, x.size());
+  EXPECT_TRUE(b.padding_is_valid());
+}
+
+TEST(FastLists, SplitListsHoldTheEntriesWithinTheInnerRadiusFirst) {
+  for (const bool vector : {true, false})
+    for (const bool filtered : {false, true}) {
+      SCOPED_TRACE(::testing::Message() << "vector kernel " << vector << ", filtered " << filtered);
+      expect_split_lists<3, double>(vector, filtered);
+      expect_split_lists<3, float>(vector, filtered);
+      expect_split_lists<2, double>(vector, filtered);
+      expect_split_lists<2, float>(vector, filtered);
+    }
+}
+
 TEST(FastLists, ParallelCountingSortGivesTheSerialOrder) {
   // 64,000 points in 8,000 cells: with 2 or more threads the grid sorts in parallel blocks;
   // a stable sort by cell has one result, so lists (which follow the grid order) must not change.

@@ -32,9 +32,14 @@ struct Stencil {
 /// to out and returns how many. out must have room for every candidate plus kPad.
 /// The squared distance is computed exactly as norm2(x - x_j) is (same operations, same
 /// order, no fused multiply-add), so lists agree bit for bit with a brute-force search.
+///
+/// With `far` (room for every candidate): the neighbors closer than sqrt(inner2) go to out, the
+/// others to far, and the caller appends far's to out's (gather() does: the list then holds its
+/// entries closer than the inner radius first, each part in the grid's order).
 template <int D, std::floating_point R>
 std::uint32_t gather_scalar(const UniformGrid<D, R>& grid, const Stencil<D, R>& st, const Vec<D, R>& x,
-                            std::uint32_t self, R r2, std::uint32_t* out) {
+                            std::uint32_t self, R r2, std::uint32_t* out, R inner2 = 0, std::uint32_t* far = nullptr,
+                            std::uint32_t* far_count = nullptr) {
   const std::uint32_t* sorted = grid.sorted();
   const R* c[D];
   for (int d = 0; d < D; ++d) c[d] = grid.sorted_coord(d);
@@ -46,23 +51,29 @@ std::uint32_t gather_scalar(const UniformGrid<D, R>& grid, const Stencil<D, R>& 
         const R t = x[d] - c[d][k];
         d2 += t * t;
       }
+      const bool hit = (d2 < r2) & (sorted[k] != self);
+      if (far && hit && !(d2 < inner2)) {
+        far[(*far_count)++] = sorted[k];
+        continue;
+      }
       out[m] = sorted[k];
-      m += static_cast<std::uint32_t>((d2 < r2) & (sorted[k] != self));
+      m += static_cast<std::uint32_t>(hit);
     }
   return m;
 }
 
 #if SPH_SIMD_AVX512
-template <int D>
+template <bool kSplit, int D>
 std::uint32_t gather_vector(const UniformGrid<D, double>& grid, const Stencil<D, double>& st, const Vec<D, double>& x,
-                            std::uint32_t self, double r2, std::uint32_t* out) {
+                            std::uint32_t self, double r2, std::uint32_t* out, double inner2, std::uint32_t* far,
+                            std::uint32_t* far_count) {
   const std::uint32_t* sorted = grid.sorted();
   const double* c[D];
   __m512d xv[D];
   for (int d = 0; d < D; ++d) c[d] = grid.sorted_coord(d), xv[d] = _mm512_set1_pd(x[d]);
-  const __m512d r2v = _mm512_set1_pd(r2);
+  const __m512d r2v = _mm512_set1_pd(r2), inner2v = _mm512_set1_pd(inner2);
   const __m256i selfv = _mm256_set1_epi32(static_cast<int>(self));
-  std::uint32_t m = 0;
+  std::uint32_t m = 0, f = 0;
   for (int q = 0; q < st.count; ++q) {
     const std::uint32_t e = st.end[q];
     for (std::uint32_t k = st.begin[q]; k < e; k += 8) {
@@ -75,25 +86,33 @@ std::uint32_t gather_vector(const UniformGrid<D, double>& grid, const Stencil<D,
       }
       const __m256i idx = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(sorted + k));
       const unsigned keep = (e - k < 8 ? (1u << (e - k)) - 1u : 0xffu) & _mm256_cmpneq_epi32_mask(idx, selfv);
-      const __mmask8 hit = static_cast<__mmask8>(_mm512_cmp_pd_mask(d2, r2v, _CMP_LT_OQ) & keep);
+      __mmask8 hit = static_cast<__mmask8>(_mm512_cmp_pd_mask(d2, r2v, _CMP_LT_OQ) & keep);
+      if constexpr (kSplit) {
+        const __mmask8 outer = hit & static_cast<__mmask8>(~_mm512_cmp_pd_mask(d2, inner2v, _CMP_LT_OQ));
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(far + f), _mm256_maskz_compress_epi32(outer, idx));
+        f += static_cast<std::uint32_t>(__builtin_popcount(outer));
+        hit = hit & static_cast<__mmask8>(~outer);
+      }
       // Register compress + plain store: the memory form of vpcompressd is slow on some CPUs.
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + m), _mm256_maskz_compress_epi32(hit, idx));
       m += static_cast<std::uint32_t>(__builtin_popcount(hit));
     }
   }
+  if constexpr (kSplit) *far_count = f;
   return m;
 }
 
-template <int D>
+template <bool kSplit, int D>
 std::uint32_t gather_vector(const UniformGrid<D, float>& grid, const Stencil<D, float>& st, const Vec<D, float>& x,
-                            std::uint32_t self, float r2, std::uint32_t* out) {
+                            std::uint32_t self, float r2, std::uint32_t* out, float inner2, std::uint32_t* far,
+                            std::uint32_t* far_count) {
   const std::uint32_t* sorted = grid.sorted();
   const float* c[D];
   __m512 xv[D];
   for (int d = 0; d < D; ++d) c[d] = grid.sorted_coord(d), xv[d] = _mm512_set1_ps(x[d]);
-  const __m512 r2v = _mm512_set1_ps(r2);
+  const __m512 r2v = _mm512_set1_ps(r2), inner2v = _mm512_set1_ps(inner2);
   const __m512i selfv = _mm512_set1_epi32(static_cast<int>(self));
-  std::uint32_t m = 0;
+  std::uint32_t m = 0, f = 0;
   for (int q = 0; q < st.count; ++q) {
     const std::uint32_t e = st.end[q];
     for (std::uint32_t k = st.begin[q]; k < e; k += 16) {
@@ -106,24 +125,42 @@ std::uint32_t gather_vector(const UniformGrid<D, float>& grid, const Stencil<D, 
       }
       const __m512i idx = _mm512_loadu_si512(sorted + k);
       const unsigned keep = (e - k < 16 ? (1u << (e - k)) - 1u : 0xffffu) & _mm512_cmpneq_epi32_mask(idx, selfv);
-      const __mmask16 hit = static_cast<__mmask16>(_mm512_cmp_ps_mask(d2, r2v, _CMP_LT_OQ) & keep);
+      __mmask16 hit = static_cast<__mmask16>(_mm512_cmp_ps_mask(d2, r2v, _CMP_LT_OQ) & keep);
+      if constexpr (kSplit) {
+        const __mmask16 outer = hit & static_cast<__mmask16>(~_mm512_cmp_ps_mask(d2, inner2v, _CMP_LT_OQ));
+        _mm512_storeu_si512(far + f, _mm512_maskz_compress_epi32(outer, idx));
+        f += static_cast<std::uint32_t>(__builtin_popcount(outer));
+        hit = hit & static_cast<__mmask16>(~outer);
+      }
       _mm512_storeu_si512(out + m, _mm512_maskz_compress_epi32(hit, idx));
       m += static_cast<std::uint32_t>(__builtin_popcount(hit));
     }
   }
+  if constexpr (kSplit) *far_count = f;
   return m;
 }
 #endif
 
+/// The neighbors of point `self` (at x) into out, as gather_scalar; with `far` (room for every
+/// candidate and a register), those closer than sqrt(inner2) first, then the others, and how
+/// many are closer in `*inner` (every one without `far`).
 template <int D, std::floating_point R>
 std::uint32_t gather(bool vector, const UniformGrid<D, R>& grid, const Stencil<D, R>& st, const Vec<D, R>& x,
-                     std::uint32_t self, R r2, std::uint32_t* out) {
+                     std::uint32_t self, R r2, std::uint32_t* out, R inner2, std::uint32_t* far, std::uint32_t* inner) {
+  std::uint32_t m = 0, f = 0;
 #if SPH_SIMD_AVX512
-  if (vector) return gather_vector<D>(grid, st, x, self, r2, out);
+  if (vector)
+    m = far ? gather_vector<true, D>(grid, st, x, self, r2, out, inner2, far, &f)
+            : gather_vector<false, D>(grid, st, x, self, r2, out, inner2, far, &f);
+  else
+    m = gather_scalar<D, R>(grid, st, x, self, r2, out, inner2, far, &f);
 #else
   (void)vector;
+  m = gather_scalar<D, R>(grid, st, x, self, r2, out, inner2, far, &f);
 #endif
-  return gather_scalar<D, R>(grid, st, x, self, r2, out);
+  if (f > 0) std::copy_n(far, f, out + m);
+  *inner = m;
+  return m + f;
 }
 
 /// Makes buf at least `need` long, growing by a sixteenth at least (few reallocations while the
@@ -163,6 +200,14 @@ struct QueryPoints {
 };
 
 }  // namespace
+
+template <int D, std::floating_point R>
+std::uint32_t* ListBuilder<D, R>::far_room(std::size_t candidates) {
+  if (!(inner_ > R(0))) return nullptr;
+  std::vector<std::uint32_t>& far = far_[static_cast<std::size_t>(thread_index())];
+  ensure_room(far, candidates + kRoom);
+  return far.data();
+}
 
 template <int D, std::floating_point R>
 void ListBuilder<D, R>::build(const UniformGrid<D, R>& grid, std::span<const Vec<D, R>> positions, R radius,
@@ -206,6 +251,7 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
   }
   chunk_entries_.resize(chunks);
   old_copy_.resize(static_cast<std::size_t>(num_threads()));
+  far_.resize(old_copy_.size());
 
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     // A chunk's first build goes to its thread's scratch, then into a buffer allocated once, at
@@ -220,8 +266,10 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
       st.update(grid, query.cell(i));
       most = std::max<std::size_t>(most, st.candidates);
       ensure_room(buf, used + st.candidates + kRoom);
-      std::uint32_t m = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + used);
-      if (filter_) m = filter_->keep(i, buf.data() + used, m);
+      std::uint32_t inner = 0;
+      std::uint32_t m = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + used, inner2(),
+                               far_room(st.candidates), &inner);
+      if (filter_) m = inner + filter_->keep(i, buf.data() + used + inner, m - inner);
       if (room_) out.begin_[i] = static_cast<std::uint32_t>(used);
       out.end_[i] = static_cast<std::uint32_t>(used + m);
       entries += m;
@@ -276,6 +324,7 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
   }
   old_copy_.resize(static_cast<std::size_t>(num_threads()));
   for (auto& copy : old_copy_) ensure_room(copy, largest_old);
+  far_.resize(old_copy_.size());
 
   if (room_ && lists.has_room()) {
     rebuild_in_place(grid, n, query, radius, rebuild, lists, visitor);
@@ -313,8 +362,10 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
       if (marked(i)) {
         st.update(grid, query.cell(i));
         ensure_room(buf, at + st.candidates + kRoom);
-        len = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at);
-        if (filter_) len = filter_->keep(i, buf.data() + at, len);
+        std::uint32_t inner = 0;
+        len = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at, inner2(),
+                     far_room(st.candidates), &inner);
+        if (filter_) len = inner + filter_->keep(i, buf.data() + at + inner, len - inner);
         written += len;
         cap = room_ ? list_capacity(len) : len;
         ensure_room(buf, at + cap + kRoom);
@@ -371,8 +422,10 @@ void ListBuilder<D, R>::rebuild_in_place(const UniformGrid<D, R>& grid, std::siz
       if (i >= old_n) {  // appended: its list goes after the chunk's last one
         const std::size_t at = i == b ? 0 : lists.begin_[i - 1] + lists.cap_[i - 1];
         ensure_room(buf, at + st.candidates + kRoom);
-        std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at);
-        if (filter_) len = filter_->keep(i, buf.data() + at, len);
+        std::uint32_t inner = 0;
+        std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at, inner2(),
+                                   far_room(st.candidates), &inner);
+        if (filter_) len = inner + filter_->keep(i, buf.data() + at + inner, len - inner);
         const std::uint32_t cap = list_capacity(len);
         ensure_room(buf, at + cap + kRoom);
         std::fill_n(buf.data() + at + len, cap - len + kRoom, 0u);
@@ -385,8 +438,10 @@ void ListBuilder<D, R>::rebuild_in_place(const UniformGrid<D, R>& grid, std::siz
         continue;
       }
       ensure_room(scratch, st.candidates + kRoom);
-      std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, scratch.data());
-      if (filter_) len = filter_->keep(i, scratch.data(), len);
+      std::uint32_t inner = 0;
+      std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, scratch.data(), inner2(),
+                                 far_room(st.candidates), &inner);
+      if (filter_) len = inner + filter_->keep(i, scratch.data() + inner, len - inner);
       written += len;
       if (len > lists.cap_[i]) {
         const std::uint32_t want = list_capacity(len);

@@ -71,9 +71,14 @@ class ListBuilder {
   /// slots for a list of that size, so that other lists' particles can be inserted (the tracked
   /// modes); rebuild_some() keeps a kept list's capacity. Off by default (compact lists).
   void keep_room(bool on) { room_ = on; }
-  /// Every list built from now on is passed through `filter` (null: none) before it is stored;
-  /// capacities and counts are those of the filtered lists.
+  /// Every list built from now on is passed through `filter` (null: none) before it is stored
+  /// (beyond split_at's radius); capacities and counts are those of the filtered lists.
   void set_filter(const ListFilter* filter) { filter_ = filter; }
+  /// Lists built from now on hold their entries closer than `inner` first, then the others, each
+  /// part in the grid's order, and only the others go through the filter (set_filter): the
+  /// entries closer than `inner` are kept as they are. 0 (the default): every list in the grid's
+  /// order, all of it filtered.
+  void split_at(R inner) { inner_ = inner; }
   /// The capacity a list of `size` entries is built with when lists keep room: a quarter more and 4.
   static std::uint32_t list_capacity(std::uint32_t size) { return size + size / 4 + 4; }
 
@@ -89,8 +94,15 @@ class ListBuilder {
   void rebuild_in_place(const UniformGrid<D, R>& grid, std::size_t n, const Query& query, R radius,
                         std::span<const std::uint8_t> rebuild, NeighborLists& lists, RebuildVisitor* visitor);
 
+  /// The calling thread's buffer for the entries beyond the inner radius (room for `candidates`),
+  /// or null when lists are not split.
+  std::uint32_t* far_room(std::size_t candidates);
+  R inner2() const { return inner_ * inner_; }
+
   bool vector_ = true;
   bool room_ = false;
+  R inner_ = 0;
+  std::vector<std::vector<std::uint32_t>> far_;  // one per thread: split_at's outer entries
   const ListFilter* filter_ = nullptr;
   std::vector<std::size_t> chunk_entries_;
   std::vector<std::int64_t> chunk_delta_;

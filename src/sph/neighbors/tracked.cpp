@@ -30,6 +30,7 @@ TrackedNeighbors<D, R>::TrackedNeighbors(R radius, R skin, int full_rebuild_peri
   SPH_CHECK(skin >= R(0), "tracked skin must not be negative");
   SPH_CHECK(full_rebuild_period >= 1, "full rebuild period must be at least 1");
   builder_.keep_room(true);
+  builder_.split_at(sure_radius());
 }
 
 template <int D, std::floating_point R>
@@ -129,6 +130,7 @@ void TrackedNeighbors<D, R>::choose_skin(const ParticleSet<D, R>& particles) {
 template <int D, std::floating_point R>
 void TrackedNeighbors<D, R>::set_skin(R skin) {
   skin_ = skin;
+  builder_.split_at(sure_radius());
   // The samples' grid is indexed for the lists' radius.
   samples_copy_.assign(this->boundary_.samples().begin(), this->boundary_.samples().end());
   if (!samples_copy_.empty()) this->boundary_.set_samples(samples_copy_, boundary_radius());

@@ -83,6 +83,9 @@ class TrackedNeighbors final : public NeighborStrategy<D, R> {
   R list_radius() const override { return candidate_radius(); }
   /// The radius candidates are gathered within: every pair whose paths can come within h + s.
   R candidate_radius() const { return (radius_ + skin_ + trigger() + R(2 * kTrackedReach) * radius_) * R(1.0001); }
+  /// Candidates closer than this are kept without the path test (ListBuilder::split_at): their
+  /// paths are within h + s now, since the other particle is at most trigger() off its own path.
+  R sure_radius() const { return (radius_ + skin_ - trigger()) * R(0.9999); }
   /// A particle's samples within h along its whole path: h + s + the path's reach.
   R boundary_radius() const override { return (radius_ + skin_ + R(kTrackedReach) * radius_) * R(1.0001); }
   /// How long a path at velocity v takes to run kTrackedReach h (infinite at rest).

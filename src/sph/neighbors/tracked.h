@@ -36,7 +36,8 @@ inline constexpr double kTrackedReach = 0.1;
 /// while both windows are open; a window that closes rebuilds its list: no pair within h is
 /// ever missed. Coherent motion (a falling block, a jet) follows its paths and is not rebuilt;
 /// only what accelerates is. The candidates are those within h + s + s / 3 + 2 kTrackedReach h
-/// of the particle (each path runs at most kTrackedReach h in its window). Without set_time()
+/// of the particle (each path runs at most kTrackedReach h in its window); those closer than
+/// h + s - s / 3 are listed without the path test, which they pass (sure_radius()). Without set_time()
 /// every path stays at its build position: the rule is then the displacement rule (a particle
 /// is rebuilt after moving s / 3). Every list is rebuilt each full_rebuild_period updates and
 /// after invalidate(), which is also when an automatic skin is chosen again.

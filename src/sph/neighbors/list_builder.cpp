@@ -141,12 +141,13 @@ std::uint32_t gather_vector(const UniformGrid<D, float>& grid, const Stencil<D, 
 }
 #endif
 
-/// The neighbors of point `self` (at x) into out, as gather_scalar; with `far` (room for every
-/// candidate and a register), those closer than sqrt(inner2) first, then the others, and how
-/// many are closer in `*inner` (every one without `far`).
+/// List i: the neighbors of point `self` (at x) into out, as gather_scalar, and returns how many.
+/// With `far` (room for every candidate and a register), those closer than sqrt(inner2) first,
+/// then the others; `filter` (if any) keeps what it wants of the others (of all, without `far`).
 template <int D, std::floating_point R>
 std::uint32_t gather(bool vector, const UniformGrid<D, R>& grid, const Stencil<D, R>& st, const Vec<D, R>& x,
-                     std::uint32_t self, R r2, std::uint32_t* out, R inner2, std::uint32_t* far, std::uint32_t* inner) {
+                     std::uint32_t self, R r2, std::uint32_t* out, R inner2, std::uint32_t* far,
+                     const ListFilter* filter, std::size_t i) {
   std::uint32_t m = 0, f = 0;
 #if SPH_SIMD_AVX512
   if (vector)
@@ -159,8 +160,8 @@ std::uint32_t gather(bool vector, const UniformGrid<D, R>& grid, const Stencil<D
   m = gather_scalar<D, R>(grid, st, x, self, r2, out, inner2, far, &f);
 #endif
   if (f > 0) std::copy_n(far, f, out + m);
-  *inner = m;
-  return m + f;
+  const std::uint32_t inner = far ? m : 0;
+  return filter ? inner + filter->keep(i, out + inner, m + f - inner) : m + f;
 }
 
 /// Makes buf at least `need` long, growing by a sixteenth at least (few reallocations while the
@@ -266,10 +267,8 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
       st.update(grid, query.cell(i));
       most = std::max<std::size_t>(most, st.candidates);
       ensure_room(buf, used + st.candidates + kRoom);
-      std::uint32_t inner = 0;
-      std::uint32_t m = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + used, inner2(),
-                               far_room(st.candidates), &inner);
-      if (filter_) m = inner + filter_->keep(i, buf.data() + used + inner, m - inner);
+      const std::uint32_t m = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + used, inner2(),
+                                     far_room(st.candidates), filter_, i);
       if (room_) out.begin_[i] = static_cast<std::uint32_t>(used);
       out.end_[i] = static_cast<std::uint32_t>(used + m);
       entries += m;
@@ -362,10 +361,8 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
       if (marked(i)) {
         st.update(grid, query.cell(i));
         ensure_room(buf, at + st.candidates + kRoom);
-        std::uint32_t inner = 0;
         len = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at, inner2(),
-                     far_room(st.candidates), &inner);
-        if (filter_) len = inner + filter_->keep(i, buf.data() + at + inner, len - inner);
+                     far_room(st.candidates), filter_, i);
         written += len;
         cap = room_ ? list_capacity(len) : len;
         ensure_room(buf, at + cap + kRoom);
@@ -422,10 +419,8 @@ void ListBuilder<D, R>::rebuild_in_place(const UniformGrid<D, R>& grid, std::siz
       if (i >= old_n) {  // appended: its list goes after the chunk's last one
         const std::size_t at = i == b ? 0 : lists.begin_[i - 1] + lists.cap_[i - 1];
         ensure_room(buf, at + st.candidates + kRoom);
-        std::uint32_t inner = 0;
-        std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at, inner2(),
-                                   far_room(st.candidates), &inner);
-        if (filter_) len = inner + filter_->keep(i, buf.data() + at + inner, len - inner);
+        const std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at, inner2(),
+                                         far_room(st.candidates), filter_, i);
         const std::uint32_t cap = list_capacity(len);
         ensure_room(buf, at + cap + kRoom);
         std::fill_n(buf.data() + at + len, cap - len + kRoom, 0u);
@@ -438,10 +433,8 @@ void ListBuilder<D, R>::rebuild_in_place(const UniformGrid<D, R>& grid, std::siz
         continue;
       }
       ensure_room(scratch, st.candidates + kRoom);
-      std::uint32_t inner = 0;
-      std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, scratch.data(), inner2(),
-                                 far_room(st.candidates), &inner);
-      if (filter_) len = inner + filter_->keep(i, scratch.data() + inner, len - inner);
+      const std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, scratch.data(), inner2(),
+                                       far_room(st.candidates), filter_, i);
       written += len;
       if (len > lists.cap_[i]) {
         const std::uint32_t want = list_capacity(len);

@@ -118,42 +118,34 @@ TEST(Dfsph, PenaltyWallsAreRefused) {
   }
 }
 
-TEST(Dfsph, ASupportWiderThanTheTestedOnesIsWarnedOfAndTheWarningIsTrue) {
-  const auto warned = [](const SceneDesc& d) {
-    return std::any_of(d.warnings.begin(), d.warnings.end(), [](const std::string& w) {
-      return w.find("DFSPH runs on supports above") != std::string::npos;
-    });
-  };
-  // The 2D tank on 2.75 spacings runs and settles (with conjugate gradients in the density
-  // solve, before 2026-12-05, it gained energy and failed at step 24).
-  const std::string tank2 = SPH_SOURCE_DIR "/scenes/validation/hydrostatic_2d_dfsph.json";
-  const SceneDesc wide2 = read_scene_file(tank2, {"Configuration.kernelRadius=0.01375"});  // 2.75 spacings
-  EXPECT_FALSE(warned(wide2));
-  EXPECT_TRUE(warned(read_scene_file(tank2, {"Configuration.kernelRadius=0.015"})));  // 3
-  {
-    RunDriver<2, double> run(wide2, RunSettings{});
-    double fastest = 0, last = 0;
-    for (int k = 0; k < 200; ++k) {
+// Wide supports start from rest as calmly as the usual ones (docs/physics.md, "DFSPH",
+// "Kernels"). Before 2026-12-06 the 3D validation tank on 3 spacings failed in its first step
+// (the samples beyond the first layer weighed too much, and the walls pushed on fluid at rest),
+// and with that mended it still gained 6 % energy by its third step; the 2D tank on 4 spacings
+// blew up at its second step (whole Jacobi steps on a lattice whose gain is 6.7).
+TEST(Dfsph, WideSupportsRunFromRestWithoutAWarning) {
+  const auto calm = [](auto& run, int steps, double bound) {
+    double fastest = 0;
+    for (int k = 0; k < steps; ++k) {
       run.step();
-      last = run.simulation().max_speed();
-      fastest = std::max(fastest, last);
+      fastest = std::max(fastest, run.simulation().max_speed());
     }
-    EXPECT_LT(fastest, 0.5);  // m/s (0.16 when measured)
-    EXPECT_LT(last, 0.1);     // (0.042 at its 200th step, 0.3 s)
+    EXPECT_LT(fastest, bound);
     EXPECT_TRUE(run.simulation().health().warnings().empty());
+    for (const std::string& w : run.simulation().health().warnings()) ADD_FAILURE() << w;
+  };
+  {
+    const SceneDesc wide2 = read_scene_file(SPH_SOURCE_DIR "/scenes/validation/hydrostatic_2d_dfsph.json",
+                                            {"Configuration.kernelRadius=0.02"});  // 4 spacings
+    EXPECT_TRUE(wide2.warnings.empty());
+    RunDriver<2, double> run(wide2, RunSettings{});
+    calm(run, 200, 0.5);  // m/s
   }
-  // The 3D tank on 3 spacings is warned of, and fails in its first steps.
-  const std::string tank3 = SPH_SOURCE_DIR "/scenes/validation/hydrostatic_3d_dfsph.json";
-  EXPECT_FALSE(warned(read_scene_file(tank3, {"Configuration.kernelRadius=0.0125"})));  // 2.5 spacings
-  EXPECT_TRUE(warned(read_scene_file(tank3, {"Configuration.kernelRadius=0.01375"})));  // 2.75
-  const SceneDesc wide3 = read_scene_file(tank3, {"Configuration.kernelRadius=0.015"});
-  EXPECT_TRUE(warned(wide3));
+  const SceneDesc wide3 = read_scene_file(SPH_SOURCE_DIR "/scenes/validation/hydrostatic_3d_dfsph.json",
+                                          {"Configuration.kernelRadius=0.015"});  // 3 spacings
+  EXPECT_TRUE(wide3.warnings.empty());
   RunDriver<3, double> run(wide3, RunSettings{});
-  EXPECT_THROW(
-      {
-        for (int k = 0; k < 5; ++k) run.step();
-      },
-      Error);
+  calm(run, 30, 0.05);
 }
 
 TEST(Dfsph, ATankHeldToATenTimesTighterToleranceStaysAtRest) {

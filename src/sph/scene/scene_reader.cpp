@@ -720,17 +720,6 @@ void warn_from_scales(SceneDesc& desc, const SimulationParams<D>& sim, const Der
         viscosity_for_sound_speed(D, kArtificialViscosityAlpha, sim.kernel_radius, std::sqrt(k),
                                   sim.fluid.rest_density),
         kArtificialViscosityAlpha));
-  // DFSPH at wide supports gains energy or fails from rest (docs/physics.md, "DFSPH", "Kernels"):
-  // the validation tanks run without a warning on 2.75 spacings (2D) and 2.5 (3D); on 3 the 2D one
-  // gains 5 % energy in its first steps, on 2.75 the 3D one 11 %, and on 2.8 it fails.
-  const double spacings = sim.kernel_radius / (2 * r);
-  const double widest = D == 3 ? 2.5 : 2.75;
-  if (sim.method == SimulationMethod::Dfsph && spacings > widest + 1e-9)
-    desc.warnings.push_back(fmt::format(
-        "Configuration.kernelRadius = {:g} m is {:.3g} particle spacings: DFSPH runs on supports above {:g} spacings "
-        "gained energy or failed in this project's tests (resting tanks within their first steps; docs/physics.md, "
-        "\"DFSPH\"); use 2 spacings, kernelRadius = 4 particleRadius = {:g} m",
-        sim.kernel_radius, spacings, widest, 4 * r));
 }
 
 template <int D>

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
@@ -50,17 +51,18 @@ const ObstacleShape<D>* shape_of(std::span<const ObstacleShape<D>* const> shapes
   return k < shapes.size() ? shapes[k] : nullptr;
 }
 
-/// The layers of sites next to a shape's surface: each site of a lattice of spacing dx over the
-/// shape's bounds grown by `grow` (x fastest) whose signed distance to the solid s is within
-/// `layers` spacings of the surface on the solid's side (`inside`: -layers dx <= s < 0) or the
-/// fluid's (0 < s <= layers dx) is moved along the surface's normal to the middle of its layer,
-/// |s| = (k + 1/2) dx, as a box's layers lie, and visited. The first layer is then dx / 2 from the
-/// surface everywhere, as on a box, so that the fluid rests a particle radius off the surface
-/// wherever the lattice happens to fall.
+/// The layers first to last - 1 of sites next to a shape's surface: each site of a lattice of
+/// spacing dx over the shape's bounds grown by `grow` (x fastest) whose signed distance to the
+/// solid s lies between first and last spacings from the surface on the solid's side (`inside`:
+/// -last dx <= s < -first dx) or the fluid's (first dx < s <= last dx) is moved along the
+/// surface's normal to the middle of its layer, |s| = (k + 1/2) dx, as a box's layers lie, and
+/// visited. The first layer is then dx / 2 from the surface everywhere, as on a box, so that the
+/// fluid rests a particle radius off the surface wherever the lattice happens to fall.
 template <int D, class F>
-void for_each_shape_site(const ObstacleShape<D>& shape, double dx, double grow, int layers, bool inside, F&& f) {
+void for_each_shape_site(const ObstacleShape<D>& shape, double dx, double grow, int first, int last, bool inside,
+                         F&& f) {
   const Box<D> b = shape_bounds(shape);
-  const double depth = layers * dx;
+  const double depth = last * dx;
   std::array<AxisSites, D> axes;
   for (int d = 0; d < D; ++d) axes[d] = axis_sites(b.lo[d] - grow, b.hi[d] + grow, dx, 0, false);
   for_each_site<D>(axes, [&](const std::array<int, D>& idx) {
@@ -68,11 +70,72 @@ void for_each_shape_site(const ObstacleShape<D>& shape, double dx, double grow, 
     for (int d = 0; d < D; ++d) x[d] = axes[d].x[static_cast<std::size_t>(idx[d])];
     const SurfaceDistance<D> s = shape.solid_distance(x, depth);
     const double away = inside ? -s.distance : s.distance;  // how far on the wanted side
-    if (!(away > 0 && away <= depth)) return;
-    const double layer = std::min(std::floor(away / dx), layers - 1.0);
+    if (!(away > first * dx && away <= depth)) return;
+    const double layer = std::max(std::min(std::floor(away / dx), last - 1.0), static_cast<double>(first));
     const double target = (layer + 0.5) * dx;
     f(x + s.normal * (inside ? away - target : target - away));
   });
+}
+
+/// The sites of the solids' layers first to last - 1 (layer 0 next to the surface): the
+/// container's shell outside the box (with_container), then each obstacle's inside it, those
+/// outside the container dropped; obstacle_begin as sample_boundary's.
+template <int D>
+std::vector<Vec<D, double>> solid_layer_sites(const Box<D>& container, const std::vector<Box<D>>& obstacles,
+                                              double spacing, int first, int last, bool with_container,
+                                              std::vector<std::size_t>* obstacle_begin,
+                                              std::span<const ObstacleShape<D>* const> shapes) {
+  std::vector<Vec<D, double>> out;
+  std::array<AxisSites, D> axes;
+  if (with_container) {
+    // The container's shell: sites outside the box on at least one axis, in the layer of the
+    // axis they are deepest on.
+    for (int d = 0; d < D; ++d) axes[d] = axis_sites(container.lo[d], container.hi[d], spacing, last, true);
+    for_each_site<D>(axes, [&](const std::array<int, D>& idx) {
+      int layer = -1;
+      Vec<D, double> x;
+      for (int d = 0; d < D; ++d) {
+        const int i = idx[d];
+        if (i < axes[d].layers) layer = std::max(layer, axes[d].layers - 1 - i);
+        if (i >= axes[d].layers + axes[d].inner) layer = std::max(layer, i - axes[d].layers - axes[d].inner);
+        x[d] = axes[d].x[static_cast<std::size_t>(i)];
+      }
+      if (layer >= first) out.push_back(x);
+    });
+  }
+  // Each obstacle: its sites inside it, in the layer of the face they are nearest to.
+  if (obstacle_begin) obstacle_begin->assign(1, out.size());
+  const auto in_container = [&](const Vec<D, double>& x) {
+    for (int d = 0; d < D; ++d)
+      if (!(x[d] >= container.lo[d] && x[d] <= container.hi[d])) return false;
+    return true;
+  };
+  for (std::size_t k = 0; k < obstacles.size(); ++k) {
+    const Box<D>& b = obstacles[k];
+    if (const ObstacleShape<D>* shape = shape_of<D>(shapes, k)) {
+      // A shape: the sites of a lattice over its bounds within the layers' depth of its surface
+      // on the solid's side (outside the surface too when it is inverted).
+      for_each_shape_site<D>(*shape, spacing, shape->inverted ? last * spacing : 0.0, first, last, true,
+                             [&](const Vec<D, double>& x) {
+                               if (in_container(x)) out.push_back(x);
+                             });
+      if (obstacle_begin) obstacle_begin->push_back(out.size());
+      continue;
+    }
+    for (int d = 0; d < D; ++d) axes[d] = axis_sites(b.lo[d], b.hi[d], spacing, 0, false);
+    for_each_site<D>(axes, [&](const std::array<int, D>& idx) {
+      int layer = std::numeric_limits<int>::max();
+      Vec<D, double> x;
+      for (int d = 0; d < D; ++d) {
+        const int i = idx[d];
+        layer = std::min({layer, i, axes[d].inner - 1 - i});
+        x[d] = axes[d].x[static_cast<std::size_t>(i)];
+      }
+      if (layer >= first && layer < last && in_container(x)) out.push_back(x);
+    });
+    if (obstacle_begin) obstacle_begin->push_back(out.size());
+  }
+  return out;
 }
 
 }  // namespace
@@ -86,55 +149,16 @@ template <int D>
 std::vector<Vec<D, double>> sample_boundary(const Box<D>& container, const std::vector<Box<D>>& obstacles,
                                             double spacing, double h, std::vector<std::size_t>* obstacle_begin,
                                             std::span<const ObstacleShape<D>* const> shapes) {
+  return solid_layer_sites<D>(container, obstacles, spacing, 0, boundary_layers(spacing, h), true, obstacle_begin,
+                              shapes);
+}
+
+template <int D>
+std::vector<Vec<D, double>> solid_sites_beyond_samples(const Box<D>& container, const std::vector<Box<D>>& obstacles,
+                                                       double spacing, double h, bool with_container,
+                                                       std::span<const ObstacleShape<D>* const> shapes) {
   const int layers = boundary_layers(spacing, h);
-  std::vector<Vec<D, double>> out;
-  // The container's shell: sites outside the box on at least one axis.
-  std::array<AxisSites, D> axes;
-  for (int d = 0; d < D; ++d) axes[d] = axis_sites(container.lo[d], container.hi[d], spacing, layers, true);
-  for_each_site<D>(axes, [&](const std::array<int, D>& idx) {
-    bool outside = false;
-    Vec<D, double> x;
-    for (int d = 0; d < D; ++d) {
-      const int i = idx[d];
-      outside = outside || i < axes[d].layers || i >= axes[d].layers + axes[d].inner;
-      x[d] = axes[d].x[static_cast<std::size_t>(i)];
-    }
-    if (outside) out.push_back(x);
-  });
-  // Each obstacle: its sites within `layers` of a face, inside the container.
-  if (obstacle_begin) obstacle_begin->assign(1, out.size());
-  const auto in_container = [&](const Vec<D, double>& x) {
-    for (int d = 0; d < D; ++d)
-      if (!(x[d] >= container.lo[d] && x[d] <= container.hi[d])) return false;
-    return true;
-  };
-  for (std::size_t k = 0; k < obstacles.size(); ++k) {
-    const Box<D>& b = obstacles[k];
-    if (const ObstacleShape<D>* shape = shape_of<D>(shapes, k)) {
-      // A shape: the sites of a lattice over its bounds within `layers` spacings of its surface
-      // on the solid's side (outside the surface too when it is inverted).
-      for_each_shape_site<D>(*shape, spacing, shape->inverted ? layers * spacing : 0.0, layers, true,
-                             [&](const Vec<D, double>& x) {
-                               if (in_container(x)) out.push_back(x);
-                             });
-      if (obstacle_begin) obstacle_begin->push_back(out.size());
-      continue;
-    }
-    for (int d = 0; d < D; ++d) axes[d] = axis_sites(b.lo[d], b.hi[d], spacing, layers, false);
-    for_each_site<D>(axes, [&](const std::array<int, D>& idx) {
-      bool near_face = false, in_container = true;
-      Vec<D, double> x;
-      for (int d = 0; d < D; ++d) {
-        const int i = idx[d];
-        near_face = near_face || i < layers || i >= axes[d].inner - layers;
-        x[d] = axes[d].x[static_cast<std::size_t>(i)];
-        in_container = in_container && x[d] >= container.lo[d] && x[d] <= container.hi[d];
-      }
-      if (near_face && in_container) out.push_back(x);
-    });
-    if (obstacle_begin) obstacle_begin->push_back(out.size());
-  }
-  return out;
+  return solid_layer_sites<D>(container, obstacles, spacing, layers, 2 * layers, with_container, nullptr, shapes);
 }
 
 template <int D>
@@ -176,7 +200,7 @@ std::vector<Vec<D, double>> rest_fluid_sites(const Box<D>& container, const std:
     const Box<D>& b = obstacles[k];
     if (const ObstacleShape<D>* shape = shape_of<D>(shapes, k)) {
       // A shape: its lattice's sites within the depth of its surface on the fluid's side.
-      for_each_shape_site<D>(*shape, spacing, shape->inverted ? 0.0 : depth, layers, false,
+      for_each_shape_site<D>(*shape, spacing, shape->inverted ? 0.0 : depth, 0, layers, false,
                              [&](const Vec<D, double>& x) {
                                if (in_box(x, core) && !in_obstacle(x)) out.push_back(x);
                              });
@@ -233,15 +257,21 @@ BoundarySet<D, R> make_boundary(const SimulationParams<D>& params) {
   const R h = static_cast<R>(params.kernel_radius);
   const double dx = 2.0 * params.particle_radius;
   const bool rest_fluid = params.boundary.volume == BoundaryVolume::RestFluid;
-  const auto rest_sites = [&](const std::vector<Box<D>>& obstacles, std::span<const ObstacleShape<D>* const> of) {
+  // What RestFluid counts beside the samples: the fluid at rest on the solids' fluid side and
+  // the solids' own continuation beyond the sampled layers (with the container's shell or not).
+  const auto rest_sites = [&](const std::vector<Box<D>>& obstacles, std::span<const ObstacleShape<D>* const> of,
+                              bool with_container) {
     std::vector<Vec<D, R>> rest;
-    if (rest_fluid)
-      for (const auto& x : rest_fluid_sites<D>(params.container, obstacles, dx, params.kernel_radius, of))
-        rest.push_back(vec_cast<R>(x));
+    if (!rest_fluid) return rest;
+    for (const auto& x : rest_fluid_sites<D>(params.container, obstacles, dx, params.kernel_radius, of))
+      rest.push_back(vec_cast<R>(x));
+    for (const auto& x :
+         solid_sites_beyond_samples<D>(params.container, obstacles, dx, params.kernel_radius, with_container, of))
+      rest.push_back(vec_cast<R>(x));
     return rest;
   };
   if (!any_obstacle_moves(params)) {
-    set.psi = boundary_psi<D, R>(set.position, params.fluid, h, rest_sites(params.obstacles, shapes));
+    set.psi = boundary_psi<D, R>(set.position, params.fluid, h, rest_sites(params.obstacles, shapes, true));
     return set;
   }
   // Moving obstacles: psi counts only what moves with the sample. The container's and the resting
@@ -260,7 +290,8 @@ BoundarySet<D, R> make_boundary(const SimulationParams<D>& params) {
       const std::vector<Vec<D, R>> own(set.position.begin() + static_cast<std::ptrdiff_t>(b0),
                                        set.position.begin() + static_cast<std::ptrdiff_t>(b1));
       const ObstacleShape<D>* own_shape[1] = {shapes[k]};
-      const std::vector<R> psi = boundary_psi<D, R>(own, params.fluid, h, rest_sites({params.obstacles[k]}, own_shape));
+      const std::vector<R> psi =
+          boundary_psi<D, R>(own, params.fluid, h, rest_sites({params.obstacles[k]}, own_shape, false));
       std::copy(psi.begin(), psi.end(), set.psi.begin() + static_cast<std::ptrdiff_t>(b0));
       continue;
     }
@@ -268,7 +299,7 @@ BoundarySet<D, R> make_boundary(const SimulationParams<D>& params) {
     still_shapes.push_back(shapes[k]);
     for (std::size_t b = b0; b < b1; ++b) still.push_back(set.position[b]), still_index.push_back(b);
   }
-  const std::vector<R> psi = boundary_psi<D, R>(still, params.fluid, h, rest_sites(still_boxes, still_shapes));
+  const std::vector<R> psi = boundary_psi<D, R>(still, params.fluid, h, rest_sites(still_boxes, still_shapes, true));
   for (std::size_t i = 0; i < still.size(); ++i) set.psi[still_index[i]] = psi[i];
   set.rest_position = samples;
   set.velocity.assign(set.size(), Vec<D, R>{});
@@ -300,6 +331,12 @@ template std::vector<Vec<2, double>> sample_boundary<2>(const Box<2>&, const std
 template std::vector<Vec<3, double>> sample_boundary<3>(const Box<3>&, const std::vector<Box<3>>&, double, double,
                                                         std::vector<std::size_t>*,
                                                         std::span<const ObstacleShape<3>* const>);
+template std::vector<Vec<2, double>> solid_sites_beyond_samples<2>(const Box<2>&, const std::vector<Box<2>>&, double,
+                                                                   double, bool,
+                                                                   std::span<const ObstacleShape<2>* const>);
+template std::vector<Vec<3, double>> solid_sites_beyond_samples<3>(const Box<3>&, const std::vector<Box<3>>&, double,
+                                                                   double, bool,
+                                                                   std::span<const ObstacleShape<3>* const>);
 template std::vector<Vec<2, double>> rest_fluid_sites<2>(const Box<2>&, const std::vector<Box<2>>&, double, double,
                                                          std::span<const ObstacleShape<2>* const>);
 template std::vector<Vec<3, double>> rest_fluid_sites<3>(const Box<3>&, const std::vector<Box<3>>&, double, double,

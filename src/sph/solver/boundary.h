@@ -14,8 +14,9 @@
 /// Each sample b carries psi_b = rho0 V_b with V_b = 1 / sum_k W(x_b - x_k), the sum over the
 /// samples within h, b included (Akinci's eq. 4-5): where samples are dense each counts less;
 /// with BoundaryVolume::RestFluid (default) the sum also counts the fluid at rest on the
-/// solid's fluid side (rest_fluid_sites), so that a sample next to the fluid weighs what the
-/// fluid it stands for would.
+/// solid's fluid side (rest_fluid_sites) and the solid's lattice beyond its sampled layers
+/// (solid_sites_beyond_samples), so that every sample weighs what the fluid it stands for would,
+/// on any support.
 
 #include <span>
 #include <vector>
@@ -75,6 +76,17 @@ template <int D>
 std::vector<Vec<D, double>> rest_fluid_sites(const Box<D>& container, const std::vector<Box<D>>& obstacles,
                                              double spacing, double h,
                                              std::span<const ObstacleShape<D>* const> shapes = {});
+
+/// The sites of the solids' lattices beyond the sampled layers: the next boundary_layers() layers
+/// behind them (the container's shell, when with_container, and each obstacle's inside it, on
+/// the lattices and in the layers sample_boundary uses). BoundaryVolume::RestFluid counts them in
+/// each sample's delta_b, so that the samples deeper than the first weigh what the solid they
+/// stand for would: without them a sample's support reaching past the last layer reads a thin
+/// solid, and on supports wider than 2 spacings the fluid next to a wall read above rho0.
+template <int D>
+std::vector<Vec<D, double>> solid_sites_beyond_samples(const Box<D>& container, const std::vector<Box<D>>& obstacles,
+                                                       double spacing, double h, bool with_container,
+                                                       std::span<const ObstacleShape<D>* const> shapes = {});
 
 /// psi_b = rho0 / delta_b, delta_b = sum_k W(x_b - x_k) over the samples within h (b included)
 /// and the `rest` points within h, W the run's density kernel (FluidParams::kernel).

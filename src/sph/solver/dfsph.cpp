@@ -28,6 +28,19 @@ constexpr double kBetaFloor = 0.1;
 constexpr double kWarmStartDensity = 0.8;
 constexpr double kWarmStartDivergence = 0.5;
 
+/// The largest gain of a Jacobi step the solves take whole (jacobi_gain): steps are scaled by
+/// min(1, kMaxJacobiGain / gain). Each projected Jacobi step removes every compressed particle's
+/// own compression as if its neighbours kept theirs; they do not, and on the worst mode of a
+/// lattice the steps together remove gain times the compression. The surplus cannot be taken
+/// back (the steps only add pressure), so it is thrown into the flow, and wider supports have
+/// larger gains (cubic spline: 2.1 / 2.8 on 2 spacings in 2D / 3D, 2.7 / 4.4 on 2.5, 3.8 / 7.5 on
+/// 3). Measured on the validation tanks, stopped at 0.5 s (docs/physics.md, "DFSPH", "Wide
+/// supports"): taken whole, the 3D tank on 3 spacings (gain 7.5) peaked at 5.1e-2 J in its first
+/// steps with a health warning and the 2D one on 4 (6.7) blew up at its second step; scaled to a
+/// gain of 4 they peak at 1.6e-5 J and 8.4e-3 J. The supports up to 3 spacings in 2D and 2.15 in
+/// 3D (the shipped scenes' 2 to 2.5 among them) keep whole steps.
+constexpr double kMaxJacobiGain = 4;
+
 /// A particle with at least this fraction of a lattice site's neighbours within h (fluid and
 /// boundary) has a full neighbourhood (SPlisHSPlasH's divergence solve takes 20 of about 33 in
 /// 3D and 7 of 12 in 2D, with h = 2 spacings).
@@ -106,6 +119,10 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
     visit(visit, 0);
     beta_floor_ = static_cast<R>(kBetaFloor * squares) * ps.mass[0] * ps.mass[0];
     full_count_ = static_cast<int>(std::ceil(kFullNeighbourhood * lattice));
+    const double gain =
+        jacobi_gain<D>(static_cast<double>(spacing_), static_cast<double>(h),
+                       [&](const Vec<D, double>& r) { return vec_cast<double>(kernels.gradient(vec_cast<R>(r))); });
+    relaxation_ = gain > kMaxJacobiGain ? static_cast<R>(kMaxJacobiGain / gain) : R(1);
     lattice_done_ = true;
   }
   full_.resize(n);
@@ -386,7 +403,11 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
   // Two passes an iteration: the accelerations a(ds) of the step ds (each particle's needs its
   // neighbours' ds), then per particle A ds, the update, its compression (summed in chunked_sum's
   // fixed blocks) and the next iteration's ds (which no other particle reads in that pass).
-  const auto step_of = [&](std::size_t i) { return std::max(b_[i] - as_[i], R(0)) / beta_[i]; };
+  // (relaxation_: the step's scale on wide supports, 1 on the usual ones; kMaxJacobiGain)
+  const auto step_of = [&](std::size_t i) {
+    const R step = std::max(b_[i] - as_[i], R(0)) / beta_[i];
+    return relaxation_ < R(1) ? relaxation_ * step : step;
+  };
   if (!finished()) parallel_for(n, [&](std::size_t i) { p_[i] = step_of(i); });
   while (!finished()) {
     accelerations(p_, acc_p_);

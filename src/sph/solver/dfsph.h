@@ -44,6 +44,9 @@
 /// C2). Sums over particles are summed in fixed chunks: results are the same for any thread
 /// count.
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -59,6 +62,59 @@ namespace sph {
 
 /// The DFSPH solves of one run. Its warm-start values are particle fields (added to the
 /// ParticleSet by the constructor): they follow reordering, emission and checkpoints.
+/// The gain of a Jacobi step of the solves on a resting lattice of spacing `spacing` (square in
+/// 2D, cubic in 3D) with support h: the largest eigenvalue of D^-1 A, A = J M^-1 J^T on equal
+/// masses and D its diagonal. A pressure mode s_j = cos(k . x_j) is an eigenvector, with the
+/// eigenvalue |sum_r sin(k . r) grad W(r)|^2 / sum_r |grad W(r)|^2 over the lattice's offsets r
+/// within h; the largest over a grid of 33 (2D) or 17 (3D) wave numbers per axis in [0, pi /
+/// spacing] (a lower bound of the true largest, within a few %). `gradient(r)`: grad W at offset r
+/// (a Vec<D, double>).
+template <int D, class Gradient>
+double jacobi_gain(double spacing, double h, Gradient&& gradient) {
+  const int reach = static_cast<int>(std::ceil(h / spacing));
+  std::vector<std::array<double, D>> offsets, grads;  // in spacings; grad W
+  double squares = 0;
+  std::array<int, D> n{};
+  for (int d = 0; d < D; ++d) n[d] = -reach;
+  for (;;) {
+    Vec<D, double> r;
+    for (int d = 0; d < D; ++d) r[d] = n[d] * spacing;
+    const double r2 = norm2(r);
+    if (r2 > 0 && r2 < h * h) {
+      const Vec<D, double> g = gradient(r);
+      std::array<double, D> o, gd;
+      for (int d = 0; d < D; ++d) o[d] = n[d], gd[d] = static_cast<double>(g[d]);
+      offsets.push_back(o);
+      grads.push_back(gd);
+      for (int d = 0; d < D; ++d) squares += gd[d] * gd[d];
+    }
+    int d = 0;
+    while (d < D && ++n[d] > reach) n[d++] = -reach;
+    if (d == D) break;
+  }
+  if (!(squares > 0)) return 0;
+  const int samples = D == 2 ? 33 : 17;
+  constexpr double kPi = 3.14159265358979323846;
+  double best = 0;
+  std::array<int, D> m{};
+  for (;;) {
+    std::array<double, D> H{};
+    for (std::size_t j = 0; j < offsets.size(); ++j) {
+      double phase = 0;
+      for (int d = 0; d < D; ++d) phase += kPi * m[d] / (samples - 1) * offsets[j][d];
+      const double s = std::sin(phase);
+      for (int d = 0; d < D; ++d) H[d] += s * grads[j][d];
+    }
+    double h2 = 0;
+    for (int d = 0; d < D; ++d) h2 += H[d] * H[d];
+    best = std::max(best, h2 / squares);
+    int d = 0;
+    while (d < D && ++m[d] == samples) m[d++] = 0;
+    if (d == D) break;
+  }
+  return best;
+}
+
 template <int D, std::floating_point R>
 class DfsphSolver {
  public:
@@ -89,6 +145,9 @@ class DfsphSolver {
 
   /// beta_i of the last compute_factors (tests).
   const std::vector<R>& factors() const { return beta_; }
+  /// The scale of the solves' Jacobi steps: min(1, 4 / jacobi_gain of the particles' lattice),
+  /// set by the first compute_factors with particles (1 before it).
+  R relaxation() const { return relaxation_; }
 
  private:
   enum class Solve { Density, Divergence };
@@ -128,6 +187,7 @@ class DfsphSolver {
   bool lattice_done_ = false;
   R beta_floor_ = 0;
   int full_count_ = 0;
+  R relaxation_ = 1;
   std::vector<R> beta_;             // per particle: A's diagonal
   std::vector<std::uint8_t> full_;  // per particle: a full neighbourhood (compute_factors)
   // The step's fluid pairs within h (compute_factors): particle i's are begin_[i] .. begin_[i+1],

@@ -117,8 +117,9 @@ enum class BoundaryHandling {
 
 /// What a boundary sample's volume V_b = 1 / delta_b counts in delta_b = sum_k W(x_b - x_k).
 enum class BoundaryVolume {
-  /// The samples and the fluid at rest on the fluid's side of the solid (its lattice sites within
-  /// h): a solid in fluid at rest then reads exactly rho0 next to its walls (default).
+  /// The samples, the fluid at rest on the fluid's side of the solid (its lattice sites within h)
+  /// and the solid's lattice beyond the sampled layers: a solid in fluid at rest then reads
+  /// exactly rho0 next to its walls, on any support (default).
   RestFluid,
   /// The samples alone (Akinci et al. 2012, eq. 4-5): the layer next to the fluid misses the
   /// fluid half of its support and weighs more, so fluid next to a wall reads a few % dense.

@@ -24,7 +24,11 @@
 
 namespace sph {
 
-/// The format version this build writes and reads. Version 12 changes no byte but the meaning of
+/// The format version this build writes and reads. Version 13 changes no byte but the meaning of
+/// a boundary-particle scene: the samples' volumes now count the solid beyond their layers, and
+/// DFSPH scales its Jacobi steps on supports wider than about 3 spacings (2D) or 2.15 (3D), both
+/// recomputed from the scene on resuming, so a version 12 checkpoint of such a scene would not
+/// resume the run it saved. Version 12 changes no byte but the meaning of
 /// a DFSPH scene's boundaryPressure: the scene text of a version 11 checkpoint always carries
 /// "extrapolate" (the writer writes the key, and it was the default), which DFSPH ignored; now
 /// DFSPH follows it, so a version 11 DFSPH checkpoint would not resume the run it saved. Version 10 stores the floating
@@ -40,7 +44,7 @@ namespace sph {
 /// name and kind, in kParticleFields order, then the fields a run added (ParticleSet::save);
 /// version 2 kept the frames' times and the schedule's next tick instead of version 1's .vtu
 /// file list.
-inline constexpr std::uint32_t kCheckpointVersion = 12;
+inline constexpr std::uint32_t kCheckpointVersion = 13;
 /// The checkpoint's file name in a run's output directory.
 inline constexpr const char* kCheckpointFile = "checkpoint.sphc";
 

@@ -143,6 +143,23 @@ TEST(RigidBody, TheContainerHoldsARestingBoxAtItsSpringsSag) {
   EXPECT_NEAR(s.position[1] - 0.1, -9.81 / (2 * w * w), 1e-6);
   EXPECT_NEAR(s.velocity[1], 0, 1e-6);
   EXPECT_NEAR(s.orientation[3], 0, 1e-12);  // pushed evenly: it does not tip
+  // container_depth (the health monitor's) reads the sag at the deepest corner, past the floor.
+  const WallDepth<2> sunk = container_depth(container, box, s, mp);
+  EXPECT_NEAR(sunk.depth, 9.81 / (2 * w * w), 1e-6);
+  EXPECT_EQ(sunk.axis, 1);
+  EXPECT_FALSE(sunk.high);
+  // Tilted by 0.1 rad about its centre and pushed 2 cm into the right wall (x = 1): its corner
+  // there is deepest, by the tilt's share of the half-diagonal.
+  RigidBodyState<2> tilted = initial_body_state(Vec<2, double>{{0.82, 0.5}}, BodyParams<2>{true, 500, {}, {}});
+  tilted.orientation = {std::cos(0.05), 0, 0, std::sin(0.05)};
+  const WallDepth<2> right = container_depth(container, box, tilted, mp);
+  const double reach = std::max(0.2 * std::cos(0.1) + 0.1 * std::sin(0.1), 0.2 * std::cos(0.1) - 0.1 * std::sin(0.1));
+  EXPECT_NEAR(right.depth, 0.82 + reach - 1.0, 1e-12);
+  EXPECT_EQ(right.axis, 0);
+  EXPECT_TRUE(right.high);
+  EXPECT_EQ(
+      container_depth(container, box, initial_body_state(center_of(box), BodyParams<2>{true, 500, {}, {}}), mp).depth,
+      0.0);
   // And a wall never pulls: a box just off the wall, moving away, gets nothing.
   s = initial_body_state(center_of(Box<2>{{{0.3, 0.01}}, {{0.7, 0.21}}}), BodyParams<2>{true, 500, {{0, 1}}, {}});
   BodyLoad<2> load;

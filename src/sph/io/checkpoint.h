@@ -24,8 +24,9 @@
 
 namespace sph {
 
-/// The format version this build writes and reads. Version 13 changes no byte but the meaning of
-/// a boundary-particle scene: the samples' volumes now count the solid beyond their layers, and
+/// The format version this build writes and reads. Version 13 stores the health monitor's seventh
+/// watch (a floating body's depth into the walls) with the others, and changes the meaning of a
+/// boundary-particle scene: the samples' volumes now count the solid beyond their layers, and
 /// DFSPH scales its Jacobi steps on supports wider than about 3 spacings (2D) or 2.15 (3D), both
 /// recomputed from the scene on resuming, so a version 12 checkpoint of such a scene would not
 /// resume the run it saved. Version 12 changes no byte but the meaning of

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <sph/core/error.h>
+#include <sph/solver/rigid_body.h>
 
 namespace sph {
 
@@ -97,6 +98,7 @@ HealthScene health_scene(const SimulationParams<D>& p) {
     s.cfl_factor = p.cfl.factor;
     s.time_step = p.cfl.max_dt;
   }
+  s.contact_step = any_dynamic_body(p) ? body_contact_step(p) : 0.0;
   return s;
 }
 
@@ -159,6 +161,22 @@ void HealthMonitor::check(HealthStats& st, std::int64_t step, double time, std::
             "outside the container");
   contained(HealthKind::InsideSolid, st.inside_solid, st.inside_depth, st.inside_id, st.inside_speed,
             "inside an obstacle");
+
+  // A floating body sunk into a wall: its contact springs (k = m w^2, w = pi / (10 step)) give
+  // under the fluid's load. The depth falls with the step they are made for, as its square under a
+  // steady load and in proportion in an impact (a body carried into a wall at speed v sinks about v
+  // / w); the warning comes as the depth crosses the threshold, before the deepest point, so the
+  // advice is a quarter of the step.
+  const double spacing = 2 * s.particle_radius;
+  if (st.body_depth > watch(HealthKind::BodyInWall).warn * spacing && s.contact_step > 0)
+    warn(st, HealthKind::BodyInWall,
+         fmt::format("floating body Obstacles[{}] is {:.3g} m ({:.2g} particle spacings) into the container's {} wall "
+                     "{}: its contact springs give under the fluid's load. They are as stiff as steps of {:.3g} s "
+                     "allow, and the depth falls with that step (in proportion in an impact, as its square under a "
+                     "steady load): lower {} (now {:.3g} s), e.g. to {:.2g} s",
+                     st.body_obstacle, st.body_depth, st.body_depth / spacing, st.body_wall, at(), s.contact_step,
+                     s.cfl ? "Configuration.cflMaxTimeStepSize" : "Configuration.timeStepSize", s.contact_step,
+                     0.25 * s.contact_step));
 
   if (!s.incompressible && st.max_mach > watch(HealthKind::Mach).warn)
     warn(st, HealthKind::Mach,

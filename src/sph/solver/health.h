@@ -34,8 +34,9 @@ enum class HealthKind : std::uint8_t {
   Compression,  ///< max rho / rho0
   Tension,      ///< min rho / rho0 (only with NegativePressure::Allow)
   Energy,       ///< total energy growth of a closed scene
+  BodyInWall,   ///< a floating body's corner past the container's walls
 };
-inline constexpr std::size_t kHealthKinds = 6;
+inline constexpr std::size_t kHealthKinds = 7;
 
 /// One row of the table: a quantity, its thresholds (a value above `warn` warns, above `fail`
 /// fails; infinity: no such level) and why.
@@ -75,6 +76,12 @@ inline constexpr HealthWatch kHealthWatches[kHealthKinds] = {
      "exceed E0, its initial value plus the initial internal energy of the equation of state (>= 0); above it "
      "the integration adds energy (dt too large, too little viscosity); the scale adds "
      "the kinetic energy of the mass M at Ma 0.01 so that a scene at rest is judged too"},
+    {HealthKind::BodyInWall, "body_in_wall",
+     "a floating body's deepest corner past the container's walls, in particle spacings", kOutsideTolerance, kNoLimit,
+     "spacings",
+     "a body's contact with the walls is a damped spring whose stiffness the longest step allows; a corner a "
+     "particle radius deep into a wall means the springs give under the fluid's load, and the body's boundary "
+     "samples crowd the wall's"},
 };
 
 /// The scene's scales the monitor needs (from SimulationParams).
@@ -94,6 +101,9 @@ struct HealthScene {
   /// and cflFactor instead of timeStepSize.
   bool cfl = false;
   double cfl_factor = 0;
+  /// Floating bodies' contact springs: their angular rate w = pi / (10 step) comes from this step,
+  /// s (cflMaxTimeStepSize with CFL steps, else timeStepSize), 0 without bodies.
+  double contact_step = 0;
 };
 
 template <int D>
@@ -115,7 +125,10 @@ struct HealthStats {
   std::uint64_t rho_max_id = 0;
   /// kinetic + gravity (from the container's lowest point along g) + wall springs, J (J/m in 2D)
   double energy = 0;
-  std::uint32_t new_warnings = 0;  ///< bit (1 << HealthKind) per warning raised first in this step
+  double body_depth = 0;            ///< the deepest corner of a floating body past a container wall, m (0: none)
+  std::int64_t body_obstacle = -1;  ///< that body's index in the scene's Obstacles
+  const char* body_wall = "";       ///< which wall: "-x", "+x", "-y", ... (its outward side; "" if none)
+  std::uint32_t new_warnings = 0;   ///< bit (1 << HealthKind) per warning raised first in this step
 };
 
 /// Judges each step's HealthStats against kHealthWatches; remembers the warnings given and how

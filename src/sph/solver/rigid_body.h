@@ -18,6 +18,7 @@
 /// and advance_body() takes a symplectic Euler step, as the fluid's: velocities first, then the
 /// position and the orientation with the new velocities.
 
+#include <algorithm>
 #include <array>
 #include <span>
 #include <vector>
@@ -111,6 +112,18 @@ void add_container_contact(const Box<D>& container, const Box<D>& box, const Rig
                            const MassProperties<D>& mp, double omega, double dt, BodyLoad<D>& load,
                            const ObstacleShape<D>* shape = nullptr);
 
+/// How far the body's deepest corner (its shape's deepest vertex) is past the container's walls,
+/// m (0: none), with the index of the wall's axis (-1: none) and whether it is the high wall.
+template <int D>
+struct WallDepth {
+  double depth = 0;
+  int axis = -1;
+  bool high = false;
+};
+template <int D>
+WallDepth<D> container_depth(const Box<D>& container, const Box<D>& box, const RigidBodyState<D>& s,
+                             const MassProperties<D>& mp, const ObstacleShape<D>* shape = nullptr);
+
 /// The energy of those springs, J (2D: J/m): 1/2 k pen^2 summed over the points and walls.
 template <int D>
 double container_contact_energy(const Box<D>& container, const Box<D>& box, const RigidBodyState<D>& s,
@@ -145,6 +158,12 @@ void add_body_contact(const ContactBox<D>& a, const ContactBox<D>& b, double ome
 /// of the longest steps (w dt <= pi / 10, stable for symplectic Euler with room to spare), so a
 /// body resting on the floor sinks g / w^2 into it (about a millimetre for 5 ms steps).
 double body_contact_rate(double max_dt);
+/// The step body_contact_rate() is given for a scene: its longest, cflMaxTimeStepSize with CFL
+/// steps (timeStepSize if that is longer), else timeStepSize, s.
+template <int D>
+double body_contact_step(const SimulationParams<D>& p) {
+  return p.time_stepping == TimeStepping::Cfl ? std::max(p.time_step, p.cfl.max_dt) : p.time_step;
+}
 
 /// One symplectic Euler step of dt: v += impulse / m + g dt; w += I^-1 (angular impulse - dt w x I
 /// w) (I in the world's frame); then x += dt v and q += dt / 2 (0, w) q, normalized.

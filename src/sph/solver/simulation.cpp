@@ -182,7 +182,7 @@ void Simulation<D, R>::init_bodies() {
     return;
   }
   body_force_.assign(bodies_.size(), BodyLoad<D>{});
-  contact_rate_ = body_contact_rate(cfl() ? std::max(params_.time_step, params_.cfl.max_dt) : params_.time_step);
+  contact_rate_ = body_contact_rate(body_contact_step(params_));
   if (boundary_.size() > 0) {
     sample_body_.assign(boundary_.size(), 0);
     for (std::size_t k = 0; k < params_.obstacles.size(); ++k)
@@ -664,6 +664,16 @@ HealthStats Simulation<D, R>::integrate_and_check(R dt) {
   }
   HealthStats s = reduce_health();
   s.energy += body_energy();
+  // The floating bodies' deepest corner past a container wall (the first body's in ties).
+  static constexpr const char* kWalls[3][2] = {{"-x", "+x"}, {"-y", "+y"}, {"-z", "+z"}};
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    const std::size_t k = body_obstacle_[b];
+    const WallDepth<D> w =
+        container_depth(params_.container, params_.obstacles[k], bodies_[b], body_mass_[b], obstacle_shape(params_, k));
+    if (w.depth > s.body_depth)
+      s.body_depth = w.depth, s.body_obstacle = static_cast<std::int64_t>(k),
+      s.body_wall = kWalls[w.axis][w.high ? 1 : 0];
+  }
   return s;
 }
 

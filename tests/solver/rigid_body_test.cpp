@@ -144,7 +144,7 @@ TEST(RigidBody, TheContainerHoldsARestingBoxAtItsSpringsSag) {
   EXPECT_NEAR(s.velocity[1], 0, 1e-6);
   EXPECT_NEAR(s.orientation[3], 0, 1e-12);  // pushed evenly: it does not tip
   // container_depth (the health monitor's) reads the sag at the deepest corner, past the floor.
-  const WallDepth<2> sunk = container_depth(container, box, s, mp);
+  const WallDepth sunk = container_depth(container, box, s, mp);
   EXPECT_NEAR(sunk.depth, 9.81 / (2 * w * w), 1e-6);
   EXPECT_EQ(sunk.axis, 1);
   EXPECT_FALSE(sunk.high);
@@ -152,7 +152,7 @@ TEST(RigidBody, TheContainerHoldsARestingBoxAtItsSpringsSag) {
   // there is deepest, by the tilt's share of the half-diagonal.
   RigidBodyState<2> tilted = initial_body_state(Vec<2, double>{{0.82, 0.5}}, BodyParams<2>{true, 500, {}, {}});
   tilted.orientation = {std::cos(0.05), 0, 0, std::sin(0.05)};
-  const WallDepth<2> right = container_depth(container, box, tilted, mp);
+  const WallDepth right = container_depth(container, box, tilted, mp);
   const double reach = std::max(0.2 * std::cos(0.1) + 0.1 * std::sin(0.1), 0.2 * std::cos(0.1) - 0.1 * std::sin(0.1));
   EXPECT_NEAR(right.depth, 0.82 + reach - 1.0, 1e-12);
   EXPECT_EQ(right.axis, 0);

@@ -60,8 +60,6 @@
 
 namespace sph {
 
-/// The DFSPH solves of one run. Its warm-start values are particle fields (added to the
-/// ParticleSet by the constructor): they follow reordering, emission and checkpoints.
 /// The gain of a Jacobi step of the solves on a resting lattice of spacing `spacing` (square in
 /// 2D, cubic in 3D) with support h: the largest eigenvalue of D^-1 A, A = J M^-1 J^T on equal
 /// masses and D its diagonal. A pressure mode s_j = cos(k . x_j) is an eigenvector, with the
@@ -115,6 +113,8 @@ double jacobi_gain(double spacing, double h, Gradient&& gradient) {
   return best;
 }
 
+/// The DFSPH solves of one run. Its warm-start values are particle fields (added to the
+/// ParticleSet by the constructor): they follow reordering, emission and checkpoints.
 template <int D, std::floating_point R>
 class DfsphSolver {
  public:

@@ -203,9 +203,9 @@ void add_container_contact(const Box<D>& container, const Box<D>& box, const Rig
 }
 
 template <int D>
-WallDepth<D> container_depth(const Box<D>& container, const Box<D>& box, const RigidBodyState<D>& s,
-                             const MassProperties<D>& mp, const ObstacleShape<D>* shape) {
-  WallDepth<D> deepest;
+WallDepth container_depth(const Box<D>& container, const Box<D>& box, const RigidBodyState<D>& s,
+                          const MassProperties<D>& mp, const ObstacleShape<D>* shape) {
+  WallDepth deepest;
   for_each_contact_point<D>(box, shape, body_pose(s, mp.center), [&](const Vec<D, double>& x) {
     for (int d = 0; d < D; ++d) {
       const double below = container.lo[d] - x[d], above = x[d] - container.hi[d];
@@ -353,10 +353,10 @@ template std::array<double, 9> principal_frame<2>(const RigidBodyState<2>&, cons
 template std::array<double, 9> principal_frame<3>(const RigidBodyState<3>&, const MassProperties<3>&);
 template std::array<double, 9> world_inverse_inertia<2>(const RigidBodyState<2>&, const MassProperties<2>&);
 template std::array<double, 9> world_inverse_inertia<3>(const RigidBodyState<3>&, const MassProperties<3>&);
-template WallDepth<2> container_depth<2>(const Box<2>&, const Box<2>&, const RigidBodyState<2>&,
-                                         const MassProperties<2>&, const ObstacleShape<2>*);
-template WallDepth<3> container_depth<3>(const Box<3>&, const Box<3>&, const RigidBodyState<3>&,
-                                         const MassProperties<3>&, const ObstacleShape<3>*);
+template WallDepth container_depth<2>(const Box<2>&, const Box<2>&, const RigidBodyState<2>&, const MassProperties<2>&,
+                                      const ObstacleShape<2>*);
+template WallDepth container_depth<3>(const Box<3>&, const Box<3>&, const RigidBodyState<3>&, const MassProperties<3>&,
+                                      const ObstacleShape<3>*);
 template double container_contact_energy<2>(const Box<2>&, const Box<2>&, const RigidBodyState<2>&,
                                             const MassProperties<2>&, double, const ObstacleShape<2>*);
 template double container_contact_energy<3>(const Box<3>&, const Box<3>&, const RigidBodyState<3>&,

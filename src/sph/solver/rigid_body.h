@@ -114,15 +114,14 @@ void add_container_contact(const Box<D>& container, const Box<D>& box, const Rig
 
 /// How far the body's deepest corner (its shape's deepest vertex) is past the container's walls,
 /// m (0: none), with the index of the wall's axis (-1: none) and whether it is the high wall.
-template <int D>
 struct WallDepth {
   double depth = 0;
   int axis = -1;
   bool high = false;
 };
 template <int D>
-WallDepth<D> container_depth(const Box<D>& container, const Box<D>& box, const RigidBodyState<D>& s,
-                             const MassProperties<D>& mp, const ObstacleShape<D>* shape = nullptr);
+WallDepth container_depth(const Box<D>& container, const Box<D>& box, const RigidBodyState<D>& s,
+                          const MassProperties<D>& mp, const ObstacleShape<D>* shape = nullptr);
 
 /// The energy of those springs, J (2D: J/m): 1/2 k pen^2 summed over the points and walls.
 template <int D>

@@ -668,7 +668,7 @@ HealthStats Simulation<D, R>::integrate_and_check(R dt) {
   static constexpr const char* kWalls[3][2] = {{"-x", "+x"}, {"-y", "+y"}, {"-z", "+z"}};
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     const std::size_t k = body_obstacle_[b];
-    const WallDepth<D> w =
+    const WallDepth w =
         container_depth(params_.container, params_.obstacles[k], bodies_[b], body_mass_[b], obstacle_shape(params_, k));
     if (w.depth > s.body_depth)
       s.body_depth = w.depth, s.body_obstacle = static_cast<std::int64_t>(k),

@@ -403,11 +403,9 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
   // Two passes an iteration: the accelerations a(ds) of the step ds (each particle's needs its
   // neighbours' ds), then per particle A ds, the update, its compression (summed in chunked_sum's
   // fixed blocks) and the next iteration's ds (which no other particle reads in that pass).
-  // (relaxation_: the step's scale on wide supports, 1 on the usual ones; kMaxJacobiGain)
-  const auto step_of = [&](std::size_t i) {
-    const R step = std::max(b_[i] - as_[i], R(0)) / beta_[i];
-    return relaxation_ < R(1) ? relaxation_ * step : step;
-  };
+  // (relaxation_: the step's scale on wide supports, kMaxJacobiGain; exactly 1 on the usual
+  // ones, which leaves the step's bits as they are)
+  const auto step_of = [&](std::size_t i) { return relaxation_ * (std::max(b_[i] - as_[i], R(0)) / beta_[i]); };
   if (!finished()) parallel_for(n, [&](std::size_t i) { p_[i] = step_of(i); });
   while (!finished()) {
     accelerations(p_, acc_p_);

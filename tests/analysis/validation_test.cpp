@@ -216,6 +216,7 @@ TEST(Hydrostatic, ExactFieldGivesRatioOne) {
     const HydrostaticProfile p = hydrostatic_profile(s, m);
     EXPECT_NEAR(p.mean_ratio, 1.0, 1e-12) << dim;
     EXPECT_LT(p.max_bin_error, 1e-12) << dim;
+    EXPECT_LT(p.max_layer_error, 1e-12) << dim;
     EXPECT_GT(p.bins.size(), 5u);
     // Interior only: (n - 4) columns (per horizontal axis) of the rows deeper than 2 spacings and
     // more than h above the floor.
@@ -236,6 +237,29 @@ TEST(Hydrostatic, DetectsAPressureTooHigh) {
   const HydrostaticProfile p = hydrostatic_profile(s, m);
   EXPECT_NEAR(p.mean_ratio, 1.1, 1e-12);
   EXPECT_NEAR(p.max_bin_error, 0.1, 1e-12);
+}
+
+// What DFSPH and WCSPH give under a free surface (docs/validation.md, "DFSPH"): the pressure of
+// alternate layers off by +-0.6 rho0 g dx. Two-spacing bins hold one layer of each sign and
+// average it out; the layers do not.
+TEST(Hydrostatic, LayersSeeAPressureThatAlternatesFromLayerToLayer) {
+  const double dx = 0.01, rho0 = 1000, g = 9.81;
+  FluidState s = exact_tank(2, dx, 20, 20, rho0, g, 1e6);
+  const double surface = free_surface_height(s, dx);
+  for (std::size_t i = 0; i < s.position.size(); ++i) {
+    const long layer = std::lround((surface - s.position[i][1]) / dx - 0.5);  // 0 at the top
+    s.pressure[i] += (layer % 2 == 0 ? -0.6 : 0.6) * rho0 * g * dx;
+  }
+  HydrostaticModel m;
+  m.box_hi = {0.2, 0.5, 0};
+  m.gravity = g;
+  m.rest_density = rho0;
+  m.spacing = dx;
+  m.h = 2 * dx;
+  const HydrostaticProfile p = hydrostatic_profile(s, m);
+  EXPECT_LT(p.max_bin_error, 1e-12);
+  // The worst layer is the first compared one, the third (depth 2.5 dx): 0.6 / 2.5.
+  EXPECT_NEAR(p.max_layer_error, 0.6 / 2.5, 1e-12);
 }
 
 TEST(Hydrostatic, SettlingTime) {

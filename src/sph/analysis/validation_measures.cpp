@@ -196,7 +196,7 @@ HydrostaticProfile hydrostatic_profile(const FluidState& s, const HydrostaticMod
   const double rho_g = m.rest_density * m.gravity;
   const double bin = m.bin_layers * m.spacing;
   const double top = m.skip_layers * m.spacing;
-  std::map<std::int64_t, DepthBin> bins;
+  std::map<std::int64_t, DepthBin> bins, layers;  // bins of `bin`, and of one spacing (the layers)
   double ratio_sum = 0;
   p.interior_density_min = std::numeric_limits<double>::infinity();
   p.interior_density_max = -std::numeric_limits<double>::infinity();
@@ -216,33 +216,41 @@ HydrostaticProfile hydrostatic_profile(const FluidState& s, const HydrostaticMod
     p.mean_density_error += std::abs(rel);
     p.interior_density_min = std::min(p.interior_density_min, rel);
     p.interior_density_max = std::max(p.interior_density_max, rel);
-    DepthBin& b = bins[static_cast<std::int64_t>(std::floor((depth - top) / bin))];
-    b.depth += depth;
-    b.pressure += s.pressure[i];
-    ++b.count;
+    for (auto [width, into] : {std::pair{bin, &bins}, std::pair{m.spacing, &layers}}) {
+      DepthBin& b = (*into)[static_cast<std::int64_t>(std::floor((depth - top) / width))];
+      b.depth += depth;
+      b.pressure += s.pressure[i];
+      ++b.count;
+    }
   }
   if (p.particles == 0) {
     p.interior_density_min = p.interior_density_max = p.mean_density_error = kNaN;
     p.mean_ratio = kNaN;
-    p.max_bin_error = kNaN;
+    p.max_bin_error = p.max_layer_error = kNaN;
     return p;
   }
   p.mean_ratio = ratio_sum / static_cast<double>(p.particles);
   p.mean_density_error /= static_cast<double>(p.particles);
   // The deepest bin is cut by the floor's margin and holds a few particles at its top: such a
   // bin (fewer than half the median count) is noise, not a profile, and is not compared.
-  std::vector<std::size_t> counts;
-  for (const auto& [k, b] : bins) counts.push_back(b.count);
-  std::nth_element(counts.begin(), counts.begin() + counts.size() / 2, counts.end());
-  const std::size_t min_count = std::max<std::size_t>(3, counts[counts.size() / 2] / 2);
-  for (auto& [k, b] : bins) {
-    b.depth /= static_cast<double>(b.count);
-    b.pressure /= static_cast<double>(b.count);
-    b.ratio = b.pressure / (rho_g * b.depth);
-    b.compared = b.count >= min_count;
-    if (b.compared) p.max_bin_error = std::max(p.max_bin_error, std::abs(b.ratio - 1.0));
-    p.bins.push_back(b);
-  }
+  const auto compare = [&](std::map<std::int64_t, DepthBin>& of, std::vector<DepthBin>* keep) {
+    std::vector<std::size_t> counts;
+    for (const auto& [k, b] : of) counts.push_back(b.count);
+    std::nth_element(counts.begin(), counts.begin() + counts.size() / 2, counts.end());
+    const std::size_t min_count = std::max<std::size_t>(3, counts[counts.size() / 2] / 2);
+    double worst = 0;
+    for (auto& [k, b] : of) {
+      b.depth /= static_cast<double>(b.count);
+      b.pressure /= static_cast<double>(b.count);
+      b.ratio = b.pressure / (rho_g * b.depth);
+      b.compared = b.count >= min_count;
+      if (b.compared) worst = std::max(worst, std::abs(b.ratio - 1.0));
+      if (keep) keep->push_back(b);
+    }
+    return worst;
+  };
+  p.max_bin_error = compare(bins, &p.bins);
+  p.max_layer_error = compare(layers, nullptr);
   return p;
 }
 

@@ -36,7 +36,8 @@ def main():
     g = -d["Configuration"]["gravitation"][1]
     rho0 = d["Fluid"]["density0"]
     lo, hi = d["Container"]["start"], d["Container"]["end"]
-    end = d["Configuration"]["stopAt"]
+    c = d["Configuration"]
+    end = c["stopAt"] if "stopAt" in c else c["numberOfSteps"] * c["timeStepSize"]
     sim = sph.Simulation(scene)
     while sim.time < 0.9 * end:
         sim.step(1)

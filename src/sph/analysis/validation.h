@@ -129,17 +129,17 @@ struct DepthBin {
   bool compared = true;  ///< false for a bin with fewer than half the median count (cut by the floor)
 };
 
+/// max_layer_error's bins are one spacing deep: a tank that keeps its lattice has one layer of
+/// particles in each. Bins of two spacings average a pressure that alternates from layer to layer
+/// (which SPH's symmetric pressure force gives under a free surface: docs/validation.md, "DFSPH").
 struct HydrostaticProfile {
   double surface = 0;          ///< free_surface_height, m
   std::vector<DepthBin> bins;  ///< bins of `bin_layers` spacings from `skip_layers` spacings down
   std::size_t particles = 0;   ///< interior particles below the skipped layers
   double mean_ratio = 0;       ///< mean of p / (rho0 g depth) over them
   double max_bin_error = 0;    ///< max |ratio - 1| over bins of at least 3 particles
-  /// The same over bins one spacing deep: a tank that keeps its lattice has one layer of particles
-  /// in each. Two-spacing bins average a pressure that alternates from layer to layer (which SPH's
-  /// symmetric pressure force gives under a free surface: docs/validation.md, "DFSPH"); these do not.
-  double max_layer_error = 0;
-  double max_compression = 0;                                 ///< max (rho - rho0) / rho0 over every particle
+  double max_layer_error = 0;  ///< the same over bins of one spacing (above)
+  double max_compression = 0;  ///< max (rho - rho0) / rho0 over every particle
   double interior_density_min = 0, interior_density_max = 0;  ///< (rho - rho0) / rho0, interior
   double mean_density_error = 0;                              ///< mean |rho - rho0| / rho0 over the interior particles
 };

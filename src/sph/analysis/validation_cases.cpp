@@ -606,9 +606,10 @@ void run_boundaries(ValidationResult& res, FrontRuns& fronts, const ValidationOp
 
 /// The dfsph case: the tanks with DFSPH (hydrostatic_2d_dfsph.json, hydrostatic_3d_dfsph.json):
 /// the mean density error at most 0.1 % and the pressure within 1 % of rho0 g d below the second
-/// layer, over the whole tank, in bins of two spacings and layer by layer; no particle outside; settled before the end.
-/// Full runs: Martin & Moyce's front at a/40 within 0.10 with DFSPH (martin_moyce_2d_dfsph.json). Quick: the coarse 2D
-/// tank for 1.2 s, with regression bounds (its mean pressure ratio instead of the bins).
+/// layer, over the whole tank, in bins of two spacings and layer by layer; no particle outside;
+/// settled before the end. Full runs: Martin & Moyce's front at a/40 within 0.10 with DFSPH
+/// (martin_moyce_2d_dfsph.json). Quick: the coarse 2D tank for 1.2 s, with regression bounds (its
+/// mean pressure ratio instead of the bins).
 void run_dfsph(ValidationResult& res, FrontRuns& fronts, const ValidationOptions& opt,
                const ValidationProgress& progress) {
   const bool q = res.quick;

@@ -8,9 +8,10 @@ Runs the scene (KEY=VALUE as --set) and averages each particle's pressure, densi
 over the steps of the run's last tenth, as sph validate does. The free surface is the mean of each
 column's top particle plus half a spacing. Prints, for each 2-spacing depth bin below the second
 layer, the mean p / (rho0 g d) of the whole bin and of its interior (the particles at least 3
-spacings from the side walls), with their counts; then the first eight layers below the second
-(bins of one spacing, the whole tank): the pressure alternates from layer to layer by about
-+-0.6 rho0 g dx, which the two-spacing bins average out. Then how one step's pressure differs from the
+spacings from the side walls), with their counts; then the first ten layers (bins of one spacing
+from the surface, the whole tank), with their mean density: under the free surface the pressure
+alternates from layer to layer by about 0.3 to 0.6 rho0 g dx, which the two-spacing bins average
+out. Then how one step's pressure differs from the
 averaged one: the least and the largest of each step's interior mean p / (rho0 g d), over the
 same steps (the interior below the second layer and above the floor's two layers).
 """
@@ -80,14 +81,16 @@ def main():
         inside = p[inner].mean() / (rho0 * g * depth[inner].mean()) if inner.any() else float("nan")
         print(f"bin {k:2d}  depth {depth[whole].mean():.4f} m  whole {ratio:.3f} ({whole.sum()})  "
               f"interior {inside:.3f} ({inner.sum()})")
-    # Layer by layer (bins of one spacing): what the two-spacing bins average out.
-    layers = np.floor((depth - 2 * dx) / dx).astype(int)
-    for k in np.unique(layers[deep])[:8]:
-        whole = deep & (layers == k)
+    # Layer by layer (bins of one spacing from the surface): what the two-spacing bins average out.
+    layers = np.floor(depth / dx).astype(int) + 1
+    for k in range(1, 11):
+        whole = layers == k
+        if not whole.any():
+            continue
         offset = (p[whole].mean() - rho0 * g * depth[whole].mean()) / (rho0 * g * dx)
-        print(f"layer {k + 3:2d}  depth {depth[whole].mean():.4f} m  whole "
+        print(f"layer {k:2d}  depth {depth[whole].mean():.4f} m  whole "
               f"{p[whole].mean() / (rho0 * g * depth[whole].mean()):.3f} ({whole.sum()})  "
-              f"p - rho0 g d = {offset:+.2f} rho0 g dx")
+              f"p - rho0 g d = {offset:+.2f} rho0 g dx  density {rho[whole].mean():.1f}")
     print(f"one step's interior mean p / (rho0 g d): {min(steps):.3f} to {max(steps):.3f} over {n} steps")
 
 

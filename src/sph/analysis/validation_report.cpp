@@ -234,21 +234,24 @@ std::string report_hydrostatic(const ValidationResult& res) {
       "Water at rest in a closed box, settling under gravity. After the run: the free surface is the\n"
       "mean height of the top particle of each column (plus half a spacing); interior particles (more than\n"
       "h from every wall, deeper than 2 spacings) are binned by depth (bins of 2 spacings) and each bin's\n"
-      "mean pressure is compared with rho0 g depth. The predicted ratio is 1 / M_yy, the spiky gradient's\n"
-      "consistency factor on a perfect lattice (docs/validation.md).\n\n";
+      "mean pressure is compared with rho0 g depth; the layer error is the same over bins of 1 spacing. The\n"
+      "predicted ratio is 1 / M_yy, the spiky gradient's consistency factor on a perfect lattice\n"
+      "(docs/validation.md).\n\n";
   md += "![pressure 2D](hydrostatic_2d.png)\n\n![pressure 3D](hydrostatic_3d.png)\n\n";
   md += "![surface](hydrostatic_surface.png)\n\n![settling](hydrostatic_settling.png)\n\n";
   md +=
       "| tank | particles | spacing | k | dt | steps | wall s | mean p/(rho0 g d) | predicted 1/M_yy | max bin error "
-      "| max compression | interior density range | surface sink | drift (2nd half) | settling |\n";
-  md += "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- | ---: | ---: | ---: |\n";
+      "| max layer error | max compression | interior density range | surface sink | drift (2nd half) | settling |\n";
+  md +=
+      "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- | ---: | ---: | ---: "
+      "|\n";
   for (const HydrostaticRun& h : res.hydrostatic)
     md += fmt::format(
-        "| {}{} | {} | {:g} m | {:g} | {:g} s | {} | {:.1f} | {:.3f} | {:.3f} | {:.3f} | {:.2f} % | {:+.2f} % .. "
-        "{:+.2f} % | {:.2f} spacings | {:.3f} spacings | {} s |\n",
+        "| {}{} | {} | {:g} m | {:g} | {:g} s | {} | {:.1f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.2f} % | {:+.2f} % "
+        ".. {:+.2f} % | {:.2f} spacings | {:.3f} spacings | {} s |\n",
         h.label, h.failure.empty() ? "" : " (failed)", h.particles, h.spacing, h.stiffness, h.dt, h.steps, h.seconds,
-        h.profile.mean_ratio, h.predicted_ratio, h.profile.max_bin_error, 100 * h.profile.max_compression,
-        100 * h.profile.interior_density_min, 100 * h.profile.interior_density_max,
+        h.profile.mean_ratio, h.predicted_ratio, h.profile.max_bin_error, h.profile.max_layer_error,
+        100 * h.profile.max_compression, 100 * h.profile.interior_density_min, 100 * h.profile.interior_density_max,
         (h.initial_surface - h.profile.surface) / h.spacing, h.surface_drift / h.spacing, g(h.settling_time));
   md += "\n" + checks_table(res, "hydrostatic");
   return md;

@@ -31,11 +31,25 @@ std::size_t UniformGrid<D, R>::lay_out_cells(std::span<const V> positions, R rad
   // Bounding box (min/max are exact, so the result does not depend on evaluation order).
   V lo = V::filled(R(0)), hi = V::filled(R(0));
   if (n > 0) {
-    lo = hi = positions[0];
-    for (const V& x : positions)
+    const std::size_t chunks = chunk_count(n);
+    box_lo_.resize(chunks);
+    box_hi_.resize(chunks);
+    parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
+      V l = positions[b], h = positions[b];
+      for (std::size_t i = b + 1; i < e; ++i)
+        for (int d = 0; d < D; ++d) {
+          l[d] = std::min(l[d], positions[i][d]);
+          h[d] = std::max(h[d], positions[i][d]);
+        }
+      box_lo_[c] = l;
+      box_hi_[c] = h;
+    });
+    lo = box_lo_[0];
+    hi = box_hi_[0];
+    for (std::size_t c = 1; c < chunks; ++c)
       for (int d = 0; d < D; ++d) {
-        lo[d] = std::min(lo[d], x[d]);
-        hi[d] = std::max(hi[d], x[d]);
+        lo[d] = std::min(lo[d], box_lo_[c][d]);
+        hi[d] = std::max(hi[d], box_hi_[c][d]);
       }
   }
   for (int d = 0; d < D; ++d)

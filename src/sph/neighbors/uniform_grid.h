@@ -136,6 +136,7 @@ class UniformGrid {
   std::vector<std::uint32_t> cell_of_;       // cell of each point
   std::vector<std::uint32_t> block_cursor_;  // parallel counting sort: per block and cell
   std::array<std::vector<R>, D> coords_;     // coordinates in sorted order, + kPad
+  std::vector<V> box_lo_, box_hi_;           // bounding box of each chunk of points
 };
 
 extern template class UniformGrid<2, float>;

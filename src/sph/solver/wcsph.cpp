@@ -298,10 +298,13 @@ std::array<R, 6> force_side_scalars(const ParticleSet<D, R>& ps, std::size_t i, 
           mu * inv_rhoi * lap_c, R(-2) * mu * inv_rhoi,   ps.density[i]};
 }
 
-/// A register of neighbors j: the offsets x_i - x_j, |x_ij|^2 and j's values.
+/// A register of neighbors j: the offsets x_i - x_j, |x_ij|^2 and j's values. inv_rho is 1 /
+/// rho_j: the pass over per-particle lists divides for each register, the pass over cluster
+/// pairs loads it from ClusterData, which divided once per particle (the same value bit for bit:
+/// a division is correctly rounded); rho itself is read only with the artificial viscosity.
 template <int D, std::floating_point R>
 struct ForceOther {
-  simd::Pack<R> rij[D], r2, rho, mass, v[D], p;
+  simd::Pack<R> rij[D], r2, rho, inv_rho, mass, v[D], p;
 };
 
 /// The force pass's arithmetic: the pair terms of a register, a particle's boundary samples and
@@ -363,7 +366,7 @@ class ForceTerms {
     const Mask near = valid & (j.r2 < h2v_);  // inside the support
     const P r = sqrt(select(near, j.r2, h2v_));
     const P dh = hv_ - r;
-    const P inv_rhoj = one / j.rho;
+    const P inv_rhoj = j.inv_rho;
     P fp = zero, fv = zero;
     if constexpr (kPressure) {
       P pij;
@@ -548,6 +551,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
       ForceOther<D, R> j;
       j.r2 = pair_offsets<D>(side.x, pos, idx + k0, j.rij);
       j.rho = P::template gather<1>(rho, idx + k0, 0);
+      j.inv_rho = P::set1(R(1)) / j.rho;
       j.mass = P::template gather<1>(mass, idx + k0, 0);
       for (int d = 0; d < D; ++d) j.v[d] = P::template gather<D>(vel, idx + k0, d);
       if constexpr (kPressure) j.p = P::template gather<1>(prs, idx + k0, 0);
@@ -565,12 +569,14 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
 
 /// The particles' values in cluster slot order (ClusterPairs::slots()), one array per scalar,
 /// each followed by a register of padding, so that a cluster's values are one contiguous load.
-/// Empty slots hold a particle far away (no pair within h), at rest, of no mass.
+/// Empty slots hold a particle far away (no pair within h), at rest, of no mass. The force pass
+/// reads each particle's 1 / rho (inv_rho: one division per particle instead of one per lane of
+/// each register), and its rho only with `densities` (the artificial viscosity).
 template <int D, std::floating_point R>
 struct ClusterData {
-  std::vector<R> x[D], v[D], rho, p, mass;
+  std::vector<R> x[D], v[D], rho, inv_rho, p, mass;
 
-  void fill(const ParticleSet<D, R>& ps, std::span<const std::uint32_t> slots, bool forces) {
+  void fill(const ParticleSet<D, R>& ps, std::span<const std::uint32_t> slots, bool forces, bool densities = false) {
     const std::size_t size = slots.size() + static_cast<std::size_t>(simd::kLanes<R>);
     // (the density pass leaves the force pass's arrays as they are: no shrinking and zero-filling
     // them again at every step)
@@ -578,7 +584,8 @@ struct ClusterData {
     resize_with_room(mass, size);
     if (forces) {
       for (int d = 0; d < D; ++d) resize_with_room(v[d], size);
-      resize_with_room(rho, size);
+      resize_with_room(inv_rho, size);
+      if (densities) resize_with_room(rho, size);
       resize_with_room(p, size);
     }
     constexpr R kFar = R(1e18);  // (its square still fits a float)
@@ -591,7 +598,8 @@ struct ClusterData {
       }
       mass[s] = empty ? R(0) : ps.mass[i];
       if (forces) {
-        rho[s] = empty ? R(1) : ps.density[i];
+        inv_rho[s] = empty ? R(1) : R(1) / ps.density[i];
+        if (densities) rho[s] = empty ? R(1) : ps.density[i];
         p[s] = empty ? R(0) : ps.pressure[i];
       }
     });
@@ -714,13 +722,14 @@ void cluster_force_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, R>& cp, R h
   const L lanes;
   const ForceTerms<K, kForm, kPressure, false, D, R> terms(ps, h, fluid, gravity, walls, {}, dt, boundary, h);
   const std::span<const std::uint32_t> slots = cp.slots();
-  data.fill(ps, slots, true);
+  data.fill(ps, slots, true, fluid.viscosity_model == ViscosityModel::Artificial);
   const Mask all = simd::first_lanes<R>(static_cast<std::size_t>(W));
   const P h2v = P::set1(h * h);
   const R* xs[D];
   const R* vs[D];
   for (int d = 0; d < D; ++d) xs[d] = data.x[d].data(), vs[d] = data.v[d].data();
-  const R *rhos = data.rho.data(), *masses = data.mass.data(), *prs = data.p.data();
+  const R *rhos = data.rho.data(), *inv_rhos = data.inv_rho.data(), *masses = data.mass.data(), *prs = data.p.data();
+  const bool densities = fluid.viscosity_model == ViscosityModel::Artificial;
   parallel_for(cp.cluster_count(), [&](std::size_t c) {
     const std::size_t base = c * S;
     ForceSide<D, R> side;
@@ -758,7 +767,8 @@ void cluster_force_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, R>& cp, R h
     const auto add = [&](std::uint32_t jc, int q, ForceOther<D, R>& j, Mask valid) {
       const std::size_t jb = std::size_t{jc} * S;
       for (int d = 0; d < D; ++d) j.v[d] = P::permuted(vs[d] + jb, lanes.tile[q]);
-      j.rho = P::permuted(rhos + jb, lanes.tile[q]);
+      j.inv_rho = P::permuted(inv_rhos + jb, lanes.tile[q]);
+      j.rho = densities ? P::permuted(rhos + jb, lanes.tile[q]) : j.inv_rho;  // (unread without)
       j.mass = P::permuted(masses + jb, lanes.tile[q]);
       if constexpr (kPressure) j.p = P::permuted(prs + jb, lanes.tile[q]);
       terms.pairs(side, j, valid, acc);

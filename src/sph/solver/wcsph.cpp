@@ -722,14 +722,14 @@ void cluster_force_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, R>& cp, R h
   const L lanes;
   const ForceTerms<K, kForm, kPressure, false, D, R> terms(ps, h, fluid, gravity, walls, {}, dt, boundary, h);
   const std::span<const std::uint32_t> slots = cp.slots();
-  data.fill(ps, slots, true, fluid.viscosity_model == ViscosityModel::Artificial);
+  const bool densities = fluid.viscosity_model == ViscosityModel::Artificial;  // (rho_j: Monaghan's term)
+  data.fill(ps, slots, true, densities);
   const Mask all = simd::first_lanes<R>(static_cast<std::size_t>(W));
   const P h2v = P::set1(h * h);
   const R* xs[D];
   const R* vs[D];
   for (int d = 0; d < D; ++d) xs[d] = data.x[d].data(), vs[d] = data.v[d].data();
   const R *rhos = data.rho.data(), *inv_rhos = data.inv_rho.data(), *masses = data.mass.data(), *prs = data.p.data();
-  const bool densities = fluid.viscosity_model == ViscosityModel::Artificial;
   parallel_for(cp.cluster_count(), [&](std::size_t c) {
     const std::size_t base = c * S;
     ForceSide<D, R> side;

@@ -345,6 +345,8 @@ class ForceTerms {
   }
 
   R mu() const { return fc_.mu; }
+  /// Monaghan's artificial viscosity: the only term that reads rho_j itself (not 1 / rho_j).
+  bool artificial() const { return fc_.artificial; }
   R lap_c() const { return lap_c_; }
   bool solid() const { return solid_; }
 
@@ -722,7 +724,7 @@ void cluster_force_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, R>& cp, R h
   const L lanes;
   const ForceTerms<K, kForm, kPressure, false, D, R> terms(ps, h, fluid, gravity, walls, {}, dt, boundary, h);
   const std::span<const std::uint32_t> slots = cp.slots();
-  const bool densities = fluid.viscosity_model == ViscosityModel::Artificial;  // (rho_j: Monaghan's term)
+  const bool densities = terms.artificial();
   data.fill(ps, slots, true, densities);
   const Mask all = simd::first_lanes<R>(static_cast<std::size_t>(W));
   const P h2v = P::set1(h * h);

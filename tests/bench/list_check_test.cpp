@@ -149,8 +149,8 @@ TEST_P(ListCheckTest, MapsReorderedListsBackThroughThePermutation) {
   std::vector<V> shuffled, gathered;
   gather<V>(points_, shuffle, shuffled);
   MortonOrder<3, double> morton;
-  std::vector<std::uint32_t> perm;
-  morton.compute(shuffled, radius_, perm);
+  const std::span<const std::uint32_t> found = morton.compute(shuffled, radius_);
+  std::vector<std::uint32_t> perm(found.begin(), found.end());
   gather<V>(shuffled, perm, gathered);
   UniformGrid<3, double> grid;
   ListBuilder<3, double> builder;

@@ -149,7 +149,7 @@ TEST(FastLists, ParallelCountingSortGivesTheSerialOrder) {
   grid.build(x, 0.05);
   const auto l = lists[0].of(1234);
   for (std::size_t k = 1; k < l.size(); ++k) {
-    const auto ca = grid.cell_of(l[k - 1]), cb = grid.cell_of(l[k]);
+    const auto ca = grid.cell_index(grid.cell_of(x[l[k - 1]])), cb = grid.cell_index(grid.cell_of(x[l[k]]));
     const bool same_row = ca / grid.dims()[0] == cb / grid.dims()[0];
     if (same_row) {
       EXPECT_TRUE(ca < cb || (ca == cb && l[k - 1] < l[k])) << k;
@@ -291,8 +291,8 @@ void expect_morton_is_stable_permutation() {
   auto x = jittered_lattice<D, double>(D == 3 ? 20 : 90, 0.025, 0.0025, 11, true);
   x.push_back(x[5]);  // a duplicate: same cell, must keep index order
   MortonOrder<D, double> order;
-  std::vector<std::uint32_t> perm;
-  order.compute(x, 0.05, perm);
+  const std::span<const std::uint32_t> result = order.compute(x, 0.05);
+  const std::vector<std::uint32_t> perm(result.begin(), result.end());
   ASSERT_EQ(perm.size(), x.size());
   std::vector<std::uint32_t> seen(perm);
   std::sort(seen.begin(), seen.end());
@@ -310,16 +310,16 @@ void expect_morton_is_stable_permutation() {
   EXPECT_LT(along, 0.1);        // about two spacings
   EXPECT_GT(input, 5 * along);  // the shuffle scattered them
   // Same input, same permutation.
-  std::vector<std::uint32_t> again;
-  order.compute(x, 0.05, again);
-  EXPECT_EQ(perm, again);
-  // And with a grid's arrays lent for the sort's second copies: the same permutation, the grid
-  // built afterwards as without the loan, and the lent arrays keep their room (no new block).
-  // Cells of 0.05 take 2 radix passes, of 0.004 3 (the result copied back from the second copy),
-  // and 3D cells of 0.0002 need 64-bit keys.
+  const std::span<const std::uint32_t> again = order.compute(x, 0.05);
+  EXPECT_TRUE(std::equal(perm.begin(), perm.end(), again.begin(), again.end()));
+  // And with a grid's memory lent for the sort's arrays: the same permutation, the grid built
+  // afterwards as without the loan, and the lent memory keeps its block (none new).
+  // Cells of 0.05 take 2 radix passes, of 0.004 3 (the result in the second copy), and 3D cells
+  // of 0.0002 need 64-bit keys (in 2D, 16 bytes a point: more than a 2D grid lends).
   for (const double cell : {0.05, 0.004, 0.0002}) {
-    std::vector<std::uint32_t> own;
-    MortonOrder<D, double>().compute(x, cell, own);
+    MortonOrder<D, double> alone;
+    const std::span<const std::uint32_t> own_result = alone.compute(x, cell);
+    const std::vector<std::uint32_t> own(own_result.begin(), own_result.end());
     // (the reference: a stable sort of the indices by their Morton keys, computed here)
     Vec<D, double> lo = x[0];
     for (const auto& p : x)
@@ -338,20 +338,24 @@ void expect_morton_is_stable_permutation() {
     EXPECT_EQ(own, reference) << cell;
     UniformGrid<D, double> grid, plain;
     grid.build(x, 0.05);
-    const std::array<std::vector<std::uint32_t>*, 2> lent = grid.lend_scratch(x.size());
-    const std::size_t room0 = lent[0]->capacity(), room1 = lent[1]->capacity();
-    const std::uint32_t* block0 = lent[0]->data();
+    ScratchBuffer& lent = grid.lend_scratch(x.size());
+    const std::size_t room = lent.capacity();
+    const std::byte* block = lent.at<std::byte>(0);
     MortonOrder<D, double> borrowing;
-    std::vector<std::uint32_t> with_loan;
-    borrowing.compute(x, cell, with_loan, lent);
-    EXPECT_EQ(with_loan, own) << cell;
-    EXPECT_EQ(lent[0]->capacity(), room0);
-    EXPECT_EQ(lent[1]->capacity(), room1);
-    EXPECT_EQ(lent[0]->data(), block0);
+    const std::span<const std::uint32_t> with_loan = borrowing.compute(x, cell, &lent);
+    EXPECT_TRUE(std::equal(own.begin(), own.end(), with_loan.begin(), with_loan.end())) << cell;
+    // (the result lies in the lent memory: a double grid lends 4 + 8 D bytes a point, and the
+    // sort needs 16 with 32-bit keys, 24 with 64-bit ones)
+    const auto* first = reinterpret_cast<const std::byte*>(with_loan.data());
+    EXPECT_TRUE(first >= block && first < block + room) << cell;
+    EXPECT_EQ(lent.capacity(), room);
+    EXPECT_EQ(lent.at<std::byte>(0), block);
     grid.build(x, 0.05);
     plain.build(x, 0.05);
     for (std::size_t i = 0; i < x.size(); ++i) ASSERT_EQ(grid.sorted()[i], plain.sorted()[i]) << cell;
-    EXPECT_EQ(lent[0]->data(), block0);  // (the build found its room)
+    for (int d = 0; d < D; ++d)
+      for (std::size_t i = 0; i < x.size(); ++i) ASSERT_EQ(grid.sorted_coord(d)[i], plain.sorted_coord(d)[i]) << cell;
+    EXPECT_EQ(lent.at<std::byte>(0), block);  // (the build found its room)
   }
 }
 
@@ -371,8 +375,7 @@ TEST(MortonOrder, KeysInterleaveBits) {
 TEST(MortonOrder, RefusesNonFinitePositions) {
   std::vector<Vec<2, double>> x{{0, 0}, {std::nan(""), 1}};
   MortonOrder<2, double> order;
-  std::vector<std::uint32_t> perm;
-  EXPECT_THROW(order.compute(x, 0.1, perm), std::logic_error);  // a bug upstream: the solver stops first
+  EXPECT_THROW(order.compute(x, 0.1), std::logic_error);  // a bug upstream: the solver stops first
 }
 
 }  // namespace

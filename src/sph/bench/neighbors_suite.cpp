@@ -34,7 +34,7 @@ struct NeighborPipeline {
   void build(std::span<const V> points, R radius) {
     std::span<const V> x = points;
     if (reorder) {
-      morton.compute(points, radius, perm);
+      perm = morton.compute(points, radius);
       gather<V>(points, perm, gathered);
       x = gathered;
     }
@@ -44,7 +44,7 @@ struct NeighborPipeline {
 
   bool reorder;
   MortonOrder<3, R> morton;
-  std::vector<std::uint32_t> perm;
+  std::span<const std::uint32_t> perm;  // (in morton's memory)
   std::vector<V> gathered;
   UniformGrid<3, R> grid;
   ListBuilder<3, R> builder;
@@ -100,9 +100,8 @@ void run_lattice(int side, const BenchOptions& options, const std::vector<int>& 
           rec.order = order;
           rec.phase = phase;
           rec.threads = check_threads;
-          rec.check = check_neighbor_lists<3, R>(
-              x, radius, view_of(p.lists),
-              shuffled ? std::span<const std::uint32_t>(p.perm) : std::span<const std::uint32_t>());
+          rec.check = check_neighbor_lists<3, R>(x, radius, view_of(p.lists),
+                                                 shuffled ? p.perm : std::span<const std::uint32_t>());
           result.neighbor_checks.push_back(rec);
           if (!rec.check.ok)
             throw BenchFailure(fmt::format("neighbor lists are wrong for {}, built with {} thread{}: {}",

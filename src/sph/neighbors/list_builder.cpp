@@ -19,9 +19,10 @@ struct Stencil {
   std::uint32_t begin[kMax], end[kMax];
   std::uint32_t candidates = 0;
 
-  void update(const UniformGrid<D, R>& grid, std::uint32_t c) {
-    if (c == cell) return;
-    cell = c;
+  void update(const UniformGrid<D, R>& grid, const typename UniformGrid<D, R>::Coords& c) {
+    const std::uint32_t index = grid.cell_index(c);
+    if (index == cell) return;
+    cell = index;
     count = grid.stencil_ranges(c, begin, end);
     candidates = 0;
     for (int k = 0; k < count; ++k) candidates += end[k] - begin[k];
@@ -184,7 +185,7 @@ template <int D, std::floating_point R>
 struct GridPoints {
   const UniformGrid<D, R>& grid;
   std::span<const Vec<D, R>> positions;
-  std::uint32_t cell(std::size_t i) const { return grid.cell_of(i); }
+  typename UniformGrid<D, R>::Coords cell(std::size_t i) const { return grid.cell_of(positions[i]); }
   const Vec<D, R>& x(std::size_t i) const { return positions[i]; }
   static std::uint32_t self(std::size_t i) { return static_cast<std::uint32_t>(i); }
 };
@@ -195,7 +196,7 @@ template <int D, std::floating_point R>
 struct QueryPoints {
   const UniformGrid<D, R>& grid;
   std::span<const Vec<D, R>> positions;
-  std::uint32_t cell(std::size_t i) const { return grid.cell_containing(positions[i]); }
+  typename UniformGrid<D, R>::Coords cell(std::size_t i) const { return grid.cell_containing(positions[i]); }
   const Vec<D, R>& x(std::size_t i) const { return positions[i]; }
   static std::uint32_t self(std::size_t) { return ~0u; }
 };

@@ -38,13 +38,12 @@ std::uint64_t morton_key(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
 }
 
 template <int D, std::floating_point R>
-void MortonOrder<D, R>::compute(std::span<const Vec<D, R>> positions, R cell, std::vector<std::uint32_t>& perm,
-                                std::array<std::vector<std::uint32_t>*, 2> scratch) {
+std::span<const std::uint32_t> MortonOrder<D, R>::compute(std::span<const Vec<D, R>> positions, R cell,
+                                                          ScratchBuffer* lent) {
   SPH_CHECK(cell > R(0) && std::isfinite(cell), "Morton cell size must be positive and finite");
   SPH_CHECK(positions.size() < std::numeric_limits<std::uint32_t>::max(), "too many points for 32-bit indices");
   const std::size_t n = positions.size();
-  perm.resize(n);
-  if (n == 0) return;
+  if (n == 0) return {};
 
   Vec<D, R> lo = positions[0];
   for (const auto& x : positions)
@@ -68,20 +67,39 @@ void MortonOrder<D, R>::compute(std::span<const Vec<D, R>> positions, R cell, st
   int bits = 0;
   while (bits < 32 && (top >> bits) != 0) ++bits;
   // 32-bit keys whenever they are enough (half the memory and passes of 64-bit ones).
-  std::vector<std::uint32_t>& tmp = scratch[1] ? *scratch[1] : tmp_;
-  if (bits * D <= 32)
-    sort_by_key(positions, lo, inv, kMaxCoord, keys32_, scratch[0] ? *scratch[0] : keys32_tmp_, perm, tmp);
-  else
-    sort_by_key(positions, lo, inv, kMaxCoord, keys64_, keys64_tmp_, perm, tmp);
+  if (bits * D <= 32) return sort_by_key<std::uint32_t>(positions, lo, inv, kMaxCoord, lent);
+  return sort_by_key<std::uint64_t>(positions, lo, inv, kMaxCoord, lent);
 }
 
 template <int D, std::floating_point R>
 template <class Key>
-void MortonOrder<D, R>::sort_by_key(std::span<const Vec<D, R>> positions, const Vec<D, R>& lo, R inv,
-                                    std::uint32_t max_coord, std::vector<Key>& keys, std::vector<Key>& keys_tmp,
-                                    std::vector<std::uint32_t>& perm, std::vector<std::uint32_t>& tmp) {
+std::span<const std::uint32_t> MortonOrder<D, R>::sort_by_key(std::span<const Vec<D, R>> positions, const Vec<D, R>& lo,
+                                                              R inv, std::uint32_t max_coord, ScratchBuffer* lent) {
   const std::size_t n = positions.size();
-  keys.resize(n);
+  // Four arrays, the permutation and its second copy, then the keys and theirs: each in the lent
+  // memory while it has room left, the rest in this sort's own.
+  const std::size_t bytes[4] = {ScratchBuffer::round_up(n * sizeof(std::uint32_t)),
+                                ScratchBuffer::round_up(n * sizeof(std::uint32_t)),
+                                ScratchBuffer::round_up(n * sizeof(Key)), ScratchBuffer::round_up(n * sizeof(Key))};
+  ScratchBuffer* where[4];
+  std::size_t offset[4], lent_used = 0, own_used = 0;
+  for (int a = 0; a < 4; ++a) {
+    if (lent && lent_used + bytes[a] <= lent->capacity()) {
+      where[a] = lent;
+      offset[a] = lent_used;
+      lent_used += bytes[a];
+    } else {
+      lent = nullptr;  // (in order: the arrays after one that did not fit are this sort's own)
+      where[a] = &own_;
+      offset[a] = own_used;
+      own_used += bytes[a];
+    }
+  }
+  own_.reserve(own_used);
+  std::uint32_t* const perm = where[0]->place<std::uint32_t>(offset[0], n);
+  std::uint32_t* const tmp = where[1]->place<std::uint32_t>(offset[1], n);
+  Key* const keys = where[2]->place<Key>(offset[2], n);
+  Key* const keys_tmp = where[3]->place<Key>(offset[3], n);
   parallel_for(n, [&](std::size_t i) {
     std::uint32_t c[D];
     for (int d = 0; d < D; ++d) {
@@ -96,18 +114,14 @@ void MortonOrder<D, R>::sort_by_key(std::span<const Vec<D, R>> positions, const 
 
   // LSD radix sort of (key, index), 8 bits per pass, only over the bits some key uses.
   Key all = 0;
-  for (Key k : keys) all |= k;
+  for (std::size_t i = 0; i < n; ++i) all |= keys[i];
   int passes = 0;
   while (passes < static_cast<int>(sizeof(Key)) && (static_cast<std::uint64_t>(all) >> (8 * passes)) != 0) ++passes;
   for (std::size_t i = 0; i < n; ++i) perm[i] = static_cast<std::uint32_t>(i);
-  keys_tmp.resize(n);
-  tmp.resize(n);
   histogram_.resize(256);
-  // Each pass scatters from one copy into the other. The buffers keep their owners (the second
-  // copies may be lent by the grid, whose room must stay its own), and a result that ends in the
-  // second copy is copied back.
-  Key *key = keys.data(), *key_out = keys_tmp.data();
-  std::uint32_t *index = perm.data(), *index_out = tmp.data();
+  // Each pass scatters from one copy into the other.
+  Key *key = keys, *key_out = keys_tmp;
+  std::uint32_t *index = perm, *index_out = tmp;
   for (int p = 0; p < passes; ++p) {
     const int shift = 8 * p;
     std::fill(histogram_.begin(), histogram_.end(), 0u);
@@ -126,7 +140,7 @@ void MortonOrder<D, R>::sort_by_key(std::span<const Vec<D, R>> positions, const 
     std::swap(key, key_out);
     std::swap(index, index_out);
   }
-  if (index != perm.data()) std::copy_n(index, n, perm.data());
+  return {index, n};
 }
 
 template class MortonOrder<2, float>;

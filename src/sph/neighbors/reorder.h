@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include <sph/core/storage.h>
 #include <sph/core/vec.h>
 
 namespace sph {
@@ -16,25 +17,23 @@ namespace sph {
 template <int D, std::floating_point R>
 class MortonOrder {
  public:
-  /// Fills `perm` (resized to positions.size()) so that perm[k] is the index of the point that
-  /// comes k-th along the Z-order curve of cells of size `cell` over the points' bounding box.
-  /// Points in the same cell keep their relative order (stable), so the result depends only on
-  /// the input. Non-finite positions are a bug upstream (the solver stops a blow-up first): refused with
-  /// std::logic_error (SPH_CHECK). cell must be > 0.
-  /// `scratch`: two arrays the sort may use for its second copy of the 32-bit keys and of the
-  /// permutation (UniformGrid::lend_scratch), instead of its own; null: its own.
-  void compute(std::span<const Vec<D, R>> positions, R cell, std::vector<std::uint32_t>& perm,
-               std::array<std::vector<std::uint32_t>*, 2> scratch = {});
+  /// Returns the permutation perm (of positions.size()) such that perm[k] is the index of the
+  /// point that comes k-th along the Z-order curve of cells of size `cell` over the points'
+  /// bounding box. Points in the same cell keep their relative order (stable), so the result
+  /// depends only on the input. Non-finite positions are a bug upstream (the solver stops a
+  /// blow-up first): refused with std::logic_error (SPH_CHECK). cell must be > 0.
+  /// `lent`: memory the sort takes its keys and permutations from (two copies of each, 8 or 16
+  /// bytes a point) before its own (UniformGrid::lend_scratch); null: its own only.
+  /// The result lies in that memory: valid until the next call, or until the lent memory is used
+  /// again.
+  std::span<const std::uint32_t> compute(std::span<const Vec<D, R>> positions, R cell, ScratchBuffer* lent = nullptr);
 
  private:
   template <class Key>
-  void sort_by_key(std::span<const Vec<D, R>> positions, const Vec<D, R>& lo, R inv, std::uint32_t max_coord,
-                   std::vector<Key>& keys, std::vector<Key>& keys_tmp, std::vector<std::uint32_t>& perm,
-                   std::vector<std::uint32_t>& tmp);
+  std::span<const std::uint32_t> sort_by_key(std::span<const Vec<D, R>> positions, const Vec<D, R>& lo, R inv,
+                                             std::uint32_t max_coord, ScratchBuffer* lent);
 
-  std::vector<std::uint32_t> keys32_, keys32_tmp_;
-  std::vector<std::uint64_t> keys64_, keys64_tmp_;
-  std::vector<std::uint32_t> tmp_;
+  ScratchBuffer own_;  // what the lent memory could not hold
   std::vector<std::uint32_t> histogram_;
 };
 

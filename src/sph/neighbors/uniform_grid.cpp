@@ -15,14 +15,17 @@ void UniformGrid<D, R>::build(std::span<const V> positions, R radius) {
   SPH_CHECK(positions.size() < std::numeric_limits<std::uint32_t>::max(), "too many points for 32-bit indices");
   const std::size_t cells = lay_out_cells(positions, radius);
   sort_by_cell(positions, cells);
-  // Coordinates in sorted order, one array per axis.
+  // Coordinates in sorted order, one array per axis (where the cells were: they are not needed
+  // any more, cell_of() computes a point's again).
   const std::size_t n = positions.size();
-  for (auto& c : coords_) c.resize(n + kPad);
+  for (int d = 0; d < D; ++d)
+    coords_[static_cast<std::size_t>(d)] =
+        store_.place<R>(coords_offset(n) + static_cast<std::size_t>(d) * coord_stride(n), n + kPad);
   parallel_for(n, [&](std::size_t k) {
     const V& x = positions[sorted_[k]];
     for (int d = 0; d < D; ++d) coords_[static_cast<std::size_t>(d)][k] = x[d];
   });
-  for (auto& c : coords_) std::fill(c.begin() + static_cast<std::ptrdiff_t>(n), c.end(), R(0));
+  for (R* c : coords_) std::fill(c + n, c + n + kPad, R(0));
 }
 
 template <int D, std::floating_point R>
@@ -89,10 +92,12 @@ template <int D, std::floating_point R>
 void UniformGrid<D, R>::sort_by_cell(std::span<const V> positions, std::size_t cells) {
   const std::size_t n = positions.size();
   // Counting sort by cell, stable in the point index.
-  cell_of_.resize(n);
-  parallel_for(n, [&](std::size_t i) { cell_of_[i] = static_cast<std::uint32_t>(linear(cell_coords(positions[i]))); });
+  store_.reserve(bytes_for(n));
+  sorted_ = store_.place<std::uint32_t>(0, n + kPad);
+  coords_ = {};
+  std::uint32_t* const cell_of = store_.place<std::uint32_t>(coords_offset(n), n);
+  parallel_for(n, [&](std::size_t i) { cell_of[i] = static_cast<std::uint32_t>(linear(cell_coords(positions[i]))); });
   cell_start_.assign(cells + 1, 0);
-  sorted_.resize(n + kPad);
   // A stable sort by cell has one result, however it is computed: with several threads, each
   // of B contiguous blocks of points counts its cells, a prefix over (cell, block) gives each
   // block its own cursors, and the blocks scatter in parallel. Only when the B histograms are
@@ -105,7 +110,7 @@ void UniformGrid<D, R>::sort_by_cell(std::span<const V> positions, std::size_t c
       std::uint32_t* count = block_cursor_.data() + b * cells;
       std::fill(count, count + cells, 0u);
       const auto [first, last] = range(b);
-      for (std::size_t i = first; i < last; ++i) ++count[cell_of_[i]];
+      for (std::size_t i = first; i < last; ++i) ++count[cell_of[i]];
     });
     std::uint32_t running = 0;
     for (std::size_t c = 0; c < cells; ++c) {
@@ -121,17 +126,17 @@ void UniformGrid<D, R>::sort_by_cell(std::span<const V> positions, std::size_t c
     parallel_for(blocks, [&](std::size_t b) {
       std::uint32_t* cursor = block_cursor_.data() + b * cells;
       const auto [first, last] = range(b);
-      for (std::size_t i = first; i < last; ++i) sorted_[cursor[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+      for (std::size_t i = first; i < last; ++i) sorted_[cursor[cell_of[i]]++] = static_cast<std::uint32_t>(i);
     });
   } else {
-    for (std::size_t i = 0; i < n; ++i) ++cell_start_[cell_of_[i] + 1];
+    for (std::size_t i = 0; i < n; ++i) ++cell_start_[cell_of[i] + 1];
     for (std::size_t c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
     // Scatter using a running cursor per cell (cell_start_ shifted by one, then restored).
-    for (std::size_t i = 0; i < n; ++i) sorted_[cell_start_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+    for (std::size_t i = 0; i < n; ++i) sorted_[cell_start_[cell_of[i]]++] = static_cast<std::uint32_t>(i);
     for (std::size_t c = cells; c > 0; --c) cell_start_[c] = cell_start_[c - 1];
     cell_start_[0] = 0;
   }
-  std::fill(sorted_.begin() + static_cast<std::ptrdiff_t>(n), sorted_.end(), 0u);
+  std::fill(sorted_ + n, sorted_ + n + kPad, 0u);
 }
 
 template class UniformGrid<2, float>;

@@ -6,6 +6,7 @@
 #include <span>
 #include <vector>
 
+#include <sph/core/storage.h>
 #include <sph/core/vec.h>
 
 namespace sph {
@@ -27,47 +28,45 @@ class UniformGrid {
 
   const std::array<std::int64_t, D>& dims() const { return dims_; }
 
-  /// Cell (linear index) of point i, as built.
-  std::uint32_t cell_of(std::size_t i) const { return cell_of_[i]; }
+  /// A cell's integer coordinates.
+  using Coords = std::array<std::int64_t, D>;
+
+  /// The cell the build put point x in; x must be one of the points it was built from (the same
+  /// computation as the build's, so the same cell bit for bit).
+  Coords cell_of(const V& x) const { return cell_coords(x); }
   /// The cell whose stencil holds every grid point within the radius of x, for a query point x
   /// that is not one of the grid's points (boundary lists: fluid particles against the grid of
   /// the boundary samples). A point outside the grid's box maps to the nearest cell on its edge,
   /// whose stencil still holds every point within the radius (cells are at least the radius).
-  std::uint32_t cell_containing(const V& x) const {
-    std::array<std::int64_t, D> c;
+  Coords cell_containing(const V& x) const {
+    Coords c;
     for (int d = 0; d < D; ++d) {
       // Clamped before the conversion, so that a far-away (or non-finite) x is well defined.
       const R t = (x[d] - origin_[d]) * inv_cell_;
       const R last = static_cast<R>(dims_[d] - 1);
       c[d] = t >= R(0) ? static_cast<std::int64_t>(t < last ? t : last) : 0;
     }
-    return static_cast<std::uint32_t>(linear(c));
+    return c;
   }
+  /// A cell's linear index (x fastest).
+  std::uint32_t cell_index(const Coords& c) const { return static_cast<std::uint32_t>(linear(c)); }
   /// Point indices in cell-sorted order (stable within a cell), followed by kPad zeros.
-  const std::uint32_t* sorted() const { return sorted_.data(); }
+  const std::uint32_t* sorted() const { return sorted_; }
   /// Coordinate d of the points in cell-sorted order, followed by kPad zeros: candidates of
   /// one row of cells are contiguous here, ready for vector loads.
-  const R* sorted_coord(int d) const { return coords_[static_cast<std::size_t>(d)].data(); }
+  const R* sorted_coord(int d) const { return coords_[static_cast<std::size_t>(d)]; }
 
   /// Readable padding after the sorted arrays, so that vector loads may run past the end.
   static constexpr std::size_t kPad = 16;
   /// Most row ranges stencil_ranges() returns: 3 in 2D, 9 in 3D.
   static constexpr int kMaxRanges = D == 3 ? 9 : 3;
 
-  /// The candidates of every point in `cell`: the 3^D cells around it, as up to kMaxRanges
+  /// The candidates of every point in cell `c`: the 3^D cells around it, as up to kMaxRanges
   /// contiguous ranges [begin[k], end[k]) of sorted positions (one per row of cells along x,
   /// empty rows skipped), in a fixed order. Returns the number of ranges.
-  int stencil_ranges(std::uint32_t cell, std::uint32_t* begin, std::uint32_t* end) const {
-    // (in 32 bits, which every cell index and extent fits, and without a division for the last
-    // axis: a 64-bit division was a fifth of the list build's own time, outside the distance tests)
-    std::int64_t c[D];
-    std::uint32_t rest = cell;
-    for (int d = 0; d + 1 < D; ++d) {
-      const auto n = static_cast<std::uint32_t>(dims_[d]);
-      c[d] = rest % n;
-      rest /= n;
-    }
-    c[D - 1] = rest;
+  int stencil_ranges(const Coords& c, std::uint32_t* begin, std::uint32_t* end) const {
+    // (from the coordinates, not from a linear index: splitting one took divisions, a fifth of the
+    // list build's own time outside the distance tests)
     const std::int64_t x0 = c[0] > 0 ? c[0] - 1 : 0;
     const std::int64_t x1 = c[0] + 1 < dims_[0] ? c[0] + 1 : dims_[0] - 1;
     const std::int64_t y0 = c[1] > 0 ? c[1] - 1 : 0;
@@ -101,24 +100,33 @@ class UniformGrid {
   /// Maximum number of dense cells, relative to the point count (plus a constant).
   static constexpr std::size_t kMaxCellsPerPoint = 8;
 
-  /// The grid's two arrays of a 32-bit value per point (the sorted indices and each point's
-  /// cell), lent as scratch for n values to a caller that builds the grid again before it is
-  /// queried (the Morton reorder's sort: the reorder invalidates the lists, so the next update
-  /// builds the grid first). Their contents are lost. They get the room a build of n points
-  /// needs first, so that the build after the caller's use does not allocate (a block outgrown
-  /// and freed can stay resident).
-  std::array<std::vector<std::uint32_t>*, 2> lend_scratch(std::size_t n) {
-    sorted_.reserve(n + kPad);
-    cell_of_.reserve(n);
-    return {&sorted_, &cell_of_};
+  /// The grid's memory for its per-point arrays (the sorted indices and coordinates: 4 + D
+  /// sizeof(R) bytes a point), lent as scratch to a caller that builds the grid again before it
+  /// is queried (the Morton reorder's sort: the reorder invalidates the lists, so the next update
+  /// builds the grid first). Its contents are lost. It gets the room a build of n points needs
+  /// first, so that the build after the caller's use does not allocate (a block outgrown and
+  /// freed can stay resident).
+  ScratchBuffer& lend_scratch(std::size_t n) {
+    store_.reserve(bytes_for(n));
+    sorted_ = nullptr;
+    coords_ = {};
+    return store_;
   }
 
  private:
   /// Sets origin_, inv_cell_ and dims_ for `positions` (cells of size >= radius, at most
   /// kMaxCellsPerPoint per point plus a constant); returns the number of cells.
   std::size_t lay_out_cells(std::span<const V> positions, R radius);
-  /// Fills cell_of_, cell_start_ and sorted_ (a stable counting sort of the points by cell).
+  /// Fills cell_start_ and sorted_ (a stable counting sort of the points by cell), with each
+  /// point's cell kept where the coordinates go next.
   void sort_by_cell(std::span<const V> positions, std::size_t cells);
+  /// Where the coordinates start in store_, and each axis's stride, for n points (each array
+  /// padded with kPad and aligned).
+  static std::size_t coords_offset(std::size_t n) {
+    return ScratchBuffer::round_up((n + kPad) * sizeof(std::uint32_t));
+  }
+  static std::size_t coord_stride(std::size_t n) { return ScratchBuffer::round_up((n + kPad) * sizeof(R)); }
+  static std::size_t bytes_for(std::size_t n) { return coords_offset(n) + D * coord_stride(n); }
   std::array<std::int64_t, D> cell_coords(const V& x) const {
     std::array<std::int64_t, D> c;
     for (int d = 0; d < D; ++d) {
@@ -136,11 +144,13 @@ class UniformGrid {
   R inv_cell_ = 0;
   std::array<std::int64_t, D> dims_{};
   std::vector<std::uint32_t> cell_start_;    // size cells + 1
-  std::vector<std::uint32_t> sorted_;        // point indices sorted by cell (stable), + kPad
-  std::vector<std::uint32_t> cell_of_;       // cell of each point
   std::vector<std::uint32_t> block_cursor_;  // parallel counting sort: per block and cell
-  std::array<std::vector<R>, D> coords_;     // coordinates in sorted order, + kPad
-  std::vector<V> box_lo_, box_hi_;           // bounding box of each chunk of points
+  // store_ holds the point indices sorted by cell (stable), then the coordinates in that order
+  // (each + kPad); while the sort runs, each point's cell where the coordinates go.
+  ScratchBuffer store_;
+  std::uint32_t* sorted_ = nullptr;
+  std::array<R*, D> coords_{};
+  std::vector<V> box_lo_, box_hi_;  // bounding box of each chunk of points
 };
 
 extern template class UniformGrid<2, float>;

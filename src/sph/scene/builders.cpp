@@ -137,7 +137,7 @@ double estimated_bytes_of(const SceneBody<D>& body, std::size_t real_bytes) {
   const double fields = 4.0 * D * real_bytes + 3.0 * real_bytes + 8.0;  // 4 vectors, 3 scalars, id
   const double lists = tracked ? 4.0 * (neighbors * 1.25 + 4.0) * (17.0 / 16.0) + 12.0 + D * real_bytes + 2.0
                                : 4.0 * neighbors * (17.0 / 16.0) + 8.0;  // entries + spare room, offsets
-  const double grid = D * real_bytes + 8.0;                              // coordinates in cell order, cell, index
+  const double grid = D * real_bytes + 4.0;  // coordinates in cell order (the Morton sort's too), index
   return n * (fields + lists + grid);
 }
 }  // namespace

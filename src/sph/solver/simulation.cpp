@@ -497,14 +497,14 @@ const StepInfo& Simulation<D, R>::step() {
   double reorder_seconds = 0;
   if (params_.reorder_period > 0 && steps_ % params_.reorder_period == 0 && particles_.size() > 1) {
     Stopwatch reorder;
-    // The lists refer to the old indices: invalidated first, so that the fluid grid, whose arrays
-    // the sort borrows for its second copies (8 bytes a particle less at the peak), is built
-    // again before anything reads it, even if the sort throws.
+    // The lists refer to the old indices: invalidated first, so that the fluid grid, whose memory
+    // the sort borrows for its keys and permutations (16 bytes a particle less at the peak, with
+    // the grid's coordinates in float 3D), is built again before anything reads it, even if the
+    // sort throws.
     neighbors_->invalidate();
     UniformGrid<D, R>* grid = neighbors_->fluid_grid();
-    morton_.compute(particles_.position, h, perm_,
-                    grid ? grid->lend_scratch(particles_.size()) : std::array<std::vector<std::uint32_t>*, 2>{});
-    particles_.permute(perm_);
+    particles_.permute(
+        morton_.compute(particles_.position, h, grid ? &grid->lend_scratch(particles_.size()) : nullptr));
     info.reordered = true;
     reorder_seconds = reorder.lap();
   }

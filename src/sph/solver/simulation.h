@@ -235,7 +235,6 @@ class Simulation {
   std::unique_ptr<NeighborStrategy<D, R>> neighbors_;
   std::unique_ptr<ListAuditor<D, R>> auditor_;
   MortonOrder<D, R> morton_;
-  std::vector<std::uint32_t> perm_;
   mutable std::vector<double> partial_;             // per-chunk partial sums (kept: no allocation per step)
   std::vector<detail::HealthChunk> health_chunks_;  // per-chunk health statistics (kept)
   std::vector<EmitterState> emitters_;

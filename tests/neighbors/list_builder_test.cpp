@@ -182,6 +182,41 @@ TEST(FastLists, PaddingHoldsValidIndicesAfterALargerSetOnTheSameThread) {
   EXPECT_TRUE(NeighborLists::from({{1}, {0}}).padding_is_valid());
 }
 
+TEST(FastLists, ListsThatOutgrowTheirChunksBufferAreExact) {
+  // A chunk's buffer keeps no room for one more particle's candidates: a list that may not fit
+  // is gathered aside and copied, and the buffer grows only by what the lists take. Lists built
+  // again, the same objects, on points compressed to 0.7 of their spacing (each list about
+  // three times as long) equal a brute-force search's, in every build path.
+  const auto x = jittered_lattice<3, double>(14, 0.025, 0.0025, 9, true);  // 2,744 points: 11 chunks
+  auto squeezed = x;
+  for (auto& p : squeezed) p = 0.7 * p;
+  const NeighborLists expected = brute_force_lists<3, double>(squeezed, 0.05);
+  for (bool room : {false, true}) {
+    UniformGrid<3, double> grid;
+    ListBuilder<3, double> builder;
+    builder.keep_room(room);
+    NeighborLists built, rebuilt;
+    grid.build(x, 0.05);
+    builder.build(grid, x, 0.05, built);
+    builder.build(grid, x, 0.05, rebuilt);
+    grid.build(squeezed, 0.05);
+    builder.build(grid, squeezed, 0.05, built);
+    const std::vector<std::uint8_t> all(x.size(), 1);
+    builder.rebuild_some(grid, squeezed, 0.05, all, rebuilt);
+    for (const NeighborLists* l : {&built, &rebuilt}) {
+      ASSERT_EQ(l->particle_count(), x.size());
+      EXPECT_TRUE(l->padding_is_valid()) << room;
+      for (std::size_t i = 0; i < x.size(); ++i) {
+        auto got = l->of(i), want = expected.of(i);
+        std::vector<std::uint32_t> a(got.begin(), got.end()), b(want.begin(), want.end());
+        std::sort(a.begin(), a.end());
+        std::sort(b.begin(), b.end());
+        ASSERT_EQ(a, b) << "point " << i << (room ? ", lists with room" : "");
+      }
+    }
+  }
+}
+
 TEST(FastLists, PairsExactlyAtRadiusAreExcluded) {
   // Points on an exact lattice at spacing 1 with r = 2: the neighbors at distance exactly 2
   // are not strictly closer and must be left out by both kernels.

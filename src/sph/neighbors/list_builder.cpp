@@ -180,6 +180,24 @@ constexpr std::size_t kRoom = 16;
 
 static_assert(kRoom >= NeighborLists::kPadding);
 
+/// Gathers point i's list (gather()'s arguments) into buf at `at` and returns its length. buf
+/// grows only by what the list needs, not by room for every candidate: when it lacks that room,
+/// the list is gathered into `spill` (the thread's) first and copied. So a chunk's buffer keeps
+/// no room for one more particle's candidates (3.4 bytes a particle at 1M in float).
+template <int D, std::floating_point R>
+std::uint32_t gather_into(std::vector<std::uint32_t>& buf, std::size_t at, std::vector<std::uint32_t>& spill,
+                          bool vector, const UniformGrid<D, R>& grid, const Stencil<D, R>& st, const Vec<D, R>& x,
+                          std::uint32_t self, R r2, R inner2, std::uint32_t* far, const ListFilter* filter,
+                          std::size_t i) {
+  if (buf.size() >= at + st.candidates + kRoom)
+    return gather(vector, grid, st, x, self, r2, buf.data() + at, inner2, far, filter, i);
+  ensure_room(spill, st.candidates + kRoom);
+  const std::uint32_t m = gather(vector, grid, st, x, self, r2, spill.data(), inner2, far, filter, i);
+  ensure_room(buf, at + m + kRoom);
+  std::copy_n(spill.data(), m, buf.data() + at);
+  return m;
+}
+
 /// The grid's own points as queries: point i's cell as built, and itself left out.
 template <int D, std::floating_point R>
 struct GridPoints {
@@ -254,6 +272,8 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
   chunk_entries_.resize(chunks);
   old_copy_.resize(static_cast<std::size_t>(num_threads()));
   far_.resize(old_copy_.size());
+  spill_.resize(old_copy_.size());
+  for (auto& spill : spill_) ensure_room(spill, kRoom);  // (4,096 entries and more: grown once, on every thread)
 
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     // A chunk's first build goes to its thread's scratch, then into a buffer allocated once, at
@@ -263,13 +283,12 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
     const bool first = own.capacity() == 0;
     std::vector<std::uint32_t>& buf = first ? old_copy_[static_cast<std::size_t>(thread_index())] : own;
     Stencil<D, R> st;
-    std::size_t used = 0, entries = 0, most = 0;
+    std::size_t used = 0, entries = 0;
     for (std::size_t i = b; i < e; ++i) {
       st.update(grid, query.cell(i));
-      most = std::max<std::size_t>(most, st.candidates);
-      ensure_room(buf, used + st.candidates + kRoom);
-      const std::uint32_t m = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + used, inner2(),
-                                     far_room(st.candidates), filter_, i);
+      const std::uint32_t m =
+          gather_into(buf, used, spill_[static_cast<std::size_t>(thread_index())], vector_, grid, st, query.x(i),
+                      query.self(i), r2, inner2(), far_room(st.candidates), filter_, i);
       if (room_) out.begin_[i] = static_cast<std::uint32_t>(used);
       out.end_[i] = static_cast<std::uint32_t>(used + m);
       entries += m;
@@ -284,7 +303,7 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
     }
     std::fill_n(buf.data() + used, kRoom, 0u);  // readable padding, valid indices (not stale ones)
     if (first) {
-      own.reserve(used + used / 16 + most + kRoom);
+      own.reserve(used + used / 16 + kRoom);
       own.assign(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(used + kRoom));
     }
     chunk_entries_[c] = entries;
@@ -325,6 +344,8 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
   old_copy_.resize(static_cast<std::size_t>(num_threads()));
   for (auto& copy : old_copy_) ensure_room(copy, largest_old);
   far_.resize(old_copy_.size());
+  spill_.resize(old_copy_.size());
+  for (auto& spill : spill_) ensure_room(spill, kRoom);  // (4,096 entries and more: grown once, on every thread)
 
   if (room_ && lists.has_room()) {
     rebuild_in_place(grid, n, query, radius, rebuild, lists, visitor);
@@ -361,9 +382,8 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
       std::uint32_t len = 0, cap = 0;
       if (marked(i)) {
         st.update(grid, query.cell(i));
-        ensure_room(buf, at + st.candidates + kRoom);
-        len = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at, inner2(),
-                     far_room(st.candidates), filter_, i);
+        len = gather_into(buf, at, spill_[static_cast<std::size_t>(thread_index())], vector_, grid, st, query.x(i),
+                          query.self(i), r2, inner2(), far_room(st.candidates), filter_, i);
         written += len;
         cap = room_ ? list_capacity(len) : len;
         ensure_room(buf, at + cap + kRoom);
@@ -419,9 +439,9 @@ void ListBuilder<D, R>::rebuild_in_place(const UniformGrid<D, R>& grid, std::siz
       st.update(grid, query.cell(i));
       if (i >= old_n) {  // appended: its list goes after the chunk's last one
         const std::size_t at = i == b ? 0 : lists.begin_[i - 1] + lists.cap_[i - 1];
-        ensure_room(buf, at + st.candidates + kRoom);
-        const std::uint32_t len = gather(vector_, grid, st, query.x(i), query.self(i), r2, buf.data() + at, inner2(),
-                                         far_room(st.candidates), filter_, i);
+        const std::uint32_t len =
+            gather_into(buf, at, spill_[static_cast<std::size_t>(thread_index())], vector_, grid, st, query.x(i),
+                        query.self(i), r2, inner2(), far_room(st.candidates), filter_, i);
         const std::uint32_t cap = list_capacity(len);
         ensure_room(buf, at + cap + kRoom);
         std::fill_n(buf.data() + at + len, cap - len + kRoom, 0u);

@@ -110,6 +110,7 @@ class ListBuilder {
   std::size_t written_ = 0;
   std::vector<std::vector<std::uint32_t>> old_copy_;       // one per thread: rebuild_some's old lists, a first build
   std::vector<std::vector<std::uint32_t>> relayout_copy_;  // rebuild_some in place: one per thread
+  std::vector<std::vector<std::uint32_t>> spill_;  // one per thread: a list whose chunk lacked room for its candidates
 };
 
 extern template class ListBuilder<2, float>;

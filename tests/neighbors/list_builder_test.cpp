@@ -149,7 +149,7 @@ TEST(FastLists, ParallelCountingSortGivesTheSerialOrder) {
   grid.build(x, 0.05);
   const auto l = lists[0].of(1234);
   for (std::size_t k = 1; k < l.size(); ++k) {
-    const auto ca = grid.cell_index(grid.cell_of(x[l[k - 1]])), cb = grid.cell_index(grid.cell_of(x[l[k]]));
+    const auto ca = grid.cell_containing(x[l[k - 1]]), cb = grid.cell_containing(x[l[k]]);
     const bool same_row = ca / grid.dims()[0] == cb / grid.dims()[0];
     if (same_row) {
       EXPECT_TRUE(ca < cb || (ca == cb && l[k - 1] < l[k])) << k;

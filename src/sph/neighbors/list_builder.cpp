@@ -19,10 +19,9 @@ struct Stencil {
   std::uint32_t begin[kMax], end[kMax];
   std::uint32_t candidates = 0;
 
-  void update(const UniformGrid<D, R>& grid, const typename UniformGrid<D, R>::Coords& c) {
-    const std::uint32_t index = grid.cell_index(c);
-    if (index == cell) return;
-    cell = index;
+  void update(const UniformGrid<D, R>& grid, std::uint32_t c) {
+    if (c == cell) return;
+    cell = c;
     count = grid.stencil_ranges(c, begin, end);
     candidates = 0;
     for (int k = 0; k < count; ++k) candidates += end[k] - begin[k];
@@ -208,7 +207,10 @@ template <int D, std::floating_point R>
 struct GridPoints {
   const UniformGrid<D, R>& grid;
   std::span<const Vec<D, R>> positions;
-  typename UniformGrid<D, R>::Coords cell(std::size_t i) const { return grid.cell_of(positions[i]); }
+  std::uint32_t cell(std::size_t i) const { return grid.cell_containing(positions[i]); }
+  void cells(std::size_t b, std::size_t e, std::uint32_t* out) const {
+    grid.cells_containing(positions.data() + b, e - b, out);
+  }
   const Vec<D, R>& x(std::size_t i) const { return positions[i]; }
   static std::uint32_t self(std::size_t i) { return static_cast<std::uint32_t>(i); }
 };
@@ -219,7 +221,10 @@ template <int D, std::floating_point R>
 struct QueryPoints {
   const UniformGrid<D, R>& grid;
   std::span<const Vec<D, R>> positions;
-  typename UniformGrid<D, R>::Coords cell(std::size_t i) const { return grid.cell_containing(positions[i]); }
+  std::uint32_t cell(std::size_t i) const { return grid.cell_containing(positions[i]); }
+  void cells(std::size_t b, std::size_t e, std::uint32_t* out) const {
+    grid.cells_containing(positions.data() + b, e - b, out);
+  }
   const Vec<D, R>& x(std::size_t i) const { return positions[i]; }
   static std::uint32_t self(std::size_t) { return ~0u; }
 };
@@ -286,14 +291,17 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
     // several times over, and the blocks freed on the way stay with the process (resident).
     std::vector<std::uint32_t>& own = out.chunks_[c];
     const bool first = own.capacity() == 0;
-    std::vector<std::uint32_t>& buf = first ? old_copy_[static_cast<std::size_t>(thread_index())] : own;
+    const auto thread = static_cast<std::size_t>(thread_index());  // (once per chunk: a call into the runtime)
+    std::vector<std::uint32_t>& buf = first ? old_copy_[thread] : own;
+    std::vector<std::uint32_t>& spill = spill_[thread];
     Stencil<D, R> st;
     std::size_t used = 0, entries = 0;
+    std::uint32_t cells[kChunkSize];  // the chunk's cells, in one loop
+    query.cells(b, e, cells);
     for (std::size_t i = b; i < e; ++i) {
-      st.update(grid, query.cell(i));
-      const std::uint32_t m =
-          gather_into(buf, used, spill_[static_cast<std::size_t>(thread_index())], vector_, grid, st, query.x(i),
-                      query.self(i), r2, inner2(), far_room(st.candidates), filter_, i);
+      st.update(grid, cells[i - b]);
+      const std::uint32_t m = gather_into(buf, used, spill, vector_, grid, st, query.x(i), query.self(i), r2, inner2(),
+                                          far_room(st.candidates), filter_, i);
       if (room_) out.begin_[i] = static_cast<std::uint32_t>(used);
       out.end_[i] = static_cast<std::uint32_t>(used + m);
       entries += m;
@@ -376,7 +384,9 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
     std::vector<std::uint32_t>& buf = lists.chunks_[c];
     const std::size_t last_old = std::min(e, old_n);  // particles [b, last_old) had lists
     const std::size_t old_size = last_old > b ? lists.begin(last_old - 1) + lists.capacity(last_old - 1) : 0;
-    std::vector<std::uint32_t>& old_copy = old_copy_[static_cast<std::size_t>(thread_index())];
+    const auto thread = static_cast<std::size_t>(thread_index());
+    std::vector<std::uint32_t>& old_copy = old_copy_[thread];
+    std::vector<std::uint32_t>& spill = spill_[thread];
     std::copy_n(buf.data(), old_size, old_copy.data());
     Stencil<D, R> st;
     std::size_t at = 0, entries = 0, written = 0;
@@ -387,8 +397,8 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
       std::uint32_t len = 0, cap = 0;
       if (marked(i)) {
         st.update(grid, query.cell(i));
-        len = gather_into(buf, at, spill_[static_cast<std::size_t>(thread_index())], vector_, grid, st, query.x(i),
-                          query.self(i), r2, inner2(), far_room(st.candidates), filter_, i);
+        len = gather_into(buf, at, spill, vector_, grid, st, query.x(i), query.self(i), r2, inner2(),
+                          far_room(st.candidates), filter_, i);
         written += len;
         cap = room_ ? list_capacity(len) : len;
         ensure_room(buf, at + cap + kRoom);
@@ -435,7 +445,9 @@ void ListBuilder<D, R>::rebuild_in_place(const UniformGrid<D, R>& grid, std::siz
   relayout_copy_.resize(old_copy_.size());
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     std::vector<std::uint32_t>& buf = lists.chunks_[c];
-    std::vector<std::uint32_t>& scratch = old_copy_[static_cast<std::size_t>(thread_index())];
+    const auto thread = static_cast<std::size_t>(thread_index());
+    std::vector<std::uint32_t>& scratch = old_copy_[thread];
+    std::vector<std::uint32_t>& spill = spill_[thread];
     std::int64_t delta = 0;
     std::size_t written = 0;
     Stencil<D, R> st;
@@ -444,9 +456,8 @@ void ListBuilder<D, R>::rebuild_in_place(const UniformGrid<D, R>& grid, std::siz
       st.update(grid, query.cell(i));
       if (i >= old_n) {  // appended: its list goes after the chunk's last one
         const std::size_t at = i == b ? 0 : lists.begin_[i - 1] + lists.cap_[i - 1];
-        const std::uint32_t len =
-            gather_into(buf, at, spill_[static_cast<std::size_t>(thread_index())], vector_, grid, st, query.x(i),
-                        query.self(i), r2, inner2(), far_room(st.candidates), filter_, i);
+        const std::uint32_t len = gather_into(buf, at, spill, vector_, grid, st, query.x(i), query.self(i), r2,
+                                              inner2(), far_room(st.candidates), filter_, i);
         const std::uint32_t cap = list_capacity(len);
         ensure_room(buf, at + cap + kRoom);
         std::fill_n(buf.data() + at + len, cap - len + kRoom, 0u);

@@ -98,8 +98,8 @@ class NeighborStrategy {
   /// The particles were reordered in memory: the lists refer to old indices, so the next
   /// update() rebuilds every list (and restarts whatever the strategy tracks per particle).
   virtual void invalidate() = 0;
-  /// The grid of the fluid particles, whose arrays a reorder may borrow as scratch
-  /// (UniformGrid::lend_scratch) before invalidate(): its next update() builds it again before
+  /// The grid of the fluid particles, whose memory a reorder may borrow as scratch
+  /// (UniformGrid::lend_scratch) after invalidate(): its next update() builds it again before
   /// reading it. Null for a strategy without one.
   virtual UniformGrid<D, R>* fluid_grid() { return nullptr; }
 

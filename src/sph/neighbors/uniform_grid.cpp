@@ -16,7 +16,7 @@ void UniformGrid<D, R>::build(std::span<const V> positions, R radius) {
   const std::size_t cells = lay_out_cells(positions, radius);
   sort_by_cell(positions, cells);
   // Coordinates in sorted order, one array per axis (where the cells were: they are not needed
-  // any more, cell_of() computes a point's again).
+  // any more, cell_containing() computes a point's again).
   const std::size_t n = positions.size();
   for (int d = 0; d < D; ++d)
     coords_[static_cast<std::size_t>(d)] =
@@ -96,7 +96,9 @@ void UniformGrid<D, R>::sort_by_cell(std::span<const V> positions, std::size_t c
   sorted_ = store_.place<std::uint32_t>(0, n + kPad);
   coords_ = {};
   std::uint32_t* const cell_of = store_.place<std::uint32_t>(coords_offset(n), n);
-  parallel_for(n, [&](std::size_t i) { cell_of[i] = static_cast<std::uint32_t>(linear(cell_coords(positions[i]))); });
+  parallel_chunks(n, [&](std::size_t, std::size_t b, std::size_t e) {
+    cells_containing(positions.data() + b, e - b, cell_of + b);
+  });
   cell_start_.assign(cells + 1, 0);
   // A stable sort by cell has one result, however it is computed: with several threads, each
   // of B contiguous blocks of points counts its cells, a prefix over (cell, block) gives each

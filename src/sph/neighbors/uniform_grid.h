@@ -28,28 +28,29 @@ class UniformGrid {
 
   const std::array<std::int64_t, D>& dims() const { return dims_; }
 
-  /// A cell's integer coordinates.
-  using Coords = std::array<std::int64_t, D>;
-
-  /// The cell the build put point x in; x must be one of the points it was built from (the same
-  /// computation as the build's, so the same cell bit for bit).
-  Coords cell_of(const V& x) const { return cell_coords(x); }
-  /// The cell whose stencil holds every grid point within the radius of x, for a query point x
-  /// that is not one of the grid's points (boundary lists: fluid particles against the grid of
-  /// the boundary samples). A point outside the grid's box maps to the nearest cell on its edge,
-  /// whose stencil still holds every point within the radius (cells are at least the radius).
-  Coords cell_containing(const V& x) const {
-    Coords c;
-    for (int d = 0; d < D; ++d) {
-      // Clamped before the conversion, so that a far-away (or non-finite) x is well defined.
+  /// The cell (linear index, x fastest) whose stencil holds every grid point within the radius
+  /// of x: for one of the grid's points, the cell the build put it in (the build computes each
+  /// point's cell with this function); for a query point that is not one of them (boundary
+  /// lists: fluid particles against the grid of the boundary samples), a point outside the
+  /// grid's box maps to the nearest cell on its edge, whose stencil still holds every point within
+  /// the radius (cells are at least the radius).
+  std::uint32_t cell_containing(const V& x) const {
+    std::uint32_t l = 0;
+    for (int d = D - 1; d >= 0; --d) {
+      // Clamped before the conversion, so that a far-away (or non-finite) x is well defined
+      // (32 bits: every cell index fits, checked by the build).
       const R t = (x[d] - origin_[d]) * inv_cell_;
       const R last = static_cast<R>(dims_[d] - 1);
-      c[d] = t >= R(0) ? static_cast<std::int64_t>(t < last ? t : last) : 0;
+      const auto k = static_cast<std::uint32_t>(t >= R(0) ? (t < last ? t : last) : R(0));
+      l = l * static_cast<std::uint32_t>(dims_[d]) + k;
     }
-    return c;
+    return l;
   }
-  /// A cell's linear index (x fastest).
-  std::uint32_t cell_index(const Coords& c) const { return static_cast<std::uint32_t>(linear(c)); }
+  /// cell_containing() of x[0], ..., x[n - 1], written to out (a chunk's at once, before its
+  /// lists: a loop the compiler can vectorize).
+  void cells_containing(const V* x, std::size_t n, std::uint32_t* out) const {
+    for (std::size_t i = 0; i < n; ++i) out[i] = cell_containing(x[i]);
+  }
   /// Point indices in cell-sorted order (stable within a cell), followed by kPad zeros.
   const std::uint32_t* sorted() const { return sorted_; }
   /// Coordinate d of the points in cell-sorted order, followed by kPad zeros: candidates of
@@ -61,12 +62,20 @@ class UniformGrid {
   /// Most row ranges stencil_ranges() returns: 3 in 2D, 9 in 3D.
   static constexpr int kMaxRanges = D == 3 ? 9 : 3;
 
-  /// The candidates of every point in cell `c`: the 3^D cells around it, as up to kMaxRanges
+  /// The candidates of every point in `cell`: the 3^D cells around it, as up to kMaxRanges
   /// contiguous ranges [begin[k], end[k]) of sorted positions (one per row of cells along x,
   /// empty rows skipped), in a fixed order. Returns the number of ranges.
-  int stencil_ranges(const Coords& c, std::uint32_t* begin, std::uint32_t* end) const {
-    // (from the coordinates, not from a linear index: splitting one took divisions, a fifth of the
-    // list build's own time outside the distance tests)
+  int stencil_ranges(std::uint32_t cell, std::uint32_t* begin, std::uint32_t* end) const {
+    // (in 32 bits, which every cell index and extent fits, and without a division for the last
+    // axis: a 64-bit division was a fifth of the list build's own time, outside the distance tests)
+    std::int64_t c[D];
+    std::uint32_t rest = cell;
+    for (int d = 0; d + 1 < D; ++d) {
+      const auto n = static_cast<std::uint32_t>(dims_[d]);
+      c[d] = rest % n;
+      rest /= n;
+    }
+    c[D - 1] = rest;
     const std::int64_t x0 = c[0] > 0 ? c[0] - 1 : 0;
     const std::int64_t x1 = c[0] + 1 < dims_[0] ? c[0] + 1 : dims_[0] - 1;
     const std::int64_t y0 = c[1] > 0 ? c[1] - 1 : 0;
@@ -127,19 +136,6 @@ class UniformGrid {
   }
   static std::size_t coord_stride(std::size_t n) { return ScratchBuffer::round_up((n + kPad) * sizeof(R)); }
   static std::size_t bytes_for(std::size_t n) { return coords_offset(n) + D * coord_stride(n); }
-  std::array<std::int64_t, D> cell_coords(const V& x) const {
-    std::array<std::int64_t, D> c;
-    for (int d = 0; d < D; ++d) {
-      auto k = static_cast<std::int64_t>((x[d] - origin_[d]) * inv_cell_);
-      c[d] = k < 0 ? 0 : (k >= dims_[d] ? dims_[d] - 1 : k);
-    }
-    return c;
-  }
-  std::size_t linear(const std::array<std::int64_t, D>& c) const {
-    std::int64_t l = c[D - 1];
-    for (int d = D - 2; d >= 0; --d) l = l * dims_[d] + c[d];
-    return static_cast<std::size_t>(l);
-  }
   V origin_{};
   R inv_cell_ = 0;
   std::array<std::int64_t, D> dims_{};

@@ -183,7 +183,7 @@ static_assert(kRoom >= NeighborLists::kPadding);
 /// Gathers point i's list (gather()'s arguments) into buf at `at` and returns its length. buf
 /// grows only by what the list needs, not by room for every candidate: when it lacks that room,
 /// the list is gathered into `spill` (the thread's) first and copied. So a chunk's buffer keeps
-/// no room for one more particle's candidates (3.4 bytes a particle at 1M in float).
+/// no room for one more particle's candidates (3.6 bytes a particle at 1M in float).
 /// (Inlined: the build's inner loop, where gather() was called directly before.)
 template <int D, std::floating_point R>
 [[gnu::always_inline]] inline std::uint32_t gather_into(std::vector<std::uint32_t>& buf, std::size_t at,
@@ -297,6 +297,7 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
     Stencil<D, R> st;
     std::size_t used = 0, entries = 0;
     std::uint32_t cells[kChunkSize];  // the chunk's cells, in one loop
+    SPH_CHECK(e - b <= kChunkSize, "parallel_chunks gives chunks of kChunkSize points at most");
     query.cells(b, e, cells);
     for (std::size_t i = b; i < e; ++i) {
       st.update(grid, cells[i - b]);

@@ -22,8 +22,9 @@ class MortonOrder {
   /// bounding box. Points in the same cell keep their relative order (stable), so the result
   /// depends only on the input. Non-finite positions are a bug upstream (the solver stops a
   /// blow-up first): refused with std::logic_error (SPH_CHECK). cell must be > 0.
-  /// `lent`: memory the sort takes its keys and permutations from (two copies of each, 8 or 16
-  /// bytes a point) before its own (UniformGrid::lend_scratch); null: its own only.
+  /// `lent`: memory the sort takes its keys and permutations from (two copies of each: 16 bytes a
+  /// point with 32-bit keys, 24 with 64-bit ones) before its own (UniformGrid::lend_scratch);
+  /// null: its own only.
   /// The result lies in that memory: valid until the next call, or until the lent memory is used
   /// again.
   std::span<const std::uint32_t> compute(std::span<const Vec<D, R>> positions, R cell, ScratchBuffer* lent = nullptr);

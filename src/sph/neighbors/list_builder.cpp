@@ -202,9 +202,12 @@ template <int D, std::floating_point R>
   return m;
 }
 
-/// The grid's own points as queries: point i's cell as built, and itself left out.
-template <int D, std::floating_point R>
-struct GridPoints {
+/// Query points and their cells (UniformGrid::cell_containing: for the grid's own points, the
+/// cell the build put each in). kOwn: the grid's own points, each left out of its own list;
+/// otherwise points that are not the grid's (fluid particles against the boundary samples' grid),
+/// nothing left out (no grid index is ~0).
+template <int D, std::floating_point R, bool kOwn>
+struct Points {
   const UniformGrid<D, R>& grid;
   std::span<const Vec<D, R>> positions;
   std::uint32_t cell(std::size_t i) const { return grid.cell_containing(positions[i]); }
@@ -212,24 +215,22 @@ struct GridPoints {
     grid.cells_containing(positions.data() + b, e - b, out);
   }
   const Vec<D, R>& x(std::size_t i) const { return positions[i]; }
-  static std::uint32_t self(std::size_t i) { return static_cast<std::uint32_t>(i); }
+  static std::uint32_t self(std::size_t i) { return kOwn ? static_cast<std::uint32_t>(i) : ~0u; }
 };
-
-/// Points that are not the grid's (fluid particles against the boundary samples' grid): the
-/// cell that holds each, and nothing left out (no grid index is ~0).
 template <int D, std::floating_point R>
-struct QueryPoints {
-  const UniformGrid<D, R>& grid;
-  std::span<const Vec<D, R>> positions;
-  std::uint32_t cell(std::size_t i) const { return grid.cell_containing(positions[i]); }
-  void cells(std::size_t b, std::size_t e, std::uint32_t* out) const {
-    grid.cells_containing(positions.data() + b, e - b, out);
-  }
-  const Vec<D, R>& x(std::size_t i) const { return positions[i]; }
-  static std::uint32_t self(std::size_t) { return ~0u; }
-};
+using GridPoints = Points<D, R, true>;
+template <int D, std::floating_point R>
+using QueryPoints = Points<D, R, false>;
 
 }  // namespace
+
+template <int D, std::floating_point R>
+void ListBuilder<D, R>::size_thread_buffers() {
+  old_copy_.resize(static_cast<std::size_t>(num_threads()));
+  far_.resize(old_copy_.size());
+  spill_.resize(old_copy_.size());
+  for (auto& spill : spill_) ensure_room(spill, 4096);  // (grown once, on every thread)
+}
 
 template <int D, std::floating_point R>
 std::uint32_t* ListBuilder<D, R>::far_room(std::size_t candidates) {
@@ -280,10 +281,7 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
     out.cap_.clear();
   }
   chunk_entries_.resize(chunks);
-  old_copy_.resize(static_cast<std::size_t>(num_threads()));
-  far_.resize(old_copy_.size());
-  spill_.resize(old_copy_.size());
-  for (auto& spill : spill_) ensure_room(spill, 4096);  // (grown once, on every thread)
+  size_thread_buffers();
 
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     // A chunk's first build goes to its thread's scratch, then into a buffer allocated once, at
@@ -355,11 +353,8 @@ void ListBuilder<D, R>::rebuild_some_with(const UniformGrid<D, R>& grid, std::si
     const std::size_t last = std::min(old_n, (c + 1) * kChunkSize) - 1;
     largest_old = std::max<std::size_t>(largest_old, lists.begin(last) + lists.capacity(last));
   }
-  old_copy_.resize(static_cast<std::size_t>(num_threads()));
+  size_thread_buffers();
   for (auto& copy : old_copy_) ensure_room(copy, largest_old);
-  far_.resize(old_copy_.size());
-  spill_.resize(old_copy_.size());
-  for (auto& spill : spill_) ensure_room(spill, 4096);  // (grown once, on every thread)
 
   if (room_ && lists.has_room()) {
     rebuild_in_place(grid, n, query, radius, rebuild, lists, visitor);

@@ -94,6 +94,8 @@ class ListBuilder {
   void rebuild_in_place(const UniformGrid<D, R>& grid, std::size_t n, const Query& query, R radius,
                         std::span<const std::uint8_t> rebuild, NeighborLists& lists, RebuildVisitor* visitor);
 
+  /// One merge, far and spill buffer per thread (the spill buffers with room for 4,096 entries).
+  void size_thread_buffers();
   /// The calling thread's buffer for the entries beyond the inner radius (room for `candidates`),
   /// or null when lists are not split.
   std::uint32_t* far_room(std::size_t candidates);

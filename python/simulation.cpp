@@ -403,6 +403,12 @@ after the current step with KeyboardInterrupt; the simulation stays usable.)doc"
           "time", [](const PySimulation& s) { return s.visit([](const auto& d) { return d.simulation().time(); }); },
           "Simulated time, s.")
       .def_property_readonly(
+          "particle_mass",
+          [](const PySimulation& s) {
+            return s.visit([](const auto& d) { return static_cast<double>(d.simulation().particles().mass); });
+          },
+          "Every particle's mass, kg (kg/m in 2D): one for all, the scene's Fluid.particleMass or the lattice's.")
+      .def_property_readonly(
           "steps",
           [](const PySimulation& s) { return s.visit([](const auto& d) { return d.simulation().steps_done(); }); },
           "Steps done.")

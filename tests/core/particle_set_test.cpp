@@ -11,7 +11,7 @@ namespace {
 
 TEST(ParticleSet, IdsAreStableThroughPermutation) {
   ParticleSet<3, float> ps;
-  for (int i = 0; i < 5; ++i) ps.add({{float(i), 0, 0}}, {{0, float(i), 0}}, 1.0f + i);
+  for (int i = 0; i < 5; ++i) ps.add({{float(i), 0, 0}}, {{0, float(i), 0}}), ps.density[i] = 1.0f + i;
   EXPECT_EQ(ps.next_id(), 5u);
   const std::vector<std::uint32_t> perm{4, 2, 0, 3, 1};
   ps.permute(perm);
@@ -21,14 +21,14 @@ TEST(ParticleSet, IdsAreStableThroughPermutation) {
     EXPECT_EQ(ps.position[k][0], float(id));
     EXPECT_EQ(ps.velocity[k][1], float(id));
     EXPECT_EQ(ps.initial_position[k][0], float(id));
-    EXPECT_EQ(ps.mass[k], 1.0f + id);
+    EXPECT_EQ(ps.density[k], 1.0f + id);
   }
-  EXPECT_EQ(ps.add({}, {}, 1.0f), 5u);
+  EXPECT_EQ(ps.add({}, {}), 5u);
 }
 
 TEST(ParticleSet, PermutationOfWrongSizeIsABug) {
   ParticleSet<2, double> ps;
-  ps.add({}, {}, 1.0);
+  ps.add({}, {});
   const std::vector<std::uint32_t> perm{0, 1};
   EXPECT_THROW(ps.permute(perm), std::logic_error);
 }
@@ -44,7 +44,7 @@ namespace {
 template <int D, class R>
 void check_field_visit() {
   ParticleSet<D, R> ps;
-  ps.add({}, {}, R(1));
+  ps.add({}, {});
   std::size_t k = 0;
   ps.for_each_field([&](const FieldDesc& f, const auto& column) {
     using T = typename std::decay_t<decltype(column)>::value_type;

@@ -18,8 +18,9 @@ int main() {
   p.gravity = {0.0, -9.81};
   p.container = {{0.0, 0.0}, {0.5, 0.5}};
   sph::ParticleSet<2, double> particles;
+  particles.mass = p.particle_mass;
   for (int i = 0; i < 10; ++i)
-    for (int j = 0; j < 10; ++j) particles.add({0.05 + 0.02 * i, 0.05 + 0.02 * j}, {0.0, 0.0}, p.particle_mass);
+    for (int j = 0; j < 10; ++j) particles.add({0.05 + 0.02 * i, 0.05 + 0.02 * j}, {0.0, 0.0});
   for (const std::string& w : sph::check_time_step(p)) std::printf("warning: %s\n", w.c_str());
   sph::Simulation<2, double> sim(p, std::move(particles));
   for (int s = 0; s < 50; ++s) sim.step();

@@ -53,10 +53,11 @@ void expect_values_follow_ids(const ParticleSet<D, R>& ps) {
 
 TEST(AddedField, ZeroForParticlesPresentAndAddedLater) {
   ParticleSet<3, double> ps;
-  ps.add({}, {}, 1.0);
+  ps.mass = 1.0;
+  ps.add({}, {});
   const std::size_t t = ps.add_field(kTemperature);
   ps.real_field(t)[0] = 5;
-  ps.add({}, {}, 1.0);
+  ps.add({}, {});
   ps.reserve(10);
   ASSERT_EQ(ps.real_field(t).size(), 2u);
   EXPECT_EQ(ps.real_field(t)[0], 5.0);

@@ -451,7 +451,7 @@ TEST(RunDirectory, DefaultMassAndTheMissingCases) {
   EXPECT_EQ(run.format, FrameFormat::Vtu);
   const SceneDesc desc = read_scene_file(kDamBreak);
   const Simulation<2, double> sim = make_simulation<2, double>(desc);
-  EXPECT_EQ(run.particle_mass, sim.particles().mass[0]);
+  EXPECT_EQ(run.particle_mass, sim.particles().mass);
   EXPECT_GT(run.particle_mass, 0);
   const auto refused = [](const fs::path& d, const std::string& what) {
     try {

@@ -53,8 +53,9 @@ ParticleSet<3, R> random_particles(std::size_t n, double lo, double hi, unsigned
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(lo, hi);
   ParticleSet<3, R> ps;
+  ps.mass = R(1);
   for (std::size_t i = 0; i < n; ++i)
-    ps.add(Vec<3, R>{{static_cast<R>(u(rng)), static_cast<R>(u(rng)), static_cast<R>(u(rng))}}, Vec<3, R>{}, R(1));
+    ps.add(Vec<3, R>{{static_cast<R>(u(rng)), static_cast<R>(u(rng)), static_cast<R>(u(rng))}}, Vec<3, R>{});
   return ps;
 }
 

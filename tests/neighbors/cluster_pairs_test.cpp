@@ -164,7 +164,8 @@ TEST(VerletClusters, NeverMissesAPairWithinHAndKeepsVerletsListsForWhoAsks) {
   const double h = 0.1, skin = 0.02;
   auto x = random_points<3, double>(2000, 1.0, 13);
   ParticleSet<3, double> ps;
-  for (const auto& p : x) ps.add(p, {}, 1.0);
+  ps.mass = 1.0;
+  for (const auto& p : x) ps.add(p, {});
   VerletNeighbors<3, double> clusters(h, skin, true), verlet(h, skin);
   EXPECT_EQ(clusters.mode(), NeighborMode::VerletClusters);
   ASSERT_NE(clusters.cluster_pairs(), nullptr);
@@ -209,7 +210,8 @@ TEST(VerletClusters, TheAuditSeesAPairTheClustersMiss) {
 TEST(VerletClusters, LoadingItsStateRebuildsTheSameClusters) {
   auto x = random_points<2, float>(1500, 1.0, 16);
   ParticleSet<2, float> ps;
-  for (const auto& p : x) ps.add(p, {}, 1.0f);
+  ps.mass = 1.0f;
+  for (const auto& p : x) ps.add(p, {});
   NeighborOptions opt;
   opt.radius = 0.04;
   auto a = make_neighbor_strategy<2, float>(NeighborMode::VerletClusters, opt);

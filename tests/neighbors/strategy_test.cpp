@@ -30,7 +30,8 @@ ParticleSet<3, double> random_particles(std::size_t n, double extent, unsigned s
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0, extent);
   ParticleSet<3, double> ps;
-  for (std::size_t i = 0; i < n; ++i) ps.add(V3{u(rng), u(rng), u(rng)}, V3{}, 1.0);
+  ps.mass = 1.0;
+  for (std::size_t i = 0; i < n; ++i) ps.add(V3{u(rng), u(rng), u(rng)}, V3{});
   return ps;
 }
 
@@ -93,7 +94,7 @@ TEST(Adaptive, AppendedParticlesGetListsAndFullRebuildComesOnSchedule) {
   auto ps = random_particles(500, 0.5, 4);
   AdaptiveNeighbors<3, double> a(kH, 3);
   a.update(ps);  // update 0: full
-  for (int k = 0; k < 20; ++k) ps.add(V3{0.25 + 0.001 * k, 0.25, 0.25}, V3{}, 1.0);
+  for (int k = 0; k < 20; ++k) ps.add(V3{0.25 + 0.001 * k, 0.25, 0.25}, V3{});
   a.update(ps);  // update 1: only the 20 new particles
   EXPECT_EQ(a.counters().lists_rebuilt, 20u);
   ASSERT_EQ(a.lists().particle_count(), ps.size());
@@ -167,7 +168,7 @@ TEST(Verlet, RebuildsWhenParticlesAreAdded) {
   v.update(ps);
   v.update(ps);
   EXPECT_EQ(v.counters().lists_rebuilt, 0u);
-  ps.add(V3{0.25, 0.25, 0.25}, V3{}, 1.0);
+  ps.add(V3{0.25, 0.25, 0.25}, V3{});
   v.update(ps);
   EXPECT_EQ(v.counters().lists_rebuilt, ps.size());
   EXPECT_EQ(v.lists().particle_count(), ps.size());
@@ -175,10 +176,11 @@ TEST(Verlet, RebuildsWhenParticlesAreAdded) {
 
 TEST(Audit, CountsMissedPairsAndTheirPenetration) {
   ParticleSet<3, double> ps;
-  ps.add(V3{0, 0, 0}, V3{}, 1.0);
-  ps.add(V3{0.03, 0, 0}, V3{}, 1.0);  // 0.3 h from particle 0
-  ps.add(V3{0, 0.08, 0}, V3{}, 1.0);  // 0.8 h from particle 0
-  ps.add(V3{1, 1, 1}, V3{}, 1.0);     // alone
+  ps.mass = 1.0;
+  ps.add(V3{0, 0, 0}, V3{});
+  ps.add(V3{0.03, 0, 0}, V3{});  // 0.3 h from particle 0
+  ps.add(V3{0, 0.08, 0}, V3{});  // 0.8 h from particle 0
+  ps.add(V3{1, 1, 1}, V3{});     // alone
   ListAuditor<3, double> auditor;
   const NeighborLists exact = brute_force_lists<3, double>(ps.position, kH);
   EXPECT_EQ(auditor.audit(ps.position, exact, kH).missed_pairs, 0u);
@@ -196,8 +198,9 @@ TEST(Audit, FindsWhatAdaptiveListsMissWhenParticlesApproach) {
   // Two particles out of range, approaching: no listed pair leaves, so nothing is flagged and
   // the adaptive lists keep missing the pair until the full rebuild.
   ParticleSet<3, double> ps;
-  ps.add(V3{0, 0, 0}, V3{}, 1.0);
-  ps.add(V3{0.15, 0, 0}, V3{}, 1.0);
+  ps.mass = 1.0;
+  ps.add(V3{0, 0, 0}, V3{});
+  ps.add(V3{0.15, 0, 0}, V3{});
   AdaptiveNeighbors<3, double> a(kH, 200);
   ListAuditor<3, double> auditor;
   a.update(ps);

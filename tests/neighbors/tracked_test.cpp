@@ -32,10 +32,11 @@ ParticleSet<D, double> random_particles(std::size_t n, double extent, unsigned s
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0, extent);
   ParticleSet<D, double> ps;
+  ps.mass = 1.0;
   for (std::size_t i = 0; i < n; ++i) {
     Vec<D, double> x;
     for (int d = 0; d < D; ++d) x[d] = u(rng);
-    ps.add(x, Vec<D, double>{}, 1.0);
+    ps.add(x, Vec<D, double>{});
   }
   return ps;
 }
@@ -112,12 +113,13 @@ TEST(Tracked, RebuildsOnlyTheParticlesThatMovedAThirdOfTheSkin) {
 // (so that each is rebuilt every other step), through a resting lattice.
 TEST(Tracked, TwoParticlesApproachingHeadOnAreNeverMissed) {
   ParticleSet<3, double> ps;
+  ps.mass = 1.0;
   for (int a = 0; a < 12; ++a)
     for (int b = 0; b < 12; ++b)
-      for (int c = 0; c < 12; ++c) ps.add(V3{0.05 * a, 0.05 * b, 0.05 * c} + V3::filled(0.0123), V3{}, 1.0);
+      for (int c = 0; c < 12; ++c) ps.add(V3{0.05 * a, 0.05 * b, 0.05 * c} + V3::filled(0.0123), V3{});
   const std::size_t p = ps.size(), q = p + 1;
-  ps.add(V3{0.03, 0.301, 0.302}, V3{}, 1.0);
-  ps.add(V3{0.58, 0.302, 0.301}, V3{}, 1.0);
+  ps.add(V3{0.03, 0.301, 0.302}, V3{});
+  ps.add(V3{0.58, 0.302, 0.301}, V3{});
   TrackedNeighbors<3, double> t(kH, kSkin, 1000, 1e-3, false);
   t.update(ps);
   const double step = 0.999 * t.trigger();
@@ -139,7 +141,7 @@ TEST(Tracked, TwoParticlesApproachingHeadOnAreNeverMissed) {
 TEST(Tracked, AParticleCrossingAClusterAndRandomJumpsAreNeverMissed) {
   auto ps = random_particles<3>(1500, 0.5, 3);
   const std::size_t fast = ps.size();
-  ps.add(V3{-0.1, 0.25, 0.25}, V3{}, 1.0);
+  ps.add(V3{-0.1, 0.25, 0.25}, V3{});
   TrackedNeighbors<3, double> t(kH, kSkin, 1000, 1e-3, false);
   t.update(ps);
   std::mt19937 rng(4);
@@ -164,13 +166,14 @@ TEST(Tracked, AParticleCrossingAClusterAndRandomJumpsAreNeverMissed) {
 // them by insertion, and no pair is missed (2D).
 TEST(Tracked, EmissionNextToARestingPoolInsertsTheNewParticles) {
   ParticleSet<2, double> ps;
+  ps.mass = 1.0;
   for (int a = 0; a < 40; ++a)
-    for (int b = 0; b < 20; ++b) ps.add(V2{0.025 * a, 0.025 * b}, V2{}, 1.0);
+    for (int b = 0; b < 20; ++b) ps.add(V2{0.025 * a, 0.025 * b}, V2{});
   TrackedNeighbors<2, double> t(kH, kSkin, 1000, 1e-3, false);
   t.update(ps);
   for (int s = 0; s < 5; ++s) {
     const std::size_t before = ps.size();
-    for (int a = 0; a < 10; ++a) ps.add(V2{0.3 + 0.025 * a, 0.5 + 0.025 * s}, V2{}, 1.0);
+    for (int a = 0; a < 10; ++a) ps.add(V2{0.3 + 0.025 * a, 0.5 + 0.025 * s}, V2{});
     t.update(ps);
     EXPECT_EQ(t.counters().lists_rebuilt, ps.size() - before);
     EXPECT_GT(t.counters().insertions, 0u);
@@ -182,9 +185,9 @@ TEST(Tracked, EmissionNextToARestingPoolInsertsTheNewParticles) {
 // out again, and the lists stay exact.
 TEST(Tracked, AListThatOutgrowsItsRoomIsLaidOutAgain) {
   ParticleSet<2, double> ps;
-  ps.add(V2{0.5, 0.5}, V2{}, 1.0);
-  for (int k = 0; k < 60; ++k)
-    ps.add(V2{0.5 + 0.3 * std::cos(k * 0.1047), 0.5 + 0.3 * std::sin(k * 0.1047)}, V2{}, 1.0);
+  ps.mass = 1.0;
+  ps.add(V2{0.5, 0.5}, V2{});
+  for (int k = 0; k < 60; ++k) ps.add(V2{0.5 + 0.3 * std::cos(k * 0.1047), 0.5 + 0.3 * std::sin(k * 0.1047)}, V2{});
   TrackedNeighbors<2, double> t(kH, kSkin, 1000, 1e-3, false);
   t.update(ps);
   ASSERT_EQ(t.lists().of(0).size(), 0u);
@@ -207,7 +210,7 @@ std::vector<NeighborCounters> run_sequence(TrackedNeighbors<3, double>& t, Parti
     std::uniform_real_distribution<double> u(-1, 1);
     for (auto& x : ps.position) x += V3{u(rng), u(rng), u(rng)} * (0.25 * t.trigger());
     if (s % 7 == 3)
-      for (int k = 0; k < 30; ++k) ps.add(V3{0.4 + 0.01 * k, 0.5, 0.5}, V3{}, 1.0);
+      for (int k = 0; k < 30; ++k) ps.add(V3{0.4 + 0.01 * k, 0.5, 0.5}, V3{});
     if (!t.pair_exit_flags().empty())
       for (std::size_t i = static_cast<std::size_t>(s); i < t.pair_exit_flags().size(); i += 97)
         t.pair_exit_flags()[i] = 1;  // the solver's Eq. 7 flags, of the particles the last update saw
@@ -292,10 +295,11 @@ void flow_step(TrackedNeighbors<3, double>& t, ParticleSet<3, double>& ps, const
 
 TEST(TrackedPaths, ABlockMovingAsOneIsRebuiltOnlyWhenItsPathsRunOut) {
   ParticleSet<3, double> ps;
+  ps.mass = 1.0;
   const V3 v{3, -2, 1};  // 3.7 mm per step: the displacement rule would rebuild every other step
   for (int a = 0; a < 10; ++a)
     for (int b = 0; b < 10; ++b)
-      for (int c = 0; c < 10; ++c) ps.add(V3{0.04 * a, 0.04 * b, 0.04 * c}, v, 1.0);
+      for (int c = 0; c < 10; ++c) ps.add(V3{0.04 * a, 0.04 * b, 0.04 * c}, v);
   TrackedNeighbors<3, double> t(kH, kSkin, 1000, 1e-3, false);
   double time = 0;
   t.set_time(time);
@@ -322,12 +326,13 @@ TEST(TrackedPaths, ABlockMovingAsOneIsRebuiltOnlyWhenItsPathsRunOut) {
 // exactly (never off them), so only the path test can list them before they meet.
 TEST(TrackedPaths, FastParticlesClosingHeadOnAreNeverMissed) {
   ParticleSet<3, double> ps;
+  ps.mass = 1.0;
   for (int a = 0; a < 12; ++a)
     for (int b = 0; b < 12; ++b)
-      for (int c = 0; c < 12; ++c) ps.add(V3{0.05 * a, 0.05 * b, 0.05 * c} + V3::filled(0.0123), V3{}, 1.0);
+      for (int c = 0; c < 12; ++c) ps.add(V3{0.05 * a, 0.05 * b, 0.05 * c} + V3::filled(0.0123), V3{});
   const std::size_t p = ps.size(), q = p + 1;
-  ps.add(V3{0.03, 0.301, 0.302}, V3{6, 0, 0}, 1.0);
-  ps.add(V3{0.58, 0.302, 0.301}, V3{-6, 0, 0}, 1.0);
+  ps.add(V3{0.03, 0.301, 0.302}, V3{6, 0, 0});
+  ps.add(V3{0.58, 0.302, 0.301}, V3{-6, 0, 0});
   TrackedNeighbors<3, double> t(kH, kSkin, 1000, 1e-3, false);
   double time = 0;
   t.set_time(time);
@@ -352,7 +357,7 @@ std::vector<NeighborCounters> random_flow(TrackedNeighbors<3, double>& t, Partic
     std::mt19937 rng(300 + static_cast<unsigned>(s));
     std::uniform_real_distribution<double> u(-1, 1);
     if (s % 9 == 4)
-      for (int k = 0; k < 20; ++k) ps.add(V3{0.3 + 0.012 * k, 0.2, 0.25}, V3{0, 2, 0}, 1.0);
+      for (int k = 0; k < 20; ++k) ps.add(V3{0.3 + 0.012 * k, 0.2, 0.25}, V3{0, 2, 0});
     std::vector<V3> a(ps.size());
     for (auto& ai : a) ai = V3{u(rng), u(rng), u(rng)} * 115.0;
     if (!t.pair_exit_flags().empty())

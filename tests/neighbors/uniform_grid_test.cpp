@@ -36,7 +36,8 @@ class GridLists : public ::testing::Test {
 
   void expect_equal_to_brute_force(const std::vector<V>& x, R radius) {
     ParticleSet<D, R> ps;
-    for (const V& p : x) ps.add(p, V{}, R(1));
+    ps.mass = R(1);
+    for (const V& p : x) ps.add(p, V{});
     StandardNeighbors<D, R> grid(radius);
     grid.update(ps);
     const NeighborLists bf = brute_force_lists<D, R>(ps.position, radius);
@@ -123,7 +124,8 @@ TYPED_TEST(GridLists, SameListsForAnyThreadCount) {
   using R = typename TestFixture::R;
   constexpr int D = TestFixture::D;
   ParticleSet<D, R> ps;
-  for (const auto& p : this->random_points(5000, 0, 1, 7)) ps.add(p, {}, R(1));
+  ps.mass = R(1);
+  for (const auto& p : this->random_points(5000, 0, 1, 7)) ps.add(p, {});
   set_num_threads(1);
   StandardNeighbors<D, R> one(R(0.05));
   one.update(ps);

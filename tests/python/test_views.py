@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 import sph
+from conftest import DAM_BREAK, SMALL_2D
 
 
 def test_views_are_read_only_and_share_the_simulation_memory(small_2d):
@@ -26,13 +27,25 @@ def test_every_field_of_the_table_is_a_property(small_2d):
     sim = sph.Simulation(small_2d)
     assert sim.field_names == list(sph.FIELDS)
     plural = {"position": "positions", "velocity": "velocities", "density": "densities", "pressure": "pressures",
-              "id": "ids", "initial_position": "initial_positions", "acceleration": "accelerations",
-              "mass": "masses"}
+              "id": "ids", "initial_position": "initial_positions", "acceleration": "accelerations"}
     assert set(plural) == set(sph.FIELDS)
     for name in sph.FIELDS:
         assert np.array_equal(getattr(sim, plural[name]), sim.field(name))
     with pytest.raises(KeyError, match="no particle field"):
         sim.field("temperature")
+
+
+def test_the_particles_have_the_scenes_one_mass(small_2d):
+    sim = sph.Simulation(small_2d)
+    sim.step(1)
+    # The lattice mass (the default) gives density0 in the block's interior; a 4 % heavier
+    # Fluid.particleMass is every particle's, and its densities are 4 % higher, to rounding.
+    assert isinstance(sim.particle_mass, float) and sim.particle_mass > 0
+    heavier = sph.Simulation(
+        sph.load_scene(DAM_BREAK, overrides={**SMALL_2D, "Fluid.particleMass": 1.04 * sim.particle_mass}))
+    assert heavier.particle_mass == pytest.approx(1.04 * sim.particle_mass, rel=1e-15)
+    heavier.step(1)
+    assert np.allclose(heavier.densities[: len(sim)], 1.04 * sim.densities, rtol=1e-3)
 
 
 def test_a_view_taken_before_a_step_keeps_its_values_and_a_new_one_shows_the_step(small_2d):

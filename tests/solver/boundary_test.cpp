@@ -123,13 +123,14 @@ SimulationParams<D> filled_box_params(int n, KernelKind kernel, double spacings 
 template <int D>
 ParticleSet<D, double> lattice_fill(const SimulationParams<D>& p, int n) {
   ParticleSet<D, double> ps;
+  ps.mass = p.particle_mass;
   const double dx = 2 * p.particle_radius;
   const int total = D == 2 ? n * n : n * n * n;
   for (int k = 0; k < total; ++k) {
     Vec<D, double> x;
     int rest = k;
     for (int d = 0; d < D; ++d) x[d] = (rest % n + 0.5) * dx, rest /= n;
-    ps.add(x, Vec<D, double>{}, p.particle_mass);
+    ps.add(x, Vec<D, double>{});
   }
   return ps;
 }
@@ -218,8 +219,9 @@ SimulationParams<2> dam_params(NeighborMode mode) {
 
 ParticleSet<2, double> dam_column(const SimulationParams<2>& p) {
   ParticleSet<2, double> ps;
+  ps.mass = p.particle_mass;
   for (int j = 0; j < 20; ++j)
-    for (int i = 0; i < 10; ++i) ps.add(V2{0.005 + 0.01 * i, 0.005 + 0.01 * j}, V2{}, p.particle_mass);
+    for (int i = 0; i < 10; ++i) ps.add(V2{0.005 + 0.01 * i, 0.005 + 0.01 * j}, V2{});
   return ps;
 }
 
@@ -279,8 +281,9 @@ TEST(BoundaryForces, TheExitTestFlagsAParticleForItsBoundaryPairs) {
   // listed sample grows past h only if it moves away, so a particle moving up fast is flagged.
   SimulationParams<2> p = filled_box_params<2>(10, KernelKind::Paper);
   ParticleSet<2, double> ps;
-  ps.add(V2{0.05, 0.005}, V2{0, 150}, p.particle_mass);  // 150 m/s * 1e-4 s = 1.5 cm > h - 0.5 cm
-  ps.add(V2{0.05, 0.05}, V2{}, p.particle_mass);
+  ps.mass = p.particle_mass;
+  ps.add(V2{0.05, 0.005}, V2{0, 150});  // 150 m/s * 1e-4 s = 1.5 cm > h - 0.5 cm
+  ps.add(V2{0.05, 0.05}, V2{});
   const BoundarySet<2, double> b = make_boundary<2, double>(p);
   StandardNeighbors<2, double> s(p.kernel_radius);
   s.set_boundary(b.position);
@@ -308,7 +311,7 @@ struct FloorParticle {
   FloorParticle(KernelKind kernel, PressureForce form)
       : p(filled_box_params<2>(10, kernel)), b(make_boundary<2, double>(p)), s(p.kernel_radius) {
     p.fluid.pressure_force = form;
-    ps.add(V2{0.05, 0.006}, V2{}, p.particle_mass);
+    ps.add(V2{0.05, 0.006}, V2{});
     s.set_boundary(b.position);
     s.update(ps);
     view = BoundaryView<2, double>{b.position, b.psi, &s.boundary_lists(), 0};
@@ -398,12 +401,13 @@ void check_dfsph_samples(BoundaryPressure pressure) {
   const double dx = 2 * p.particle_radius;
   const int n = D == 2 ? 8 : 5;
   ParticleSet<D, double> ps;
+  ps.mass = p.particle_mass;
   const int total = D == 2 ? n * n : n * n * n;
   for (int k = 0; k < total; ++k) {
     Vec<D, double> x;
     int rest = k;
     for (int d = 0; d < D; ++d) x[d] = (d == 1 ? 0.5 + 1.3 * (rest % n) : 1.3 + 1.3 * (rest % n)) * dx, rest /= n;
-    ps.add(x, Vec<D, double>{}, p.particle_mass);
+    ps.add(x, Vec<D, double>{});
   }
   const BoundarySet<D, double> b = make_boundary<D, double>(p);
   StandardNeighbors<D, double> s(p.kernel_radius);
@@ -428,8 +432,8 @@ void check_dfsph_samples(BoundaryPressure pressure) {
     for (const std::uint32_t j : s.lists().of(i)) {
       const Vec<D, double> xij = ps.position[i] - ps.position[j];
       if (norm2(xij) >= h2) continue;
-      sum += kernels.gradient(xij) * ps.mass[j];
-      squares += ps.mass[j] * norm2(kernels.gradient(xij));
+      sum += kernels.gradient(xij) * ps.mass;
+      squares += ps.mass * norm2(kernels.gradient(xij));
     }
     for (const std::uint32_t k : s.boundary_lists().of(i)) {
       const Vec<D, double> xib = ps.position[i] - b.position[k];
@@ -438,7 +442,7 @@ void check_dfsph_samples(BoundaryPressure pressure) {
       const double e = std::max(dot(g, b.position[k] - ps.position[i]) / ps.density[i], 0.0);
       head[i] -= kernels.gradient(xib) * (b.psi[k] * e);
     }
-    const double beta = norm2(sum + solid * w) + ps.mass[i] * squares;
+    const double beta = norm2(sum + solid * w) + ps.mass * squares;
     if (norm2(solid) > 0) {
       ++near_floor;
       EXPECT_NEAR(solver.factors()[i], beta, 1e-12 * beta) << D << "D, particle " << i;
@@ -484,6 +488,7 @@ std::pair<double, double> dfsph_body_compression(BoundaryPressure pressure, bool
   p.obstacles = {body_box};
   // The pool: a lattice from the floor to the box, wall to wall.
   ParticleSet<D, double> ps;
+  ps.mass = p.particle_mass;
   const int across = 14, up = 6;
   const int total = D == 2 ? across * up : across * up * across;
   for (int k = 0; k < total; ++k) {
@@ -496,7 +501,7 @@ std::pair<double, double> dfsph_body_compression(BoundaryPressure pressure, bool
     }
     Vec<D, double> v{};
     v[1] = 0.05;
-    ps.add(x, v, p.particle_mass);
+    ps.add(x, v);
   }
   Vec<D, double> g{};
   g[1] = -9.81;
@@ -550,10 +555,10 @@ std::pair<double, double> dfsph_body_compression(BoundaryPressure pressure, bool
   Vec<3, double> angular_impulse{};
   double divergence_share = 0;
   for (std::size_t i = 0; i < ps.size(); ++i) {
-    const Vec<D, double> f = (reaction[i] * dt + change[i]) * (-ps.mass[i]);
+    const Vec<D, double> f = (reaction[i] * dt + change[i]) * (-ps.mass);
     impulse += f;
     add_moment<D>(angular_impulse, ps.position[i], mp.center, f);
-    divergence_share += ps.mass[i] * std::sqrt(norm2(change[i]));
+    divergence_share += ps.mass * std::sqrt(norm2(change[i]));
   }
   EXPECT_GT(divergence_share, 1e-3 * mp.mass);  // (kg m/s: the divergence solve pushed the box)
   const Vec<D, double> body_v = impulse * (1 / mp.mass);
@@ -582,7 +587,7 @@ std::pair<double, double> dfsph_body_compression(BoundaryPressure pressure, bool
     for (const std::uint32_t j : s.lists().of(i)) {
       const Vec<D, double> xij = ps.position[i] - ps.position[j];
       if (norm2(xij) >= h2) continue;
-      rate += ps.mass[j] * dot(vi - ps.velocity[j] - ps.acceleration[j] * dt, kernels.gradient(xij));
+      rate += ps.mass * dot(vi - ps.velocity[j] - ps.acceleration[j] * dt, kernels.gradient(xij));
     }
     for (const std::uint32_t k : s.boundary_lists().of(i)) {
       const Vec<D, double> xib = ps.position[i] - b.position[k];
@@ -625,8 +630,9 @@ TEST(ArtificialViscosity, ActsOnApproachingPairsOnlyEqualAndOpposite) {
   const double h = 0.02;
   for (double v : {1.0, -1.0}) {  // approaching, receding
     ParticleSet<2, double> ps;
-    ps.add(V2{0, 0}, V2{v, 0}, 0.1);
-    ps.add(V2{0.01, 0.002}, V2{-v, 0}, 0.1);
+    ps.mass = 0.1;
+    ps.add(V2{0, 0}, V2{v, 0});
+    ps.add(V2{0.01, 0.002}, V2{-v, 0});
     const NeighborLists lists = NeighborLists::from({{1}, {0}});
     compute_density_pressure<2, double>(ps, lists, h, fluid);
     ps.pressure.assign(2, 0.0);  // viscosity alone

@@ -31,16 +31,17 @@ struct Blob {
 
   explicit Blob(int side, unsigned seed) {
     std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> jit(-0.2 * dx, 0.2 * dx), vel(-1, 1), mass(0.9, 1.1);
+    std::uniform_real_distribution<double> jit(-0.2 * dx, 0.2 * dx), vel(-1, 1);
     const int nz = D == 3 ? side : 1;
     const double m = 1000 * std::pow(dx, D);
+    ps.mass = static_cast<R>(m);
     for (int k = 0; k < nz; ++k)
       for (int j = 0; j < side; ++j)
         for (int i = 0; i < side; ++i) {
           Vec<D, R> x, v;
           const int c[3] = {i, j, k};
           for (int d = 0; d < D; ++d) x[d] = static_cast<R>(c[d] * dx + jit(rng)), v[d] = static_cast<R>(vel(rng));
-          ps.add(x, v, static_cast<R>(m * mass(rng)));
+          ps.add(x, v);
         }
     // Samples on the plane below the block (last axis at -dx), spacing dx / 2.
     const int ns = 2 * side;

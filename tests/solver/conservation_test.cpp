@@ -41,6 +41,7 @@ ParticleSet<D, R> blob(const SimulationParams<D>& p, int n, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> jitter(-0.2, 0.2), vel(-0.5, 0.5);
   ParticleSet<D, R> ps;
+  ps.mass = static_cast<R>(p.particle_mass);
   const double dx = 2 * p.particle_radius;
   const int nz = D == 3 ? n : 1;
   for (int k = 0; k < nz; ++k)
@@ -52,7 +53,7 @@ ParticleSet<D, R> blob(const SimulationParams<D>& p, int n, unsigned seed) {
           x[d] = static_cast<R>((idx[d] + jitter(rng)) * dx);
           v[d] = static_cast<R>(vel(rng));
         }
-        ps.add(x, v, static_cast<R>(p.particle_mass));
+        ps.add(x, v);
       }
   return ps;
 }
@@ -75,7 +76,7 @@ void check_momentum_conserved(int n, int steps, double tol, NeighborMode mode = 
   const Vec<D, double> p0 = sim.momentum();
   double scale = 0;  // sum of |m v|: the size of the round-off to expect
   for (std::size_t i = 0; i < sim.particles().size(); ++i)
-    scale += sim.particles().mass[i] * norm(vec_cast<double>(sim.particles().velocity[i]));
+    scale += sim.particles().mass * norm(vec_cast<double>(sim.particles().velocity[i]));
   for (int s = 0; s < steps; ++s) sim.step();
   const Vec<D, double> p1 = sim.momentum();
   EXPECT_GT(sim.kinetic_energy(), 0.0);
@@ -141,8 +142,8 @@ double inviscid_energy_change(PressureForce form, int n, int steps, double dt) {
     double e = 0;
     for (std::size_t i = 0; i < P.size(); ++i) {
       double rho = 0;
-      for (std::size_t j = 0; j < P.size(); ++j) rho += P.mass[j] * poly6.w_r2(norm2(P.position[i] - P.position[j]));
-      e += P.mass[i] * (0.5 * norm2(P.velocity[i]) + k * (std::log(rho / rho0) + rho0 / rho - 1));
+      for (std::size_t j = 0; j < P.size(); ++j) rho += P.mass * poly6.w_r2(norm2(P.position[i] - P.position[j]));
+      e += P.mass * (0.5 * norm2(P.velocity[i]) + k * (std::log(rho / rho0) + rho0 / rho - 1));
     }
     return e;
   };
@@ -193,6 +194,7 @@ double settled_pressure_ratio(PressureForce form, int columns, int layers,
   p.container.hi = Vec<D, double>::filled(columns * dx);
   p.container.hi[1] = 2 * layers * dx;
   ParticleSet<D, double> ps;
+  ps.mass = p.particle_mass;
   const int nz = D == 3 ? columns : 1;
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < layers; ++j)
@@ -201,7 +203,7 @@ double settled_pressure_ratio(PressureForce form, int columns, int layers,
         x[0] = (i + 0.5) * dx;
         x[1] = (j + 0.5) * dx;
         if constexpr (D == 3) x[2] = (k + 0.5) * dx;
-        ps.add(x, {}, p.particle_mass);
+        ps.add(x, {});
       }
   Simulation<D, double> sim(p, std::move(ps));
   EXPECT_TRUE(check_time_step<D>(p).empty());
@@ -327,7 +329,8 @@ TEST(Simulation, BlowUpIsReportedWithStepAndParticle) {
   p.container.lo = Vec<2, double>::filled(0);
   p.container.hi = Vec<2, double>::filled(1);
   ParticleSet<2, double> ps;
-  ps.add({{0.5, 0.5}}, {{1e9, 0}}, p.particle_mass);  // far beyond any physical speed
+  ps.mass = p.particle_mass;
+  ps.add({{0.5, 0.5}}, {{1e9, 0}});  // far beyond any physical speed
   Simulation<2, double> sim(p, std::move(ps));
   try {
     sim.step();
@@ -345,8 +348,9 @@ TEST(Simulation, NonFiniteValuesAreReportedInTheStepTheyAppear) {
   p.container.lo = Vec<2, double>::filled(0);
   p.container.hi = Vec<2, double>::filled(1);
   ParticleSet<2, double> ps;
-  ps.add({{0.5, 0.5}}, {}, p.particle_mass);
-  ps.add({{0.2, 0.2}}, {}, p.particle_mass);
+  ps.mass = p.particle_mass;
+  ps.add({{0.5, 0.5}}, {});
+  ps.add({{0.2, 0.2}}, {});
   Simulation<2, double> sim(p, std::move(ps));
   for (int s = 0; s < 3; ++s) sim.step();
   // A NaN appearing in particle id 1's velocity (as an overflow would leave it). Its index is
@@ -391,8 +395,9 @@ TEST(Walls, ObstacleHoldsAFallingParticleAndNeverPulls) {
   p.container.hi = Vec<2, double>::filled(1);
   p.obstacles.push_back({{{0.4, 0.2}}, {{0.6, 0.3}}});
   ParticleSet<2, double> ps;
-  ps.add({{0.5, 0.6}}, {}, p.particle_mass);   // falls onto the obstacle's top face
-  ps.add({{0.05, 0.6}}, {}, p.particle_mass);  // falls beside it, onto the container floor
+  ps.mass = p.particle_mass;
+  ps.add({{0.5, 0.6}}, {});   // falls onto the obstacle's top face
+  ps.add({{0.05, 0.6}}, {});  // falls beside it, onto the container floor
   Simulation<2, double> sim(p, std::move(ps));
   for (int s = 0; s < 10000; ++s) sim.step();  // 2 s: both come to rest
   const auto& P = sim.particles();
@@ -411,7 +416,8 @@ TEST(Walls, ContactForceIsNeverAttractive) {
   p.container.hi = Vec<2, double>::filled(1);
   p.walls.damping = 1e4;  // strong damping: a plain damped spring would pull a leaving particle back
   ParticleSet<2, double> ps;
-  ps.add({{0.5, 0.005}}, {{0, 3.0}}, p.particle_mass);  // inside the contact zone, moving away
+  ps.mass = p.particle_mass;
+  ps.add({{0.5, 0.005}}, {{0, 3.0}});  // inside the contact zone, moving away
   const WallContact<2, double> contact(p.container, p.obstacles, 0.01, p.walls);
   EXPECT_GE(contact(ps.position[0], ps.velocity[0])[1], 0.0);
 }

@@ -49,6 +49,7 @@ ParticleSet<D, double> block(int n, double scale, double jitter, unsigned seed, 
   std::uniform_real_distribution<double> u(-jitter * kSpacing, jitter * kSpacing);
   const double m = lattice_mass<D>(kRho0, kSpacing, kH, KernelKind::Cubic);
   ParticleSet<D, double> ps;
+  ps.mass = m;
   const int total = D == 2 ? n * n : n * n * n;
   for (int k = 0; k < total; ++k) {
     Vec<D, double> x;
@@ -57,7 +58,7 @@ ParticleSet<D, double> block(int n, double scale, double jitter, unsigned seed, 
       x[d] = (rest % n + 0.5) * kSpacing * scale + u(rng);
       rest /= n;
     }
-    ps.add(x, v(x), m);
+    ps.add(x, v(x));
   }
   return ps;
 }
@@ -82,11 +83,11 @@ template <int D>
 Vec<D, double> pair_gradient(const ParticleSet<D, double>& ps, const std::vector<double>& L,
                              const SmoothingKernels<D, double>& k, std::size_t i, std::size_t j) {
   const Vec<D, double> g = k.gradient(ps.position[i] - ps.position[j]);
-  if (L.empty()) return g * ps.mass[j];
+  if (L.empty()) return g * ps.mass;
   Vec<D, double> out{};
   for (int r = 0; r < D; ++r)
     for (int c = 0; c < D; ++c) out[r] += 0.5 * (L[i * D * D + r * D + c] + L[j * D * D + r * D + c]) * g[c];
-  return out * ps.mass[j];
+  return out * ps.mass;
 }
 
 /// beta_i = |sum_j m_j g_ij|^2 + m_i sum_j m_j |g_ij|^2, directly, for the particles with at least
@@ -112,9 +113,9 @@ void check_factors(bool corrected) {
       if (norm2(ps.position[i] - ps.position[j]) >= kH * kH) continue;
       const Vec<D, double> mg = pair_gradient(ps, L, k, i, j);
       sum += mg;
-      squares += norm2(mg) / ps.mass[j];
+      squares += norm2(mg) / ps.mass;
     }
-    const double beta = norm2(sum) + ps.mass[i] * squares;
+    const double beta = norm2(sum) + ps.mass * squares;
     EXPECT_NEAR(solver.factors()[i], beta, 1e-12 * beta) << D << "D, particle " << i;
     ++checked;
   }
@@ -136,7 +137,7 @@ template <int D>
 double momentum_ratio(const ParticleSet<D, double>& ps, const std::vector<Vec<D, double>>& dv) {
   Vec<D, double> total{};
   double size = 0;
-  for (std::size_t i = 0; i < ps.size(); ++i) total += dv[i] * ps.mass[i], size += ps.mass[i] * std::sqrt(norm2(dv[i]));
+  for (std::size_t i = 0; i < ps.size(); ++i) total += dv[i] * ps.mass, size += ps.mass * std::sqrt(norm2(dv[i]));
   return std::sqrt(norm2(total)) / size;
 }
 

@@ -40,9 +40,9 @@ SimulationParams<2> tank_params() {
 
 ParticleSet<2, double> block(int nx, int ny, double x0 = 0.01, double y0 = 0.01, Vec<2, double> v = {}) {
   ParticleSet<2, double> ps;
+  ps.mass = lattice_mass<2>(1000, 0.02, 0.04);
   for (int i = 0; i < nx; ++i)
-    for (int j = 0; j < ny; ++j)
-      ps.add(Vec<2, double>{x0 + 0.02 * i, y0 + 0.02 * j}, v, lattice_mass<2>(1000, 0.02, 0.04));
+    for (int j = 0; j < ny; ++j) ps.add(Vec<2, double>{x0 + 0.02 * i, y0 + 0.02 * j}, v);
   return ps;
 }
 
@@ -63,7 +63,7 @@ TEST(Health, ATankAtRestIsContainedSubsonicAndLosesEnergy) {
   // Potential energy from the container's floor: sum m g y over the lattice.
   double expected = 0;
   for (std::size_t i = 0; i < sim.particles().size(); ++i)
-    expected += sim.particles().mass[i] * 9.81 * sim.particles().position[i][1];
+    expected += sim.particles().mass * 9.81 * sim.particles().position[i][1];
   EXPECT_NEAR(e0, expected, 1e-9 * expected) << "at rest, clear of the walls' contact zones";
   for (int s = 0; s < 500; ++s) {
     const StepInfo& info = sim.step();
@@ -106,7 +106,7 @@ TEST(Health, BoundaryParticleScenesGetStepAndModeAdviceNotWallSprings) {
   p.boundary.handling = BoundaryHandling::Particles;
   p.neighbors = NeighborMode::Adaptive;
   ParticleSet<2, double> far = block(10, 10, 0.1, 0.1);
-  far.add(Vec<2, double>{0.45, 0.2}, Vec<2, double>{2.0, 0.0}, far.mass[0]);
+  far.add(Vec<2, double>{0.45, 0.2}, Vec<2, double>{2.0, 0.0});
   Simulation<2, double> lost(p, std::move(far));
   const std::string e = error_of([&] { lost.step(); });
   EXPECT_NE(e.find("simulation lost its fluid at step 0"), std::string::npos) << e;
@@ -118,7 +118,7 @@ TEST(Health, BoundaryParticleScenesGetStepAndModeAdviceNotWallSprings) {
 TEST(Health, AParticleOutsideTheContainerWarnsOnceAndOneBeyondHFails) {
   // 100 particles and one 1.5 cm past the right wall (tolerance r = 1 cm): under 1 % of them.
   ParticleSet<2, double> ps = block(10, 10, 0.1, 0.1);
-  ps.add(Vec<2, double>{0.415, 0.2}, {}, ps.mass[0]);
+  ps.add(Vec<2, double>{0.415, 0.2}, {});
   Simulation<2, double> sim(tank_params(), std::move(ps));
   const StepInfo& first = sim.step();
   EXPECT_EQ(first.health.outside, 1u);
@@ -134,7 +134,7 @@ TEST(Health, AParticleOutsideTheContainerWarnsOnceAndOneBeyondHFails) {
   EXPECT_EQ(sim.health().counts()[static_cast<int>(HealthKind::Outside)], 2);
 
   ParticleSet<2, double> far = block(10, 10, 0.1, 0.1);
-  far.add(Vec<2, double>{0.45, 0.2}, {}, far.mass[0]);  // 5 cm past the wall: beyond h = 4 cm
+  far.add(Vec<2, double>{0.45, 0.2}, {});  // 5 cm past the wall: beyond h = 4 cm
   Simulation<2, double> lost(tank_params(), std::move(far));
   const std::string e = error_of([&] { lost.step(); });
   EXPECT_NE(e.find("simulation lost its fluid at step 0"), std::string::npos) << e;
@@ -142,7 +142,7 @@ TEST(Health, AParticleOutsideTheContainerWarnsOnceAndOneBeyondHFails) {
   EXPECT_EQ(lost.steps_done(), 1);
 
   ParticleSet<2, double> many = block(10, 10, 0.1, 0.1);
-  for (int k = 0; k < 2; ++k) many.add(Vec<2, double>{0.415, 0.1 + 0.05 * k}, {}, many.mass[0]);
+  for (int k = 0; k < 2; ++k) many.add(Vec<2, double>{0.415, 0.1 + 0.05 * k}, {});
   Simulation<2, double> leak(tank_params(), std::move(many));
   const std::string e2 = error_of([&] { leak.step(); });
   EXPECT_NE(e2.find("2 of 102 particles are outside the container (more than 1 % of them"), std::string::npos) << e2;
@@ -152,7 +152,7 @@ TEST(Health, AParticleInsideAnObstacleIsCounted) {
   SimulationParams<2> p = tank_params();
   p.obstacles.push_back({{{0.2, 0.0}}, {{0.3, 0.1}}});
   ParticleSet<2, double> ps = block(10, 10, 0.01, 0.15);
-  ps.add(Vec<2, double>{0.25, 0.07}, {}, ps.mass[0]);  // 3 cm inside the obstacle's top (tolerance 1 cm)
+  ps.add(Vec<2, double>{0.25, 0.07}, {});  // 3 cm inside the obstacle's top (tolerance 1 cm)
   Simulation<2, double> sim(p, std::move(ps));
   const StepInfo& info = sim.step();
   EXPECT_EQ(info.health.inside_solid, 1u);

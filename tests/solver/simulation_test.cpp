@@ -60,11 +60,11 @@ Simulation<3, R> dam_break(int n, NeighborMode mode, int reorder_period) {
   p.full_rebuild_period = 200;
   p.reorder_period = reorder_period;
   ParticleSet<3, R> ps;
+  ps.mass = R(p.particle_mass);
   // Added column by column (x slowest): far from Morton order, so reordering does something.
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j)
-      for (int k = 0; k < n; ++k)
-        ps.add(Vec<3, R>{R(0.01 + 0.02 * i), R(0.01 + 0.02 * j), R(0.01 + 0.02 * k)}, {}, R(p.particle_mass));
+      for (int k = 0; k < n; ++k) ps.add(Vec<3, R>{R(0.01 + 0.02 * i), R(0.01 + 0.02 * j), R(0.01 + 0.02 * k)}, {});
   return Simulation<3, R>(p, std::move(ps));
 }
 
@@ -197,7 +197,8 @@ TEST(Reorder, ParticlesEmittedOnAReorderStepAreTheLastOnes) {
 
 TEST(ParticleSetPermute, RejectsARepeatedIndex) {
   ParticleSet<2, double> ps;
-  for (int i = 0; i < 3; ++i) ps.add(Vec<2, double>::filled(i), {}, 1.0);
+  ps.mass = 1.0;
+  for (int i = 0; i < 3; ++i) ps.add(Vec<2, double>::filled(i), {});
   const std::vector<std::uint32_t> bad{0, 0, 2};
   EXPECT_THROW(ps.permute(bad), std::logic_error);
   EXPECT_EQ(ps.id[1], 1u) << "a refused permutation must leave the set unchanged";

@@ -17,14 +17,15 @@ using V2 = Vec<2, double>;
 TEST(PairExitTest, FlagsBothParticlesOfExactlyThePairsPredictedToLeave) {
   const double h = 1.0, dt = 0.2;
   ParticleSet<2, double> ps;
-  ps.add(V2{0, 0}, V2{0, 0}, 1.0);      // 0
-  ps.add(V2{0.9, 0}, V2{1, 0}, 1.0);    // 1: leaves 0: predicted distance 0.9 + 0.2 = 1.1 > h
-  ps.add(V2{0, 0.5}, V2{0, 0}, 1.0);    // 2: stays 0.5 from 0
-  ps.add(V2{3, 3}, V2{0, 0}, 1.0);      // 3: alone
-  ps.add(V2{3.5, 3}, V2{-2, 0}, 1.0);   // 4: passes through 5 but stays within h of it
-  ps.add(V2{3.9, 3}, V2{0, 0}, 1.0);    // 5: predicted |x4 - x5 + dt (u4 - u5)| = |-0.4 - 0.4| = 0.8 < h
-  ps.add(V2{10, 10}, V2{0, 0}, 1.0);    // 6: listed by 7 only (asymmetric lists)
-  ps.add(V2{10.5, 10}, V2{5, 0}, 1.0);  // 7: predicted 0.5 + 1.0 = 1.5 > h
+  ps.mass = 1.0;
+  ps.add(V2{0, 0}, V2{0, 0});      // 0
+  ps.add(V2{0.9, 0}, V2{1, 0});    // 1: leaves 0: predicted distance 0.9 + 0.2 = 1.1 > h
+  ps.add(V2{0, 0.5}, V2{0, 0});    // 2: stays 0.5 from 0
+  ps.add(V2{3, 3}, V2{0, 0});      // 3: alone
+  ps.add(V2{3.5, 3}, V2{-2, 0});   // 4: passes through 5 but stays within h of it
+  ps.add(V2{3.9, 3}, V2{0, 0});    // 5: predicted |x4 - x5 + dt (u4 - u5)| = |-0.4 - 0.4| = 0.8 < h
+  ps.add(V2{10, 10}, V2{0, 0});    // 6: listed by 7 only (asymmetric lists)
+  ps.add(V2{10.5, 10}, V2{5, 0});  // 7: predicted 0.5 + 1.0 = 1.5 > h
   // Lists as an adaptive run may have them: 1 does not list 0 back, 6 does not list 7.
   //                                         0       1   2    3   4    5    6   7
   const NeighborLists lists = NeighborLists::from({{1, 2}, {}, {0}, {}, {5}, {4}, {}, {6}});
@@ -54,8 +55,9 @@ TEST(PairExitTest, FlagsBothParticlesOfExactlyThePairsPredictedToLeave) {
 TEST(PairExitTest, ListedPairsBeyondHAddNoDensity) {
   // Verlet and stale adaptive lists hold pairs beyond h: they must not change the density.
   ParticleSet<2, double> ps;
-  ps.add(V2{0, 0}, V2{}, 1.0);
-  ps.add(V2{1.2, 0}, V2{}, 1.0);
+  ps.mass = 1.0;
+  ps.add(V2{0, 0}, V2{});
+  ps.add(V2{1.2, 0}, V2{});
   const NeighborLists with = NeighborLists::from({{1}, {0}});
   const NeighborLists without = NeighborLists::from({{}, {}});
   FluidParams fluid;
@@ -95,8 +97,9 @@ SimulationParams<2> column_params(NeighborMode mode, int period) {
 
 ParticleSet<2, double> column(const SimulationParams<2>& p) {
   ParticleSet<2, double> ps;
+  ps.mass = p.particle_mass;
   for (int j = 0; j < 30; ++j)
-    for (int i = 0; i < 15; ++i) ps.add(V2{0.01 + 0.01 * i, 0.01 + 0.01 * j}, V2{}, p.particle_mass);
+    for (int i = 0; i < 15; ++i) ps.add(V2{0.01 + 0.01 * i, 0.01 + 0.01 * j}, V2{});
   return ps;
 }
 

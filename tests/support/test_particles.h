@@ -13,13 +13,14 @@ namespace sph::test {
 template <int D, class R>
 ParticleSet<D, R> make_test_particles(std::size_t n) {
   ParticleSet<D, R> ps;
+  ps.mass = R(0.5);
   for (std::size_t i = 0; i < n; ++i) {
     Vec<D, R> x, vel;
     for (int d = 0; d < D; ++d) {
       x[d] = static_cast<R>(0.1 * static_cast<double>(i) + 0.01 * d + 1.0 / 3.0);  // not exact in float
       vel[d] = static_cast<R>(-1.0 * static_cast<double>(i) + 0.5 * d - 0.1);
     }
-    ps.add(x, vel, R(0.5));
+    ps.add(x, vel);
   }
   for (std::size_t i = 0; i < n; ++i) {
     ps.density[i] = static_cast<R>(1000.1 + static_cast<double>(i));

@@ -374,7 +374,7 @@ MomentumRun run_momentum(const std::filesystem::path& dir, const std::string& mo
     // The scale of the momentum in play: sum m |v| at the start (the total momentum itself can
     // be zero for colliding blocks).
     for (std::size_t i = 0; i < ps.size(); ++i)
-      run.scale += static_cast<double>(ps.mass[i]) * std::sqrt(static_cast<double>(norm2(ps.velocity[i])));
+      run.scale += static_cast<double>(ps.mass) * std::sqrt(static_cast<double>(norm2(ps.velocity[i])));
     if (!(run.scale > 0)) throw Error("the blocks must move: every initial velocity is zero", path);
     const Vec<D, double> p0 = sim.momentum();
     const auto sample = [&]() {

@@ -57,13 +57,12 @@ inline constexpr FieldDesc kParticleFields[] = {
      false,
      {"x0", "y0", "z0"}},
     {"acceleration", FieldKind::Vector, "m/s^2", "m/s^2", "acceleration of the last step", false, false, {}},
-    {"mass", FieldKind::Real, "kg", "kg", "mass", false, false, {}},
 };
 
 /// Indices into kParticleFields (ParticleSet's members, in that order).
 namespace field {
 inline constexpr std::size_t kPosition = 0, kVelocity = 1, kDensity = 2, kPressure = 3, kId = 4, kInitialPosition = 5,
-                             kAcceleration = 6, kMass = 7;
+                             kAcceleration = 6;
 }  // namespace field
 
 namespace detail {

@@ -1,6 +1,7 @@
 #include <sph/core/particle_set.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include <sph/core/error.h>
 #include <sph/core/state_stream.h>
@@ -65,12 +66,11 @@ void ParticleSet<D, R>::reserve(std::size_t n) {
 }
 
 template <int D, std::floating_point R>
-std::uint64_t ParticleSet<D, R>::add(const V& x, const V& v, R m) {
+std::uint64_t ParticleSet<D, R>::add(const V& x, const V& v) {
   for_each_field([](const FieldDesc&, auto& column) { column.emplace_back(); });  // zeros
   position.back() = x;
   velocity.back() = v;
   initial_position.back() = x;
-  mass.back() = m;
   id.back() = next_id_;
   return next_id_++;
 }
@@ -109,6 +109,7 @@ void ParticleSet<D, R>::permute(std::span<const std::uint32_t> perm) {
 template <int D, std::floating_point R>
 void ParticleSet<D, R>::save(StateWriter& out) const {
   out.put(next_id_);
+  out.put(mass);
   out.put(static_cast<std::uint64_t>(std::size(kParticleFields) + added_.size()));
   for_each_field([&](const FieldDesc& f, const auto& column) {
     out.put(std::string(f.name));
@@ -120,6 +121,8 @@ void ParticleSet<D, R>::save(StateWriter& out) const {
 template <int D, std::floating_point R>
 void ParticleSet<D, R>::load(StateReader& in) {
   in.get(next_id_);
+  in.get(mass);
+  in.expect(std::isfinite(mass) && mass >= R(0), "a particle mass that is not a finite number at least 0");
   const auto fields = in.get<std::uint64_t>();
   in.expect(fields == std::size(kParticleFields) + added_.size(),
             "it holds " + std::to_string(fields) + " particle fields; this run has " +

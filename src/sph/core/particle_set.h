@@ -36,7 +36,11 @@ inline std::array<std::string, 3> added_field_ply_names(const FieldSpec& spec) {
 /// is carried through all of them, and through checkpoints and frames.
 ///
 /// Units: position and initial position in m, velocity in m/s, acceleration in m/s^2,
-/// density in kg/m^D (kg/m^3 in 3D, kg/m^2 in 2D), pressure in Pa (N/m in 2D), mass in kg.
+/// density in kg/m^D (kg/m^3 in 3D, kg/m^2 in 2D), pressure in Pa (N/m in 2D), mass in kg
+/// (kg/m in 2D).
+///
+/// Every particle of a set has one mass (`mass`, docs/physics.md "Particle mass"): it is not a
+/// per-particle field, so the pair loops broadcast it instead of gathering it per neighbour.
 template <int D, std::floating_point R>
 class ParticleSet {
  public:
@@ -50,7 +54,8 @@ class ParticleSet {
   std::vector<std::uint64_t> id;
   std::vector<V> initial_position;
   std::vector<V> acceleration;
-  std::vector<R> mass;
+  /// Every particle's mass (kg; kg/m in 2D): one value for the set, saved with it.
+  R mass = R(0);
 
   std::size_t size() const { return position.size(); }
   bool empty() const { return position.empty(); }
@@ -90,9 +95,9 @@ class ParticleSet {
   /// Reserves room for n particles in every field.
   void reserve(std::size_t n);
 
-  /// Appends one particle at rest state (zero acceleration, density, pressure and added fields)
-  /// and returns its stable id. Its initial position is x.
-  std::uint64_t add(const V& x, const V& v, R m);
+  /// Appends one particle (of the set's `mass`) at rest state (zero acceleration, density,
+  /// pressure and added fields) and returns its stable id. Its initial position is x.
+  std::uint64_t add(const V& x, const V& v);
 
   /// The id the next added particle will get.
   std::uint64_t next_id() const { return next_id_; }
@@ -102,10 +107,10 @@ class ParticleSet {
   /// cycles: no copy of the fields, and no allocation once it has run at this size.
   void permute(std::span<const std::uint32_t> perm);
 
-  /// Writes every field (name, kind and values) and the next id (checkpoints).
+  /// Writes every field (name, kind and values), the next id and the mass (checkpoints).
   void save(StateWriter& out) const;
-  /// Replaces every field and the next id with what save() wrote. Throws sph::Error if the
-  /// data is inconsistent (fields of different lengths, an id not below the next id) or holds
+  /// Replaces every field, the next id and the mass with what save() wrote. Throws sph::Error if
+  /// the data is inconsistent (fields of different lengths, an id not below the next id) or holds
   /// other fields than this set (a checkpoint of a build or solver with other fields).
   void load(StateReader& in);
 
@@ -129,8 +134,7 @@ class ParticleSet {
     f(kParticleFields[field::kId], s.id);
     f(kParticleFields[field::kInitialPosition], s.initial_position);
     f(kParticleFields[field::kAcceleration], s.acceleration);
-    f(kParticleFields[field::kMass], s.mass);
-    static_assert(std::size(kParticleFields) == 8, "every built-in field is visited above");
+    static_assert(std::size(kParticleFields) == 7, "every built-in field is visited above");
     for (auto& a : s.added_) {
       const FieldDesc d = a.desc();
       if (a.spec.kind == FieldKind::Vector)

@@ -24,7 +24,9 @@
 
 namespace sph {
 
-/// The format version this build writes and reads. Version 13 stores the health monitor's seventh
+/// The format version this build writes and reads. Version 14 stores the particles' one mass
+/// after the next id, where version 13 kept a per-particle "mass" field last among the built-in
+/// fields. Version 13 stores the health monitor's seventh
 /// watch (a floating body's depth into the walls) with the others, and changes the meaning of a
 /// boundary-particle scene: the samples' volumes now count the solid beyond their layers, and
 /// DFSPH scales its Jacobi steps on supports wider than about 3 spacings (2D) or 2.15 (3D), both
@@ -45,7 +47,7 @@ namespace sph {
 /// name and kind, in kParticleFields order, then the fields a run added (ParticleSet::save);
 /// version 2 kept the frames' times and the schedule's next tick instead of version 1's .vtu
 /// file list.
-inline constexpr std::uint32_t kCheckpointVersion = 13;
+inline constexpr std::uint32_t kCheckpointVersion = 14;
 /// The checkpoint's file name in a run's output directory.
 inline constexpr const char* kCheckpointFile = "checkpoint.sphc";
 

@@ -161,7 +161,7 @@ void RunOutput<D, R>::write_boundary(const Simulation<D, R>& sim) const {
   samples.reserve(b.size());
   const std::size_t psi =
       samples.add_field({"psi", FieldKind::Real, "kg/m", "kg", "a boundary sample's psi = rho0 V_b"});
-  for (std::size_t k = 0; k < b.size(); ++k) samples.add(b.position[k], Vec<D, R>{}, b.psi[k]);
+  for (std::size_t k = 0; k < b.size(); ++k) samples.add(b.position[k], Vec<D, R>{});
   samples.real_field(psi) = b.psi;
   write_vtu(dir_ / "boundary.vtu", samples, 0.0, FrameFields::only({"id", "psi"}));
 }

@@ -81,6 +81,7 @@ template <int D, std::floating_point R>
 ParticleSet<D, R> build_particles(const SceneBody<D>& body) {
   const double dx = 2.0 * body.sim.particle_radius;
   ParticleSet<D, R> ps;
+  ps.mass = static_cast<R>(body.sim.particle_mass);
   ps.reserve(count_block_particles<D>(body));
   const bool shapes = any_shape(body.sim);
   for (std::size_t bi = 0; bi < body.blocks.size(); ++bi) {
@@ -96,7 +97,7 @@ ParticleSet<D, R> build_particles(const SceneBody<D>& body) {
           throw Error(fmt::format("the fluid block overlaps Obstacles[{}]; move the block or the obstacle", oi),
                       fmt::format("FluidBlocks[{}]", bi));
       }
-      ps.add(vec_cast<R>(x), vec_cast<R>(blk.velocity), static_cast<R>(body.sim.particle_mass));
+      ps.add(vec_cast<R>(x), vec_cast<R>(blk.velocity));
     });
   }
   return ps;

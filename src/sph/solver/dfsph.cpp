@@ -117,7 +117,7 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
       }
     };
     visit(visit, 0);
-    beta_floor_ = static_cast<R>(kBetaFloor * squares) * ps.mass[0] * ps.mass[0];
+    beta_floor_ = static_cast<R>(kBetaFloor * squares) * ps.mass * ps.mass;
     full_count_ = static_cast<int>(std::ceil(kFullNeighbourhood * lattice));
     const double gain =
         jacobi_gain<D>(static_cast<double>(spacing_), static_cast<double>(h),
@@ -175,10 +175,10 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
         ps, i, lists, kernels, boundary, h2,
         [&](std::uint32_t j, const Vec<D, R>& plain) {
           const Vec<D, R> g = li ? corrected_gradient<D, R>(li, &correction[std::size_t{j} * D * D], plain) : plain;
-          const Vec<D, R> mg = g * ps.mass[j];
+          const Vec<D, R> mg = g * ps.mass;
           pair_j_[k] = j, pair_g_[k] = mg, ++k;
           sum += mg;
-          squares += ps.mass[j] * norm2(g);
+          squares += ps.mass * norm2(g);
           ++count;
         },
         [&](std::uint32_t b, const Vec<D, R>& plain) {
@@ -212,7 +212,7 @@ void DfsphSolver<D, R>::compute_factors(const ParticleSet<D, R>& ps, const Neigh
         for (int b = 0; b < 3; ++b) turn += double(t[a]) * inv[a * 3 + b] * double(t[b]);
       coupled += static_cast<R>(body_response_[k].inverse_mass * double(norm2(g)) + turn);
     }
-    beta_[i] = std::max(norm2(sum) + ps.mass[i] * (squares + coupled), beta_floor_);
+    beta_[i] = std::max(norm2(sum) + ps.mass * (squares + coupled), beta_floor_);
     if (!body_response_.empty()) near_body_[i] = near_body;
     full_[i] = count >= full_count_;
   });
@@ -297,7 +297,7 @@ template <int D, std::floating_point R>
 void DfsphSolver<D, R>::body_accelerations(const ParticleSet<D, R>& ps, const std::vector<R>& x,
                                            std::vector<BodyMotion>& out) {
   body_motions(
-      ps, [&](std::size_t i, std::size_t k) { return body_solid_[i * bodies_ + k] * (ps.mass[i] * x[i]); }, out);
+      ps, [&](std::size_t i, std::size_t k) { return body_solid_[i * bodies_ + k] * (ps.mass * x[i]); }, out);
 }
 
 template <int D, std::floating_point R>
@@ -363,7 +363,7 @@ SolveStats DfsphSolver<D, R>::solve(ParticleSet<D, R>& ps, R rho0, R dt) {
         [&](std::size_t i, std::size_t k) {
           Vec<D, R> change = body_acceleration_[i * bodies_ + k] * dt;
           if (body_velocity_change_) change += body_velocity_change_[i * bodies_ + k];
-          return change * (-ps.mass[i]);
+          return change * (-ps.mass);
         },
         body_change_);
     for (std::size_t k = 0; k < body_change_.size(); ++k) {

@@ -17,7 +17,7 @@ void gradient_corrections(const ParticleSet<D, R>& ps, const NeighborLists& list
       for (int r = 0; r < D; ++r)
         for (int c = 0; c < D; ++c) a[r][c] -= v * g[r] * rij[c];  // x_j - x_i = -rij
     };
-    for (const std::uint32_t j : lists.of(i)) add(ps.position[i] - ps.position[j], ps.mass[j] / ps.density[j]);
+    for (const std::uint32_t j : lists.of(i)) add(ps.position[i] - ps.position[j], ps.mass / ps.density[j]);
     if (solid)
       for (const std::uint32_t b : boundary.lists->of(i))
         add(ps.position[i] - boundary.position[b], boundary.psi[b] / rest_density);

@@ -108,6 +108,10 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
       health_poses_(params_.obstacles.size()),
       emitters_(params_.emitters.size()),
       monitor_(health_scene(params_), params_.health_failures) {
+  // The fluid's particles have the scene's one mass (the emitters' too).
+  SPH_CHECK(particles_.empty() || particles_.mass == static_cast<R>(params_.particle_mass),
+            "the particles' mass differs from the scene's particle mass");
+  particles_.mass = static_cast<R>(params_.particle_mass);
   NeighborOptions opt;
   opt.radius = params_.kernel_radius;
   opt.full_rebuild_period = params_.full_rebuild_period;
@@ -276,7 +280,7 @@ void Simulation<D, R>::advance_bodies(double dt) {
         Vec<D, double> change = vec_cast<double>(body_acceleration_[i * nb + s]) * dt;
         if (dv) change += vec_cast<double>(body_velocity_change_[i * nb + s]);
         if (norm2(change) == 0) continue;
-        change *= static_cast<double>(particles_.mass[i]);
+        change *= static_cast<double>(particles_.mass);
         Vec<3, double> moment{};
         add_moment<D>(moment, vec_cast<double>(particles_.position[i]), bodies_[s].position, change);
         double* o = out + s * kPer;
@@ -371,7 +375,7 @@ std::size_t Simulation<D, R>::emit() {
       for (int b = 0; b < rows && s.emitted < e.max_particles; ++b)
         for (int a = 0; a < e.width && s.emitted < e.max_particles; ++a) {
           const Vec<D, double> x = nozzle_position<D>(e, axes.first, axes.second, a, b);
-          particles_.add(vec_cast<R>(late > 0 ? x + flown : x), vel, static_cast<R>(params_.particle_mass));
+          particles_.add(vec_cast<R>(late > 0 ? x + flown : x), vel);
           ++s.emitted;
           ++added;
         }
@@ -644,7 +648,7 @@ HealthStats Simulation<D, R>::integrate_and_check(R dt) {
       const auto& x = particles_.position[i];
       const auto& v = particles_.velocity[i];
       any = any || !all_finite(x) || !all_finite(v);
-      probe.template add<!kIntegrate>(chunk, i, x, v, particles_.mass[i], particles_.density[i]);
+      probe.template add<!kIntegrate>(chunk, i, x, v, particles_.mass, particles_.density[i]);
     }
     chunk.bad = any;
   });
@@ -758,7 +762,7 @@ std::pair<double, double> Simulation<D, R>::kinetic_energy_and_max_speed() const
     R m = 0;
     for (std::size_t i = b; i < e; ++i) {
       const R v2 = norm2(particles_.velocity[i]);
-      s += 0.5 * static_cast<double>(particles_.mass[i]) * static_cast<double>(v2);
+      s += 0.5 * static_cast<double>(particles_.mass) * static_cast<double>(v2);
       m = std::max(m, v2);
     }
     partial_[c] = s;
@@ -775,7 +779,7 @@ Vec<D, double> Simulation<D, R>::momentum() const {
   Vec<D, double> p{};
   for (int d = 0; d < D; ++d)
     p[d] = chunked_sum(particles_.size(), partial_, [&](std::size_t i) {
-      return static_cast<double>(particles_.mass[i]) * static_cast<double>(particles_.velocity[i][d]);
+      return static_cast<double>(particles_.mass) * static_cast<double>(particles_.velocity[i][d]);
     });
   return p;
 }

@@ -56,13 +56,13 @@ SolveStats ImplicitViscosity<D, R>::solve(ParticleSet<D, R>& ps, const NeighborL
   for (auto* v : {&x_, &r_, &z_, &p_, &ap_, &b_}) v->resize(n);
   parallel_for(n, [&](std::size_t i) {
     const Vec<D, R> xi = ps.position[i];
-    const R mi = ps.mass[i], inv_rhoi = R(1) / ps.density[i];
+    const R mi = ps.mass, inv_rhoi = R(1) / ps.density[i];
     R diag = mi;
     std::size_t k = begin_[i];
     for (const std::uint32_t j : lists.of(i)) {
       const R r2 = norm2(xi - ps.position[j]);
       if (!(r2 < h2)) continue;
-      const R w = dt * mu * kernels.viscosity_laplacian(r2) * ((mi * ps.mass[j]) * (inv_rhoi * (R(1) / ps.density[j])));
+      const R w = dt * mu * kernels.viscosity_laplacian(r2) * ((mi * ps.mass) * (inv_rhoi * (R(1) / ps.density[j])));
       pair_j_[k] = j, pair_w_[k] = w, ++k;
       diag += w;
     }

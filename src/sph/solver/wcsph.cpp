@@ -161,20 +161,27 @@ struct DensityKernel {
 };
 
 /// The density sum of one particle over one list: sum_j mass_j W(|x_i - x_j|) by lanes, with
-/// the count of pairs closer than h added to `count`.
-template <KernelKind K, int D, std::floating_point R>
-simd::Pack<R> density_sum(const simd::Pack<R> (&xi)[D], const R* pos, const R* mass, std::span<const std::uint32_t> nb,
+/// the count of pairs closer than h added to `count`. `mass` is the fluid's one mass (R), or an
+/// array indexed as the positions (const R*: the boundary samples' psi), gathered per neighbour.
+template <KernelKind K, int D, std::floating_point R, class M>
+simd::Pack<R> density_sum(const simd::Pack<R> (&xi)[D], const R* pos, M mass, std::span<const std::uint32_t> nb,
                           const DensityKernel<K, D, R>& dk, std::uint64_t& count) {
   using P = simd::Pack<R>;
   constexpr int W = simd::kLanes<R>;
+  constexpr bool kGathered = std::is_same_v<M, const R*>;
+  static_assert(kGathered || std::is_same_v<M, R>, "a mass for all, or one per neighbour");
   const std::uint32_t* idx = nb.data();
   P sum = P::set1(R(0));
+  P one_mass = sum;
+  if constexpr (!kGathered) one_mass = P::set1(mass);
   for (std::size_t k0 = 0; k0 < nb.size(); k0 += W) {
     const Mask valid = simd::first_lanes<R>(nb.size() - k0);
     P rij[D];
     const P r2 = pair_offsets<D>(xi, pos, idx + k0, rij);
     const Mask in = valid & (r2 < dk.h2v);
-    sum = sum + density_term<K, D>(r2, in, P::template gather<1>(mass, idx + k0, 0), dk.h2v, dk.normv, dk.kernel);
+    P m = one_mass;
+    if constexpr (kGathered) m = P::template gather<1>(mass, idx + k0, 0);
+    sum = sum + density_term<K, D>(r2, in, m, dk.h2v, dk.normv, dk.kernel);
     count += static_cast<std::uint64_t>(__builtin_popcount(in));
   }
   return sum;
@@ -199,10 +206,10 @@ class DensityStore {
 
   /// Particle i (at xi, in every lane), whose fluid pairs sum to `pairs`.
   void operator()(std::size_t i, const simd::Pack<R> (&xi)[D], R pairs, std::uint64_t& boundary_count) const {
-    R rho = ps_.mass[i] * w0_ + pairs;
+    R rho = ps_.mass * w0_ + pairs;
     if (walls_)
-      rho += simd::sum_lanes(
-          density_sum<K, D>(xi, bpos_, boundary_.psi.data(), boundary_.lists->of(i), dk_, boundary_count));
+      rho += simd::sum_lanes(density_sum<K, D>(xi, bpos_, static_cast<const R*>(boundary_.psi.data()),
+                                               boundary_.lists->of(i), dk_, boundary_count));
     ps_.density[i] = rho;
     const R p = k_ * (rho - rho0_);
     ps_.pressure[i] = clamp_ ? std::max(p, R(0)) : p;
@@ -224,14 +231,13 @@ std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
   const DensityStore<K, D, R> store(ps, h, fluid, boundary);
   const DensityKernel<K, D, R> dk(h);
   const R* pos = flat(ps.position);
-  const R* mass = ps.mass.data();
   within.assign(chunk_count(ps.size()), 0);
   parallel_chunks(ps.size(), [&](std::size_t c, std::size_t b, std::size_t e) {
     std::uint64_t count = 0, boundary_count = 0;
     for (std::size_t i = b; i < e; ++i) {
       P xi[D];
       for (int d = 0; d < D; ++d) xi[d] = P::set1(ps.position[i][d]);
-      store(i, xi, simd::sum_lanes(density_sum<K, D>(xi, pos, mass, lists.of(i), dk, count)), boundary_count);
+      store(i, xi, simd::sum_lanes(density_sum<K, D>(xi, pos, ps.mass, lists.of(i), dk, count)), boundary_count);
     }
     within[c] = count;
   });
@@ -540,7 +546,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
   const R* vel = flat(ps.velocity);
   const R* rho = ps.density.data();
   const R* prs = ps.pressure.data();
-  const R* mass = ps.mass.data();
+  const P mass = P::set1(ps.mass);  // (every particle's: broadcast, not gathered)
   parallel_for(ps.size(), [&](std::size_t i) {
     const ForceSide<D, R> side = terms.side(i);
     P acc[D];
@@ -554,7 +560,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
       j.r2 = pair_offsets<D>(side.x, pos, idx + k0, j.rij);
       j.rho = P::template gather<1>(rho, idx + k0, 0);
       j.inv_rho = P::set1(R(1)) / j.rho;
-      j.mass = P::template gather<1>(mass, idx + k0, 0);
+      j.mass = mass;
       for (int d = 0; d < D; ++d) j.v[d] = P::template gather<D>(vel, idx + k0, d);
       if constexpr (kPressure) j.p = P::template gather<1>(prs, idx + k0, 0);
       terms.pairs(side, j, valid, acc);
@@ -571,19 +577,20 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
 
 /// The particles' values in cluster slot order (ClusterPairs::slots()), one array per scalar,
 /// each followed by a register of padding, so that a cluster's values are one contiguous load.
-/// Empty slots hold a particle far away (no pair within h), at rest, of no mass. The force pass
+/// Empty slots hold a particle far away (no pair within h), at rest; the passes broadcast the
+/// particles' one mass (an empty slot's pairs are masked out by distance, or are an empty i-slot's,
+/// whose sums are not stored). The force pass
 /// reads each particle's 1 / rho (inv_rho: one division per particle instead of one per lane of
 /// each register), and its rho only with `densities` (the artificial viscosity).
 template <int D, std::floating_point R>
 struct ClusterData {
-  std::vector<R> x[D], v[D], rho, inv_rho, p, mass;
+  std::vector<R> x[D], v[D], rho, inv_rho, p;
 
   void fill(const ParticleSet<D, R>& ps, std::span<const std::uint32_t> slots, bool forces, bool densities = false) {
     const std::size_t size = slots.size() + static_cast<std::size_t>(simd::kLanes<R>);
     // (the density pass leaves the force pass's arrays as they are: no shrinking and zero-filling
     // them again at every step)
     for (int d = 0; d < D; ++d) resize_with_room(x[d], size);
-    resize_with_room(mass, size);
     if (forces) {
       for (int d = 0; d < D; ++d) resize_with_room(v[d], size);
       resize_with_room(inv_rho, size);
@@ -598,7 +605,6 @@ struct ClusterData {
         x[d][s] = empty ? kFar : ps.position[i][d];
         if (forces) v[d][s] = empty ? R(0) : ps.velocity[i][d];
       }
-      mass[s] = empty ? R(0) : ps.mass[i];
       if (forces) {
         inv_rho[s] = empty ? R(1) : R(1) / ps.density[i];
         if (densities) rho[s] = empty ? R(1) : ps.density[i];
@@ -661,7 +667,7 @@ std::uint64_t cluster_density_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, 
   const std::span<const std::uint32_t> slots = cp.slots();
   data.fill(ps, slots, false);
   const DensityKernel<K, D, R> dk(h);
-  const P zero = P::set1(R(0));
+  const P zero = P::set1(R(0)), mass = P::set1(ps.mass);
   const std::size_t clusters = cp.cluster_count();
   // Blocks of clusters, each counting its pairs (a count is the same in any order; the blocks are
   // small so that every thread has clusters: kChunkSize clusters, 1,024 particles, would give a
@@ -690,8 +696,7 @@ std::uint64_t cluster_density_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, 
           // operations, and a branch on them, taken at random, cost the 3D block twice the pass's
           // time; the force pass's terms are many, and it skips them)
           const Mask in = (jc == c ? real & ~lanes.self[q] : real) & (r2 < dk.h2v);
-          sum =
-              sum + density_term<K, D>(r2, in, P::permuted(&data.mass[jb], lanes.tile[q]), dk.h2v, dk.normv, dk.kernel);
+          sum = sum + density_term<K, D>(r2, in, mass, dk.h2v, dk.normv, dk.kernel);
           count += static_cast<std::uint64_t>(__builtin_popcount(in));
         }
       }
@@ -731,7 +736,8 @@ void cluster_force_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, R>& cp, R h
   const R* xs[D];
   const R* vs[D];
   for (int d = 0; d < D; ++d) xs[d] = data.x[d].data(), vs[d] = data.v[d].data();
-  const R *rhos = data.rho.data(), *inv_rhos = data.inv_rho.data(), *masses = data.mass.data(), *prs = data.p.data();
+  const R *rhos = data.rho.data(), *inv_rhos = data.inv_rho.data(), *prs = data.p.data();
+  const P mass = P::set1(ps.mass);
   parallel_for(cp.cluster_count(), [&](std::size_t c) {
     const std::size_t base = c * S;
     ForceSide<D, R> side;
@@ -771,7 +777,7 @@ void cluster_force_pass(ParticleSet<D, R>& ps, const ClusterPairs<D, R>& cp, R h
       for (int d = 0; d < D; ++d) j.v[d] = P::permuted(vs[d] + jb, lanes.tile[q]);
       j.inv_rho = P::permuted(inv_rhos + jb, lanes.tile[q]);
       j.rho = densities ? P::permuted(rhos + jb, lanes.tile[q]) : j.inv_rho;  // (unread without)
-      j.mass = P::permuted(masses + jb, lanes.tile[q]);
+      j.mass = mass;
       if constexpr (kPressure) j.p = P::permuted(prs + jb, lanes.tile[q]);
       terms.pairs(side, j, valid, acc);
     };
@@ -845,7 +851,7 @@ void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, 
       const R inv_rhoj = R(1) / ps.density[j];
       const R pij = paper ? (R(0.5) * ps.pressure[i] + R(0.5) * ps.pressure[j]) * inv_rhoi * inv_rhoj
                           : ps.pressure[i] * inv_rhoi * inv_rhoi + ps.pressure[j] * inv_rhoj * inv_rhoj;
-      acc -= corrected_gradient<D, R>(li, &L[std::size_t{j} * D * D], g) * (ps.mass[j] * pij);
+      acc -= corrected_gradient<D, R>(li, &L[std::size_t{j} * D * D], g) * (ps.mass * pij);
     }
     if (solid) {
       const R pii =

@@ -79,8 +79,11 @@ class PySimulation {
     }
     py::gil_scoped_release release;
     use_threads(threads_);
-    dispatch(desc,
-             [&]<int D, class R>() { driver_ = std::make_unique<RunDriver<D, R>>(std::move(desc), RunSettings{}); });
+    dispatch(desc, [&]<int D, class R>() {
+      RunSettings settings;
+      settings.every_field = true;  // (every field a view)
+      driver_ = std::make_unique<RunDriver<D, R>>(std::move(desc), std::move(settings));
+    });
   }
   ~PySimulation() { detach_views(); }
   PySimulation(const PySimulation&) = delete;

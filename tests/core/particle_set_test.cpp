@@ -26,6 +26,26 @@ TEST(ParticleSet, IdsAreStableThroughPermutation) {
   EXPECT_EQ(ps.add({}, {}), 5u);
 }
 
+TEST(ParticleSet, ASetWithoutInitialPositionsLeavesThemOutOfEveryOperation) {
+  ParticleSet<3, float> ps;
+  ps.mass = 2.f;
+  ps.keep_initial_positions(false);
+  for (int i = 0; i < 4; ++i) ps.add({{float(i), 0, 0}}, {});
+  EXPECT_TRUE(ps.initial_position.empty());
+  std::size_t fields = 0;
+  ps.for_each_field([&](const FieldDesc& f, const auto& column) {
+    EXPECT_NE(f.name, "initial_position");
+    EXPECT_EQ(column.size(), 4u) << f.name;
+    ++fields;
+  });
+  EXPECT_EQ(fields, std::size(kParticleFields) - 1);
+  const std::vector<std::uint32_t> perm{3, 2, 1, 0};
+  ps.permute(perm);
+  EXPECT_EQ(ps.position[0][0], 3.f);
+  EXPECT_EQ(ps.id[0], 3u);
+  EXPECT_THROW(ps.keep_initial_positions(true), std::logic_error) << "the positions they were added at are gone";
+}
+
 TEST(ParticleSet, PermutationOfWrongSizeIsABug) {
   ParticleSet<2, double> ps;
   ps.add({}, {});

@@ -1,8 +1,10 @@
 // StateWriter / StateReader / Checksum: the byte streams checkpoints are made of.
 
 #include <cstdint>
+#include <memory>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -123,17 +125,59 @@ TEST(ParticleSetState, RoundTripsEveryFieldAndTheNextId) {
 }
 
 TEST(ParticleSetState, RefusesFieldsOfDifferentLengths) {
+  ParticleSet<2, double> a;
+  a.add({}, {}), a.add({}, {});
+  a.velocity.pop_back();  // one short
   std::stringstream buf;
   StateWriter w(buf);
-  w.put(std::uint64_t{2});                // next id
-  w.put(std::vector<Vec<2, double>>(2));  // position
-  w.put(std::vector<Vec<2, double>>(1));  // velocity: one short
-  for (int k = 0; k < 2; ++k) w.put(std::vector<Vec<2, double>>(2));
-  for (int k = 0; k < 3; ++k) w.put(std::vector<double>(2));
-  w.put(std::vector<std::uint64_t>{0, 1});
+  a.save(w);
   ParticleSet<2, double> p;
   StateReader r(buf, w.written(), "ckpt");
-  EXPECT_THROW(p.load(r), Error);
+  try {
+    p.load(r);
+    ADD_FAILURE() << "loaded fields of different lengths";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("different lengths"), std::string::npos) << e.what();
+  }
+}
+
+// A set without initial positions round-trips without them; a set that keeps them refuses its
+// state, and the reverse (each names the field where they differ).
+TEST(ParticleSetState, InitialPositionsKeptOrNotOnBothSides) {
+  ParticleSet<3, float> a;
+  a.mass = 0.5f;
+  a.keep_initial_positions(false);
+  for (int i = 0; i < 3; ++i) a.add({{float(i), 1.f, 2.f}}, {{0.f, float(i), 0.f}});
+  const auto saved = [](const ParticleSet<3, float>& set) {
+    auto buf = std::make_shared<std::stringstream>();
+    StateWriter w(*buf);
+    set.save(w);
+    return std::make_pair(buf, w.written());
+  };
+  {
+    auto [buf, size] = saved(a);
+    ParticleSet<3, float> b;
+    b.keep_initial_positions(false);
+    StateReader r(*buf, size, "ckpt");
+    b.load(r);
+    EXPECT_EQ(b.position, a.position);
+    EXPECT_EQ(b.velocity, a.velocity);
+    EXPECT_EQ(b.mass, 0.5f);
+    EXPECT_TRUE(b.initial_position.empty());
+  }
+  {
+    auto [buf, size] = saved(a);
+    ParticleSet<3, float> keeps;
+    StateReader r(*buf, size, "ckpt");
+    EXPECT_THROW(keeps.load(r), Error);
+  }
+  ParticleSet<3, float> c;
+  c.add({}, {});
+  auto [buf, size] = saved(c);
+  ParticleSet<3, float> drops;
+  drops.keep_initial_positions(false);
+  StateReader r(*buf, size, "ckpt");
+  EXPECT_THROW(drops.load(r), Error);
 }
 
 }  // namespace

@@ -146,6 +146,45 @@ TEST(RunDriver, StopsTwiceAndResumesTwiceBitwise) {
             nlohmann::json::array({10, 41}));
 }
 
+// A run keeps each particle's initial position only where something reads it: frames that hold
+// it, or every_field (Python). Without them the run's results are the same, and it stops and
+// resumes bitwise (its checkpoint has no such field).
+TEST(RunDriver, KeepsTheInitialPositionsOnlyWhereSomethingReadsThem) {
+  TempDir tmp;
+  const auto keeps = [](const SceneDesc& desc, const RunSettings& settings) {
+    return RunDriver<2, double>(desc, settings).simulation().particles().keeps_initial_positions();
+  };
+  const SceneDesc framed = dam_break("standard", 20);  // (its frames hold every field)
+  EXPECT_TRUE(keeps(framed, RunSettings{tmp / "framed", 0}));
+  EXPECT_FALSE(keeps(framed, RunSettings{})) << "no directory: no frames";
+  RunSettings every;
+  every.every_field = true;
+  EXPECT_TRUE(keeps(framed, every));
+  const SceneDesc unframed = read_scene_file(SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json",
+                                             {"Configuration.numberOfSteps=20", "Configuration.outputEveryNSteps=0"});
+  EXPECT_FALSE(keeps(unframed, RunSettings{tmp / "unframed", 0}));
+
+  const SceneDesc without =
+      read_scene_file(SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json",
+                      {"Configuration.numberOfSteps=" + std::to_string(kSteps), "Configuration.outputEveryNSteps=7",
+                       "Configuration.outputFields=[\"velocity\", \"id\"]"});
+  EXPECT_FALSE(keeps(without, RunSettings{tmp / "probe", 0}));
+  ASSERT_EQ(run_new(without, tmp / "full").status, RunStatus::Completed);
+  {
+    RunSettings kept{tmp / "kept", 0};
+    kept.every_field = true;
+    RunDriver<2, double> run(without, kept);
+    ASSERT_TRUE(run.simulation().particles().keeps_initial_positions());
+    ASSERT_EQ(run.run().status, RunStatus::Completed);
+  }
+  expect_same_frames(tmp / "full", tmp / "kept");
+  EXPECT_EQ(stats_rows(tmp / "full" / "stats.csv"), stats_rows(tmp / "kept" / "stats.csv"));
+  ASSERT_EQ(run_new(without, tmp / "part", stop_at(23)).status, RunStatus::Interrupted);
+  ASSERT_EQ(resume(tmp / "part").status, RunStatus::Completed);
+  expect_same_frames(tmp / "full", tmp / "part");
+  EXPECT_EQ(stats_rows(tmp / "full" / "stats.csv"), stats_rows(tmp / "part" / "stats.csv"));
+}
+
 TEST(RunDriver, ARequestDuringTheLastStepLetsTheRunComplete) {
   TempDir tmp;
   int polls = 0;

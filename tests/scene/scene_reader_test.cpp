@@ -606,10 +606,10 @@ TEST(MemoryEstimate, CountsBlocksAndEmitterBudgetsAndGrowsWithPrecisionAndSkin) 
   EXPECT_EQ(sph::max_particles(dam), 3200u);
   EXPECT_EQ(sph::max_particles(tank), 8000u) << "the tank starts empty: its emitter's budget";
   const double d = sph::estimated_run_bytes(dam);
-  // 2D double: 4 vectors (64 bytes), 3 scalars (24), an id (8); 4 pi neighbors of 4 bytes with
-  // 1/16 room and an end offset (57); the grid's coordinates, cell and index (24): 177 bytes.
-  EXPECT_GT(d / 3200, 170.0);
-  EXPECT_LT(d / 3200, 185.0);
+  // 2D double: 4 vectors (64 bytes), 2 scalars (16), an id (8); 4 pi neighbors of 4 bytes with
+  // 1/16 room, and 8 bytes of offsets (61); the grid's coordinates and index (20): 169 bytes.
+  EXPECT_GT(d / 3200, 165.0);
+  EXPECT_LT(d / 3200, 175.0);
   const sph::SceneDesc dam_float =
       sph::read_scene_file(dir + "dam_break_2d.json", {"Configuration.precision=\"float\""});
   EXPECT_LT(sph::estimated_run_bytes(dam_float), d);

@@ -108,6 +108,7 @@ RunRecord run_one(const SceneDesc& base, NeighborMode mode, bool perturbed, cons
   rec.label = std::string(to_string(mode)) + (perturbed ? " (perturbed)" : "");
   // Each mode's run (not the chaos floor's) writes its run directory as `sph run -o DIR` would.
   RunSettings settings;
+  settings.every_field = true;  // (the snapshots read the initial positions)
   if (!opt.runs_dir.empty() && !perturbed) settings.dir = opt.runs_dir / slug(rec.label);
   RunDriver<D, R> run(run_scene<D>(base, mode, opt.audit, steps), settings);
   Simulation<D, R>& sim = run.simulation();

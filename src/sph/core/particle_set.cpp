@@ -61,6 +61,13 @@ const std::vector<Vec<D, R>>& ParticleSet<D, R>::vector_field(std::size_t k) con
 }
 
 template <int D, std::floating_point R>
+void ParticleSet<D, R>::keep_initial_positions(bool keep) {
+  SPH_CHECK(empty(), "keep_initial_positions: the set already holds particles");
+  keep_initial_ = keep;
+  if (!keep) std::vector<V>().swap(initial_position);  // (its memory too)
+}
+
+template <int D, std::floating_point R>
 void ParticleSet<D, R>::reserve(std::size_t n) {
   for_each_field([n](const FieldDesc&, auto& column) { column.reserve(n); });
 }
@@ -70,7 +77,7 @@ std::uint64_t ParticleSet<D, R>::add(const V& x, const V& v) {
   for_each_field([](const FieldDesc&, auto& column) { column.emplace_back(); });  // zeros
   position.back() = x;
   velocity.back() = v;
-  initial_position.back() = x;
+  if (keep_initial_) initial_position.back() = x;
   id.back() = next_id_;
   return next_id_++;
 }
@@ -110,7 +117,7 @@ template <int D, std::floating_point R>
 void ParticleSet<D, R>::save(StateWriter& out) const {
   out.put(next_id_);
   out.put(mass);
-  out.put(static_cast<std::uint64_t>(std::size(kParticleFields) + added_.size()));
+  out.put(static_cast<std::uint64_t>(field_count()));
   for_each_field([&](const FieldDesc& f, const auto& column) {
     out.put(std::string(f.name));
     out.put(static_cast<std::uint8_t>(f.kind));
@@ -124,9 +131,8 @@ void ParticleSet<D, R>::load(StateReader& in) {
   in.get(mass);
   in.expect(std::isfinite(mass) && mass >= R(0), "a particle mass that is not a finite number at least 0");
   const auto fields = in.get<std::uint64_t>();
-  in.expect(fields == std::size(kParticleFields) + added_.size(),
-            "it holds " + std::to_string(fields) + " particle fields; this run has " +
-                std::to_string(std::size(kParticleFields) + added_.size()));
+  in.expect(fields == field_count(),
+            "it holds " + std::to_string(fields) + " particle fields; this run has " + std::to_string(field_count()));
   std::size_t n = 0;
   bool first = true;
   for_each_field([&](const FieldDesc& f, auto& column) {

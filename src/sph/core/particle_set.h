@@ -41,6 +41,10 @@ inline std::array<std::string, 3> added_field_ply_names(const FieldSpec& spec) {
 ///
 /// Every particle of a set has one mass (`mass`, docs/physics.md "Particle mass"): it is not a
 /// per-particle field, so the pair loops broadcast it instead of gathering it per neighbour.
+///
+/// The initial positions are only ever written out (frames, Python's views): a set made with
+/// keep_initial_positions(false) has no such field (12 bytes a particle less in float 3D), and
+/// every operation (for_each_field and all that goes through it) leaves it out.
 template <int D, std::floating_point R>
 class ParticleSet {
  public:
@@ -59,6 +63,11 @@ class ParticleSet {
 
   std::size_t size() const { return position.size(); }
   bool empty() const { return position.empty(); }
+
+  /// Whether the set keeps each particle's initial position (the default). Changed only while the
+  /// set is empty (SPH_CHECK): the positions a particle was added at are not known afterwards.
+  bool keeps_initial_positions() const { return keep_initial_; }
+  void keep_initial_positions(bool keep);
 
   /// Calls f(const FieldDesc&, column) for every field in kParticleFields order, then for the
   /// fields added with add_field in the order they were added; `column` is the field's
@@ -96,7 +105,8 @@ class ParticleSet {
   void reserve(std::size_t n);
 
   /// Appends one particle (of the set's `mass`) at rest state (zero acceleration, density,
-  /// pressure and added fields) and returns its stable id. Its initial position is x.
+  /// pressure and added fields) and returns its stable id. Its initial position is x (where the
+  /// set keeps initial positions).
   std::uint64_t add(const V& x, const V& v);
 
   /// The id the next added particle will get.
@@ -111,7 +121,8 @@ class ParticleSet {
   void save(StateWriter& out) const;
   /// Replaces every field, the next id and the mass with what save() wrote. Throws sph::Error if
   /// the data is inconsistent (fields of different lengths, an id not below the next id) or holds
-  /// other fields than this set (a checkpoint of a build or solver with other fields).
+  /// other fields than this set (a checkpoint of a build or solver with other fields, or of a set
+  /// that kept its initial positions where this one does not, or the reverse).
   void load(StateReader& in);
 
  private:
@@ -132,7 +143,7 @@ class ParticleSet {
     f(kParticleFields[field::kDensity], s.density);
     f(kParticleFields[field::kPressure], s.pressure);
     f(kParticleFields[field::kId], s.id);
-    f(kParticleFields[field::kInitialPosition], s.initial_position);
+    if (s.keep_initial_) f(kParticleFields[field::kInitialPosition], s.initial_position);
     f(kParticleFields[field::kAcceleration], s.acceleration);
     static_assert(std::size(kParticleFields) == 7, "every built-in field is visited above");
     for (auto& a : s.added_) {
@@ -144,7 +155,10 @@ class ParticleSet {
     }
   }
 
+  std::size_t field_count() const { return std::size(kParticleFields) - (keep_initial_ ? 0 : 1) + added_.size(); }
+
   std::uint64_t next_id_ = 0;
+  bool keep_initial_ = true;
   std::vector<AddedField> added_;
   std::vector<std::uint64_t> placed_;  // permute(): one bit per particle
 };

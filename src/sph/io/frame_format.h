@@ -7,6 +7,7 @@
 #include <string_view>
 #include <vector>
 
+#include <sph/core/error.h>
 #include <sph/core/particle_set.h>
 #include <sph/scene/frame_formats.h>
 
@@ -25,8 +26,9 @@ class FrameFields {
     f.names_ = std::move(names);
     return f;
   }
-  bool has(std::string_view name) const {
-    if (all_) return true;
+  bool has(std::string_view name) const { return all_ || names(name); }
+  /// Whether the field is named (not only taken as one of all).
+  bool names(std::string_view name) const {
     for (const std::string& n : names_)
       if (n == name) return true;
     return false;
@@ -38,9 +40,12 @@ class FrameFields {
 };
 
 /// Calls f(desc, column) for each field of `ps` that a frame with `fields` holds, in the set's
-/// field order (ParticleSet::for_each_field).
+/// field order (ParticleSet::for_each_field). SPH_CHECK: a set that does not keep its initial
+/// positions is not asked for them by name (RunSettings::every_field).
 template <int D, std::floating_point R, class F>
 void for_each_frame_field(const ParticleSet<D, R>& ps, const FrameFields& fields, F&& f) {
+  SPH_CHECK(ps.keeps_initial_positions() || !fields.names(kParticleFields[field::kInitialPosition].name),
+            "a frame names the initial positions, which these particles do not keep");
   ps.for_each_field([&](const FieldDesc& desc, const auto& column) {
     if (desc.in_frames && fields.has(desc.name)) f(desc, column);
   });

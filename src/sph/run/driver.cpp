@@ -24,11 +24,14 @@ std::string_view to_string(RunStatus status) {
 
 namespace {
 
-/// The simulation of `desc`, once the scene is known to fit in memory.
+/// The simulation of `desc`, once the scene is known to fit in memory; its particles keep their
+/// initial positions if something may read them (RunSettings::every_field).
 template <int D, std::floating_point R>
-Simulation<D, R> build_simulation(const SceneDesc& desc) {
+Simulation<D, R> build_simulation(const SceneDesc& desc, const RunSettings& settings) {
   check_fits_in_memory(desc);
-  return make_simulation<D, R>(desc);
+  const bool initial = settings.every_field || (!settings.dir.empty() &&
+                                                desc.output.frames_hold(kParticleFields[field::kInitialPosition].name));
+  return make_simulation<D, R>(desc, initial);
 }
 
 }  // namespace
@@ -37,7 +40,7 @@ template <int D, std::floating_point R>
 RunDriver<D, R>::RunDriver(SceneDesc desc, RunSettings settings)
     : desc_(std::move(desc)),
       settings_(std::move(settings)),
-      sim_(build_simulation<D, R>(desc_)),
+      sim_(build_simulation<D, R>(desc_, settings_)),
       info_{std::string(to_string(sim_.params().neighbors)), num_threads()} {
   SPH_CHECK(settings_.checkpoint_every == 0 || !settings_.dir.empty(), "RunDriver: checkpoints need a directory");
   SPH_CHECK(!settings_.surface || !settings_.dir.empty(), "RunDriver: surfaces need a directory");
@@ -57,7 +60,7 @@ template <int D, std::floating_point R>
 RunDriver<D, R>::RunDriver(SceneDesc desc, CheckpointReader& checkpoint, RunSettings settings)
     : desc_(std::move(desc)),
       settings_(std::move(settings)),
-      sim_(build_simulation<D, R>(desc_)),
+      sim_(build_simulation<D, R>(desc_, settings_)),
       info_{std::string(to_string(sim_.params().neighbors)), num_threads()},
       resumed_(true) {
   SPH_CHECK(!settings_.dir.empty(), "RunDriver: a resumed run needs its directory");

@@ -52,6 +52,11 @@ struct RunSettings {
   /// surface_NNNNNN.ply, .obj, .vdb (sph/surface/mesh_files.h). Its spacing is taken from the
   /// scene (2 Configuration.particleRadius). Needs `dir`.
   std::optional<SurfaceOutput> surface{};
+  /// The particles keep every field, those no output of the run reads too. Without it a run
+  /// keeps the initial positions only when it writes frames (`dir`) that hold them (12 bytes a
+  /// particle in float 3D). Python's Simulation sets it (its views and write_frame offer every
+  /// field), and so does `sph compare` (its snapshots read the initial positions).
+  bool every_field = false;
 };
 
 /// What the caller hears during the run. Each is called between steps; any may be empty.

@@ -78,10 +78,11 @@ std::size_t count_block_particles(const SceneBody<D>& body) {
 }
 
 template <int D, std::floating_point R>
-ParticleSet<D, R> build_particles(const SceneBody<D>& body) {
+ParticleSet<D, R> build_particles(const SceneBody<D>& body, bool keep_initial_positions) {
   const double dx = 2.0 * body.sim.particle_radius;
   ParticleSet<D, R> ps;
   ps.mass = static_cast<R>(body.sim.particle_mass);
+  ps.keep_initial_positions(keep_initial_positions);
   ps.reserve(count_block_particles<D>(body));
   const bool shapes = any_shape(body.sim);
   for (std::size_t bi = 0; bi < body.blocks.size(); ++bi) {
@@ -104,11 +105,11 @@ ParticleSet<D, R> build_particles(const SceneBody<D>& body) {
 }
 
 template <int D, std::floating_point R>
-Simulation<D, R> make_simulation(const SceneDesc& desc) {
+Simulation<D, R> make_simulation(const SceneDesc& desc, bool keep_initial_positions) {
   SPH_CHECK(desc.dimension == D, "scene dimension differs from the simulation's");
   const SceneBody<D>& body = desc.body<D>();
   try {
-    return Simulation<D, R>(body.sim, build_particles<D, R>(body));
+    return Simulation<D, R>(body.sim, build_particles<D, R>(body, keep_initial_positions));
   } catch (const Error& e) {
     throw Error(e.message(), e.where().empty() ? desc.source : desc.source + ": " + e.where());
   }
@@ -135,7 +136,9 @@ double estimated_bytes_of(const SceneBody<D>& body, std::size_t real_bytes) {
   // Lattice neighbors within the list radius: the area or volume of its ball over dx^D.
   const double q = radius / (2.0 * p.particle_radius);
   const double neighbors = D == 2 ? 3.14159265358979 * q * q : 4.18879020478639 * q * q * q;
-  const double fields = 4.0 * D * real_bytes + 3.0 * real_bytes + 8.0;  // 4 vectors, 3 scalars, id
+  // 4 vectors (position, velocity, acceleration, initial position: kept by a run with frames that
+  // hold them, the estimate assumes so), 2 scalars (density, pressure), id
+  const double fields = 4.0 * D * real_bytes + 2.0 * real_bytes + 8.0;
   const double lists = tracked ? 4.0 * (neighbors * 1.25 + 4.0) * (17.0 / 16.0) + 12.0 + D * real_bytes + 2.0
                                : 4.0 * neighbors * (17.0 / 16.0) + 8.0;  // entries + spare room, offsets
   const double grid = D * real_bytes + 4.0;  // coordinates in cell order (the Morton sort's too), index
@@ -158,9 +161,9 @@ template bool block_particle_kept<2>(const SimulationParams<2>&, const Vec<2, do
 template bool block_particle_kept<3>(const SimulationParams<3>&, const Vec<3, double>&);
 template std::vector<BlockCount> count_block_particles_kept<2>(const SceneBody<2>&);
 template std::vector<BlockCount> count_block_particles_kept<3>(const SceneBody<3>&);
-#define SPH_INSTANTIATE(D, R)                                            \
-  template ParticleSet<D, R> build_particles<D, R>(const SceneBody<D>&); \
-  template Simulation<D, R> make_simulation<D, R>(const SceneDesc&);
+#define SPH_INSTANTIATE(D, R)                                                  \
+  template ParticleSet<D, R> build_particles<D, R>(const SceneBody<D>&, bool); \
+  template Simulation<D, R> make_simulation<D, R>(const SceneDesc&, bool);
 SPH_INSTANTIATE(2, float)
 SPH_INSTANTIATE(2, double)
 SPH_INSTANTIATE(3, float)

@@ -9,10 +9,11 @@ namespace sph {
 
 /// Fills each fluid block with particles on a lattice of spacing 2 * particleRadius, the first
 /// particle half a spacing inside the block's lower corner, leaving out the sites in or near an
-/// obstacle's shape (block_particle_kept). Particles get ids in block order.
+/// obstacle's shape (block_particle_kept). Particles get ids in block order, and the scene's
+/// particle mass; the set keeps their initial positions if `keep_initial_positions`.
 /// Throws sph::Error if a block overlaps a box obstacle.
 template <int D, std::floating_point R>
-ParticleSet<D, R> build_particles(const SceneBody<D>& body);
+ParticleSet<D, R> build_particles(const SceneBody<D>& body, bool keep_initial_positions = true);
 
 /// Whether a fluid block's lattice site x keeps its particle: not inside an obstacle's shape
 /// (shape.h), nor closer than a particle radius to its surface (box obstacles refuse the block).
@@ -40,8 +41,9 @@ std::size_t max_particles(const SceneDesc& desc);
 /// allocating anything, a scene that cannot fit in the machine's memory.
 double estimated_run_bytes(const SceneDesc& desc);
 
-/// Builds the initial particles and the simulation of a scene of dimension D.
+/// Builds the initial particles and the simulation of a scene of dimension D (its particles keep
+/// their initial positions if `keep_initial_positions`: RunDriver decides, from what reads them).
 template <int D, std::floating_point R>
-Simulation<D, R> make_simulation(const SceneDesc& desc);
+Simulation<D, R> make_simulation(const SceneDesc& desc, bool keep_initial_positions = true);
 
 }  // namespace sph

@@ -1,9 +1,11 @@
 #pragma once
 /// \file SceneDesc: a scene file's content as plain structs (no JSON types), SI units.
 
+#include <algorithm>
 #include <cstdint>
 #include <iterator>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -29,6 +31,13 @@ struct OutputDesc {
   /// Write the boundary particles (their positions and psi) once, as boundary.vtu in the run
   /// directory (Configuration.outputBoundary).
   bool boundary = false;
+
+  /// Whether the run writes frames at all (a schedule: every_steps or fps).
+  bool writes_frames() const { return every_steps > 0 || fps > 0; }
+  /// Whether its frames hold the field `name`.
+  bool frames_hold(std::string_view name) const {
+    return writes_frames() && std::find(fields.begin(), fields.end(), name) != fields.end();
+  }
 
   friend bool operator==(const OutputDesc&, const OutputDesc&) = default;
 };

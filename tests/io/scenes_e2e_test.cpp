@@ -165,7 +165,7 @@ TEST(ScenesE2E, TankFill3D) {
   }
   check_state(sim, Expect{10, 60}, "tank_fill_3d after 1200 steps");
   // Ids are 0..N-1 (never reused, nothing removed).
-  std::vector<std::uint64_t> ids = sim.particles().id;
+  std::vector<std::uint32_t> ids = sim.particles().id;
   std::sort(ids.begin(), ids.end());
   for (std::size_t i = 0; i < ids.size(); ++i) ASSERT_EQ(ids[i], i);
 }

@@ -81,4 +81,4 @@ def test_fields_other_than_positions_and_velocities_cannot_be_set(small_2d):
     with pytest.raises(AttributeError):
         sim.densities = np.zeros(800)
     with pytest.raises(AttributeError):
-        sim.ids = np.zeros(800, dtype=np.uint64)
+        sim.ids = np.zeros(800, dtype=np.uint32)

@@ -14,7 +14,7 @@ def test_views_are_read_only_and_share_the_simulation_memory(small_2d):
     assert np.shares_memory(a, b)  # two views of one buffer: no copy
     assert isinstance(a.base, sph._ViewMemory)
     assert a.shape == (len(sim), 2) and a.dtype == np.float64
-    assert sim.ids.dtype == np.uint64 and sim.densities.shape == (len(sim),)
+    assert sim.ids.dtype == np.uint32 and sim.densities.shape == (len(sim),)
     with pytest.raises(ValueError, match="read-only"):
         a[0, 0] = 1.0
     with pytest.raises(ValueError, match="read-only"):

@@ -267,7 +267,7 @@ HydrostaticRun run_hydrostatic(const std::filesystem::path& dir, int dimension, 
     FluidState mean = state_of(sim);
     std::vector<std::uint64_t> slot(mean.position.size());  // id -> the averaged state's index
     for (std::size_t i = 0; i < slot.size(); ++i) slot[i] = i;
-    const std::vector<std::uint64_t> first_ids = sim.particles().id;
+    const std::vector<std::uint32_t> first_ids = sim.particles().id;
     for (std::size_t i = 0; i < first_ids.size(); ++i) {
       SPH_CHECK(first_ids[i] < slot.size(), "a tank's particle ids are 0 .. N-1");
       slot[first_ids[i]] = i;
@@ -279,7 +279,7 @@ HydrostaticRun run_hydrostatic(const std::filesystem::path& dir, int dimension, 
     const auto sample = [&]() {
       const FluidState s = state_of(sim);
       if (sim.time() >= window_start) {
-        const std::vector<std::uint64_t>& ids = sim.particles().id;
+        const std::vector<std::uint32_t>& ids = sim.particles().id;
         for (std::size_t i = 0; i < s.position.size(); ++i) {
           const std::size_t k = slot[ids[i]];
           for (int d = 0; d < 3; ++d) mean.position[k][d] += s.position[i][d];

@@ -18,7 +18,7 @@ namespace sph {
 enum class FieldKind {
   Vector,  ///< D reals (frames hold 3 components, z = 0 in 2D)
   Real,    ///< one real
-  Id,      ///< one unsigned 64-bit integer
+  Id,      ///< one unsigned 32-bit integer (VTU frames write it as UInt64)
 };
 
 /// A per-particle field. Views into static text (the built-in table) or into a ParticleSet's

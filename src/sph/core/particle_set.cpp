@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <sph/core/error.h>
 #include <sph/core/state_stream.h>
@@ -74,11 +75,12 @@ void ParticleSet<D, R>::reserve(std::size_t n) {
 
 template <int D, std::floating_point R>
 std::uint64_t ParticleSet<D, R>::add(const V& x, const V& v) {
+  SPH_CHECK(next_id_ <= std::numeric_limits<std::uint32_t>::max(), "more particles than 32-bit ids number");
   for_each_field([](const FieldDesc&, auto& column) { column.emplace_back(); });  // zeros
   position.back() = x;
   velocity.back() = v;
   if (keep_initial_) initial_position.back() = x;
-  id.back() = next_id_;
+  id.back() = static_cast<std::uint32_t>(next_id_);
   return next_id_++;
 }
 

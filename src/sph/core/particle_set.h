@@ -55,7 +55,9 @@ class ParticleSet {
   std::vector<R> density;
   std::vector<R> pressure;
   /// Stable id: assigned once when a particle is added, never reused, survives permutation.
-  std::vector<std::uint64_t> id;
+  /// 32 bits: a scene holds at most 2e9 particles over its whole run (blocks and emitter budgets,
+  /// scene_reader), and frames write ids in 32 bits but VTU's UInt64.
+  std::vector<std::uint32_t> id;
   std::vector<V> initial_position;
   std::vector<V> acceleration;
   /// Every particle's mass (kg; kg/m in 2D): one value for the set, saved with it.
@@ -71,7 +73,7 @@ class ParticleSet {
 
   /// Calls f(const FieldDesc&, column) for every field in kParticleFields order, then for the
   /// fields added with add_field in the order they were added; `column` is the field's
-  /// std::vector<V> (FieldKind::Vector), std::vector<R> (Real) or std::vector<std::uint64_t> (Id).
+  /// std::vector<V> (FieldKind::Vector), std::vector<R> (Real) or std::vector<std::uint32_t> (Id).
   template <class F>
   void for_each_field(F&& f) {
     visit_fields(*this, f);

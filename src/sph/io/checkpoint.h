@@ -26,7 +26,8 @@ namespace sph {
 
 /// The format version this build writes and reads. Version 14 stores the particles' one mass
 /// after the next id, where version 13 kept a per-particle "mass" field last among the built-in
-/// fields. Version 13 stores the health monitor's seventh
+/// fields; ids of 32 bits, not 64; and the initial positions only where the run keeps them
+/// (RunSettings::every_field). Version 13 stores the health monitor's seventh
 /// watch (a floating body's depth into the walls) with the others, and changes the meaning of a
 /// boundary-particle scene: the samples' volumes now count the solid beyond their layers, and
 /// DFSPH scales its Jacobi steps on supports wider than about 3 spacings (2D) or 2.15 (3D), both

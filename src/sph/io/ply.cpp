@@ -37,7 +37,7 @@ template <std::floating_point R>
 char* put_value(char* p, R v) {
   return put_le(p, static_cast<float>(v));
 }
-char* put_value(char* p, std::uint64_t id) { return put_le(p, static_cast<std::uint32_t>(id)); }
+char* put_value(char* p, std::uint32_t id) { return put_le(p, id); }
 
 }  // namespace
 

@@ -69,6 +69,8 @@ template <class T>
 const std::vector<T>& frame_values(const std::vector<T>& v) {
   return v;
 }
+/// Ids: 32 bits in memory, UInt64 in VTU frames (as they always were written).
+std::vector<std::uint64_t> frame_values(const std::vector<std::uint32_t>& v) { return {v.begin(), v.end()}; }
 
 /// PointData's Scalars= and Vectors= attributes: the fields ParaView shows first.
 template <int D, std::floating_point R>
@@ -164,13 +166,12 @@ void write_legacy_vtk(const std::filesystem::path& path, const ParticleSet<D, R>
   s += fmt::format("\nPOINT_DATA {}\nFIELD FieldData {}\n", n, arrays);
   for_each_frame_field(ps, fields, [&](const FieldDesc& f, const auto& column) {
     using T = typename std::decay_t<decltype(column)>::value_type;
-    if constexpr (std::is_same_v<T, std::uint64_t>) {
-      // 32 bits: ids stay below the 2e9 particles a scene may hold, and every reader knows
-      // unsigned_int (64-bit types are spelt differently by VTK versions).
-      std::vector<std::uint32_t> id(n);
-      for (std::size_t i = 0; i < n; ++i) id[i] = static_cast<std::uint32_t>(column[i]);
+    if constexpr (std::is_same_v<T, std::uint32_t>) {
+      // 32 bits, as the particles keep them (ids stay below the 2e9 particles a scene may
+      // hold), and every reader knows unsigned_int (64-bit types are spelt differently by VTK
+      // versions).
       s += fmt::format("{} {} {} {}\n", f.name, 1, n, "unsigned_int");
-      append_big_endian(s, id);
+      append_big_endian(s, column);
     } else {
       s += fmt::format("{} {} {} {}\n", f.name, f.components(), n, real);
       append_big_endian(s, frame_values(column));

@@ -171,8 +171,6 @@ void ensure_room(std::vector<std::uint32_t>& buf, std::size_t need) {
   if (buf.size() >= need) return;
   std::size_t size = std::max(need, buf.size() + buf.size() / 32 + 256);
   if (need <= buf.capacity()) size = std::min(size, buf.capacity());  // (no reallocation while it fits)
-  // (exactly that: resize() alone would take twice the old size, as std::vector grows)
-  if (size > buf.capacity()) buf.reserve(size);
   buf.resize(size);
 }
 

@@ -104,10 +104,12 @@ struct StepsRow {
   /// the machine"): the list entries (fluid and boundary) each of the two pair passes (density,
   /// forces) visits per particle and step, the share of the fluid entries closer than h (1 for
   /// lists of exactly the pairs within h; less with a skin), and the pair visits both passes
-  /// achieve per second of their own time and per thread.
+  /// achieve per second of their own time and per thread (the force pass's alone where the
+  /// density sums are made in the list build: StepInfo::density_in_lists, the standard mode).
   double pair_visits_per_particle = 0;
   double within_h_fraction = 0;
   double pair_visits_per_core_second = 0;
+  bool density_in_lists = false;         ///< the density sums were made in the list build (their time is the lists')
   std::int64_t baseline_rss_bytes = -1;  ///< VmRSS before the simulation was built
   std::int64_t peak_rss_bytes = -1;      ///< VmHWM after the run
   bool peak_reset = false;               ///< the peak counter was reset before the build

@@ -210,6 +210,7 @@ json steps_json(const BenchResult& r) {
                        {"pair_visits_per_particle", x.pair_visits_per_particle},
                        {"within_h_fraction", x.within_h_fraction},
                        {"pair_visits_per_core_second", x.pair_visits_per_core_second},
+                       {"density_in_lists", x.density_in_lists},
                        {"memory",
                         {{"baseline_rss_bytes", x.baseline_rss_bytes},
                          {"peak_rss_bytes", x.peak_rss_bytes},

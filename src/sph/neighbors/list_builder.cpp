@@ -36,10 +36,12 @@ struct Stencil {
 /// With `far` (room for every candidate): the neighbors closer than sqrt(inner2) go to out, the
 /// others to far, and the caller appends far's to out's (gather() does: the list then holds its
 /// entries closer than the inner radius first, each part in the grid's order).
+/// With `dist` (room for every candidate; not with `far`): each neighbor's squared distance, at
+/// its place in out.
 template <int D, std::floating_point R>
 std::uint32_t gather_scalar(const UniformGrid<D, R>& grid, const Stencil<D, R>& st, const Vec<D, R>& x,
                             std::uint32_t self, R r2, std::uint32_t* out, R inner2 = 0, std::uint32_t* far = nullptr,
-                            std::uint32_t* far_count = nullptr) {
+                            std::uint32_t* far_count = nullptr, R* dist = nullptr) {
   const std::uint32_t* sorted = grid.sorted();
   const R* c[D];
   for (int d = 0; d < D; ++d) c[d] = grid.sorted_coord(d);
@@ -57,16 +59,18 @@ std::uint32_t gather_scalar(const UniformGrid<D, R>& grid, const Stencil<D, R>& 
         continue;
       }
       out[m] = sorted[k];
+      if (dist) dist[m] = d2;
       m += static_cast<std::uint32_t>(hit);
     }
   return m;
 }
 
 #if SPH_SIMD_AVX512
-template <bool kSplit, int D>
+template <bool kSplit, bool kDist, int D>
 std::uint32_t gather_vector(const UniformGrid<D, double>& grid, const Stencil<D, double>& st, const Vec<D, double>& x,
                             std::uint32_t self, double r2, std::uint32_t* out, double inner2, std::uint32_t* far,
-                            std::uint32_t* far_count) {
+                            std::uint32_t* far_count, double* dist) {
+  static_assert(!(kSplit && kDist), "squared distances of whole lists only");
   const std::uint32_t* sorted = grid.sorted();
   const double* c[D];
   __m512d xv[D];
@@ -95,6 +99,7 @@ std::uint32_t gather_vector(const UniformGrid<D, double>& grid, const Stencil<D,
       }
       // Register compress + plain store: the memory form of vpcompressd is slow on some CPUs.
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + m), _mm256_maskz_compress_epi32(hit, idx));
+      if constexpr (kDist) _mm512_storeu_pd(dist + m, _mm512_maskz_compress_pd(hit, d2));
       m += static_cast<std::uint32_t>(__builtin_popcount(hit));
     }
   }
@@ -102,10 +107,11 @@ std::uint32_t gather_vector(const UniformGrid<D, double>& grid, const Stencil<D,
   return m;
 }
 
-template <bool kSplit, int D>
+template <bool kSplit, bool kDist, int D>
 std::uint32_t gather_vector(const UniformGrid<D, float>& grid, const Stencil<D, float>& st, const Vec<D, float>& x,
                             std::uint32_t self, float r2, std::uint32_t* out, float inner2, std::uint32_t* far,
-                            std::uint32_t* far_count) {
+                            std::uint32_t* far_count, float* dist) {
+  static_assert(!(kSplit && kDist), "squared distances of whole lists only");
   const std::uint32_t* sorted = grid.sorted();
   const float* c[D];
   __m512 xv[D];
@@ -133,6 +139,7 @@ std::uint32_t gather_vector(const UniformGrid<D, float>& grid, const Stencil<D, 
         hit = hit & static_cast<__mmask16>(~outer);
       }
       _mm512_storeu_si512(out + m, _mm512_maskz_compress_epi32(hit, idx));
+      if constexpr (kDist) _mm512_storeu_ps(dist + m, _mm512_maskz_compress_ps(hit, d2));
       m += static_cast<std::uint32_t>(__builtin_popcount(hit));
     }
   }
@@ -144,20 +151,23 @@ std::uint32_t gather_vector(const UniformGrid<D, float>& grid, const Stencil<D, 
 /// List i: the neighbors of point `self` (at x) into out, as gather_scalar, and returns how many.
 /// With `far` (room for every candidate and a register), those closer than sqrt(inner2) first,
 /// then the others; `filter` (if any) keeps what it wants of the others (of all, without `far`).
+/// With `dist` (room for every candidate and a register; neither `far` nor `filter`), the
+/// entries' squared distances too.
 template <int D, std::floating_point R>
 std::uint32_t gather(bool vector, const UniformGrid<D, R>& grid, const Stencil<D, R>& st, const Vec<D, R>& x,
                      std::uint32_t self, R r2, std::uint32_t* out, R inner2, std::uint32_t* far,
-                     const ListFilter* filter, std::size_t i) {
+                     const ListFilter* filter, std::size_t i, R* dist = nullptr) {
   std::uint32_t m = 0, f = 0;
 #if SPH_SIMD_AVX512
   if (vector)
-    m = far ? gather_vector<true, D>(grid, st, x, self, r2, out, inner2, far, &f)
-            : gather_vector<false, D>(grid, st, x, self, r2, out, inner2, far, &f);
+    m = far    ? gather_vector<true, false, D>(grid, st, x, self, r2, out, inner2, far, &f, dist)
+        : dist ? gather_vector<false, true, D>(grid, st, x, self, r2, out, inner2, far, &f, dist)
+               : gather_vector<false, false, D>(grid, st, x, self, r2, out, inner2, far, &f, dist);
   else
-    m = gather_scalar<D, R>(grid, st, x, self, r2, out, inner2, far, &f);
+    m = gather_scalar<D, R>(grid, st, x, self, r2, out, inner2, far, &f, dist);
 #else
   (void)vector;
-  m = gather_scalar<D, R>(grid, st, x, self, r2, out, inner2, far, &f);
+  m = gather_scalar<D, R>(grid, st, x, self, r2, out, inner2, far, &f, dist);
 #endif
   if (f > 0) std::copy_n(far, f, out + m);
   const std::uint32_t inner = far ? m : 0;
@@ -190,11 +200,12 @@ template <int D, std::floating_point R>
                                                         std::vector<std::uint32_t>& spill, bool vector,
                                                         const UniformGrid<D, R>& grid, const Stencil<D, R>& st,
                                                         const Vec<D, R>& x, std::uint32_t self, R r2, R inner2,
-                                                        std::uint32_t* far, const ListFilter* filter, std::size_t i) {
+                                                        std::uint32_t* far, const ListFilter* filter, std::size_t i,
+                                                        R* dist = nullptr) {
   const bool fits = buf.size() >= at + st.candidates + kRoom;
   if (!fits) ensure_room(spill, st.candidates + kRoom);
   std::uint32_t* const out = fits ? buf.data() + at : spill.data();
-  const std::uint32_t m = gather(vector, grid, st, x, self, r2, out, inner2, far, filter, i);
+  const std::uint32_t m = gather(vector, grid, st, x, self, r2, out, inner2, far, filter, i, dist);
   if (!fits) {
     ensure_room(buf, at + m + kRoom);
     std::copy_n(spill.data(), m, buf.data() + at);
@@ -282,6 +293,12 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
   }
   chunk_entries_.resize(chunks);
   size_thread_buffers();
+  SPH_CHECK(!visitor_ || (!filter_ && !(inner_ > R(0)) && !room_), "a pair visitor sees whole, compact lists");
+  if (visitor_) {
+    dist_.resize(old_copy_.size());
+    for (auto& dist : dist_)
+      if (dist.size() < 4096) dist.resize(4096);  // (grown once, on every thread)
+  }
 
   parallel_chunks(n, [&](std::size_t c, std::size_t b, std::size_t e) {
     // A chunk's first build goes to its thread's scratch, then into a buffer allocated once, at
@@ -292,6 +309,7 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
     const auto thread = static_cast<std::size_t>(thread_index());  // (once per chunk: a call into the runtime)
     std::vector<std::uint32_t>& buf = first ? old_copy_[thread] : own;
     std::vector<std::uint32_t>& spill = spill_[thread];
+    std::vector<R>* const dist = visitor_ ? &dist_[thread] : nullptr;
     Stencil<D, R> st;
     std::size_t used = 0, entries = 0;
     std::uint32_t cells[kChunkSize];  // the chunk's cells, in one loop
@@ -299,8 +317,10 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
     query.cells(b, e, cells);
     for (std::size_t i = b; i < e; ++i) {
       st.update(grid, cells[i - b]);
+      if (dist && dist->size() < st.candidates + kRoom) dist->resize(st.candidates + kRoom);
       const std::uint32_t m = gather_into(buf, used, spill, vector_, grid, st, query.x(i), query.self(i), r2, inner2(),
-                                          far_room(st.candidates), filter_, i);
+                                          far_room(st.candidates), filter_, i, dist ? dist->data() : nullptr);
+      if (dist) visitor_->visit(i, {buf.data() + used, m}, {dist->data(), m});
       if (room_) out.begin_[i] = static_cast<std::uint32_t>(used);
       out.end_[i] = static_cast<std::uint32_t>(used + m);
       entries += m;

@@ -37,6 +37,17 @@ struct ListFilter {
   virtual std::uint32_t keep(std::size_t i, std::uint32_t* list, std::uint32_t len) const = 0;
 };
 
+/// Sees each list ListBuilder::build() gathers, with the squared distances of its entries (the
+/// same values the distance test compared, in the list's order), while they are at hand: the
+/// standard mode's density sums are made there (wcsph.h, PairDensity), without gathering the
+/// neighbors' positions again. Called from the thread that builds the list; `r2` is readable
+/// (stale values) for NeighborLists::kPadding entries past its end.
+template <std::floating_point R>
+struct PairVisitor {
+  virtual ~PairVisitor() = default;
+  virtual void visit(std::size_t i, std::span<const std::uint32_t> list, std::span<const R> r2) const = 0;
+};
+
 template <int D, std::floating_point R>
 class ListBuilder {
  public:
@@ -79,6 +90,9 @@ class ListBuilder {
   /// entries closer than `inner` are kept as they are. 0 (the default): every list in the grid's
   /// order, all of it filtered.
   void split_at(R inner) { inner_ = inner; }
+  /// Every list build() makes from now on is shown to `visitor` (null: none) with its squared
+  /// distances. Not with a filter, split lists or room (the tracked modes'), nor in rebuild_some().
+  void set_pair_visitor(const PairVisitor<R>* visitor) { visitor_ = visitor; }
   /// The capacity a list of `size` entries is built with when lists keep room: a quarter more and 4.
   static std::uint32_t list_capacity(std::uint32_t size) { return size + size / 4 + 4; }
 
@@ -106,6 +120,8 @@ class ListBuilder {
   R inner_ = 0;
   std::vector<std::vector<std::uint32_t>> far_;  // one per thread: split_at's outer entries
   const ListFilter* filter_ = nullptr;
+  const PairVisitor<R>* visitor_ = nullptr;
+  std::vector<std::vector<R>> dist_;  // one per thread: the squared distances of the list visitor_ sees
   std::vector<std::size_t> chunk_entries_;
   std::vector<std::int64_t> chunk_delta_;
   std::vector<std::size_t> chunk_written_;

@@ -7,6 +7,7 @@
 #include <sph/core/particle_set.h>
 #include <sph/neighbors/boundary_lists.h>
 #include <sph/neighbors/cluster_pairs.h>
+#include <sph/neighbors/list_builder.h>
 #include <sph/neighbors/neighbor_lists.h>
 #include <sph/neighbors/neighbor_mode.h>
 #include <sph/neighbors/uniform_grid.h>
@@ -59,6 +60,14 @@ class NeighborStrategy {
   /// of clusters), which the WCSPH density and force passes then loop over instead of lists();
   /// null for the strategies that keep per-particle lists only.
   virtual const ClusterPairs<D, R>* cluster_pairs() const { return nullptr; }
+  /// Asks that every update() from now on show each fluid list it builds, with its entries'
+  /// squared distances, to `visitor` (null: none; list_builder.h, PairVisitor), in the thread that
+  /// builds it. Returns whether the strategy will: true only where every update() builds every
+  /// fluid list whole (standard); the others ignore the visitor.
+  virtual bool visit_pairs_with(const PairVisitor<R>* visitor) {
+    (void)visitor;
+    return false;
+  }
   /// The simulated time (s) of the state the next update() sees. The tracked modes follow each
   /// particle along a path in time; the others ignore it.
   virtual void set_time(double t) { (void)t; }

@@ -148,6 +148,9 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
   }
   neighbors_ = make_neighbor_strategy<D, R>(params_.neighbors, opt);
   neighbors_->set_boundary(boundary_.position);
+  // Where the strategy builds every list each step (standard), the density sums are made then.
+  pair_density_ = make_pair_density<D, R>(static_cast<R>(params_.kernel_radius), params_.fluid);
+  if (!neighbors_->visit_pairs_with(pair_density_.get())) pair_density_.reset();
   if (params_.audit) auditor_ = std::make_unique<ListAuditor<D, R>>();
   reserve_for_emitters();
   // Density and pressure of the initial state, so that frame 0 shows real values. Exact lists
@@ -519,6 +522,7 @@ const StepInfo& Simulation<D, R>::step() {
   place_obstacles();
   if (boundary_.moving()) neighbors_->move_boundary(boundary_.position);
   neighbors_->set_time(time());
+  if (pair_density_) pair_density_->aim(particles_);
   neighbors_->update(particles_);
   info.neighbors = neighbors_->counters();
   if (boundary_.moving()) {  // (for strategies that rebuild lists on their own schedule)
@@ -566,7 +570,9 @@ const StepInfo& Simulation<D, R>::step() {
 
   Stopwatch watch;
   // (DFSPH: the EOS pressure this pass computes is replaced by the density solve's)
-  info.pairs_within_h = compute_density_pressure(particles_, lists, h, params_.fluid, solid, clusters);
+  info.density_in_lists = pair_density_ != nullptr;
+  info.pairs_within_h =
+      compute_density_pressure(particles_, lists, h, params_.fluid, solid, clusters, info.density_in_lists);
   const R rho0 = static_cast<R>(params_.fluid.rest_density);
   if (dfsph_) {
     const SmoothingKernels<D, R> kernels(params_.fluid, h);

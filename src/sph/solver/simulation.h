@@ -42,14 +42,17 @@ struct StepInfo {
   bool reordered = false;   ///< particles were reordered in memory (Morton curve) this step
   NeighborCounters neighbors;
   std::uint64_t pairs_within_h = 0;  ///< listed (directed) pairs closer than h this step
-  bool audited = false;              ///< SimulationParams::audit was on: `audit` is filled
-  ListAudit audit;                   ///< pairs within h that the lists missed this step
-  ListAudit boundary_audit;          ///< fluid-boundary pairs within h the boundary lists missed
-  PhaseTimes seconds;                ///< (the audit's own time is in none of the phases)
-  HealthStats health;                ///< measured in the integrate pass, judged by the health monitor
-  SolveStats density_solve;          ///< DFSPH: the constant-density solve (0 iterations with WCSPH)
-  SolveStats divergence_solve;       ///< DFSPH: the divergence solve
-  SolveStats viscosity_solve;        ///< Fluid.viscositySolver "implicit": the viscosity solve
+  /// The fluid pairs' density sums were made while the lists were built (standard mode,
+  /// PairDensity): their time is in seconds.lists, and seconds.density holds the rest of the pass.
+  bool density_in_lists = false;
+  bool audited = false;         ///< SimulationParams::audit was on: `audit` is filled
+  ListAudit audit;              ///< pairs within h that the lists missed this step
+  ListAudit boundary_audit;     ///< fluid-boundary pairs within h the boundary lists missed
+  PhaseTimes seconds;           ///< (the audit's own time is in none of the phases)
+  HealthStats health;           ///< measured in the integrate pass, judged by the health monitor
+  SolveStats density_solve;     ///< DFSPH: the constant-density solve (0 iterations with WCSPH)
+  SolveStats divergence_solve;  ///< DFSPH: the divergence solve
+  SolveStats viscosity_solve;   ///< Fluid.viscositySolver "implicit": the viscosity solve
 };
 
 namespace detail {
@@ -233,6 +236,7 @@ class Simulation {
   std::vector<Vec<D, R>> body_acceleration_, body_velocity_change_;
   std::vector<double> body_partial_;  // per-chunk sums of the bodies' loads
   std::unique_ptr<NeighborStrategy<D, R>> neighbors_;
+  std::unique_ptr<PairDensity<D, R>> pair_density_;  // the density sums the strategy's builds make (null: none)
   std::unique_ptr<ListAuditor<D, R>> auditor_;
   MortonOrder<D, R> morton_;
   mutable std::vector<double> partial_;             // per-chunk partial sums (kept: no allocation per step)

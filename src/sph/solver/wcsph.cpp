@@ -190,6 +190,35 @@ template <KernelKind K, int D, std::floating_point R, class M>
   return sum;
 }
 
+/// density_sum's sum over one list whose squared distances are at hand (PairDensity): the same
+/// terms in the same lanes, loaded instead of computed from gathered positions.
+template <KernelKind K, int D, std::floating_point R>
+simd::Pack<R> density_sum_of(std::span<const R> r2s, R mass, const DensityKernel<K, D, R>& dk) {
+  using P = simd::Pack<R>;
+  constexpr int W = simd::kLanes<R>;
+  const P one_mass = P::set1(mass);
+  P sum = P::set1(R(0));
+  for (std::size_t k0 = 0; k0 < r2s.size(); k0 += W) {
+    const P r2 = P::load(r2s.data() + k0);
+    const Mask in = simd::first_lanes<R>(r2s.size() - k0) & (r2 < dk.h2v);
+    sum = sum + density_term<K, D>(r2, in, one_mass, dk.h2v, dk.normv, dk.kernel);
+  }
+  return sum;
+}
+
+template <KernelKind K, int D, std::floating_point R>
+class KernelPairDensity final : public PairDensity<D, R> {
+ public:
+  explicit KernelPairDensity(R h) : dk_(h) {}
+  void visit(std::size_t i, std::span<const std::uint32_t> list, std::span<const R> r2) const override {
+    (void)list;
+    this->density_[i] = simd::sum_lanes(density_sum_of<K, D>(r2, this->mass_, dk_));
+  }
+
+ private:
+  DensityKernel<K, D, R> dk_;
+};
+
 /// What both density passes do with a particle's sum over its fluid pairs: add its own mass's
 /// m_i W(0) and its boundary samples' psi_b W_ib (Akinci et al. 2012 eq. 6: psi in place of the
 /// mass), store the density and the EOS pressure.
@@ -229,7 +258,7 @@ class DensityStore {
 
 template <KernelKind K, int D, std::floating_point R>
 std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                           const BoundaryView<D, R>& boundary, std::vector<std::uint64_t>& within) {
+                           const BoundaryView<D, R>& boundary, std::vector<std::uint64_t>& within, bool pairs_summed) {
   using P = simd::Pack<R>;
   const DensityStore<K, D, R> store(ps, h, fluid, boundary);
   const DensityKernel<K, D, R> dk(h);
@@ -240,10 +269,13 @@ std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
     for (std::size_t i = b; i < e; ++i) {
       P xi[D];
       for (int d = 0; d < D; ++d) xi[d] = P::set1(ps.position[i][d]);
-      store(i, xi, simd::sum_lanes(density_sum<K, D>(xi, pos, ps.mass, lists.of(i), dk, count)), boundary_count);
+      const R pairs =
+          pairs_summed ? ps.density[i] : simd::sum_lanes(density_sum<K, D>(xi, pos, ps.mass, lists.of(i), dk, count));
+      store(i, xi, pairs, boundary_count);
     }
     within[c] = count;
   });
+  if (pairs_summed) return lists.entry_count();
   std::uint64_t total = 0;
   for (std::uint64_t w : within) total += w;
   return total;
@@ -888,7 +920,9 @@ void corrected_pressure_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, 
 
 template <int D, std::floating_point R>
 std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
-                                       const BoundaryView<D, R>& boundary, const ClusterPairs<D, R>* clusters) {
+                                       const BoundaryView<D, R>& boundary, const ClusterPairs<D, R>* clusters,
+                                       bool pairs_summed) {
+  SPH_CHECK(!(clusters && pairs_summed), "pairs are summed while per-particle lists are built");
   if (clusters)
     check_cluster_inputs(ps, *clusters);
   else
@@ -898,7 +932,7 @@ std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborList
   ClusterData<D, R>& data = kept_cluster_data<D, R>();
   const auto run = [&]<KernelKind kKernel>() {
     return clusters ? cluster_density_pass<kKernel>(ps, *clusters, h, fluid, boundary, within, data)
-                    : density_pass<kKernel>(ps, lists, h, fluid, boundary, within);
+                    : density_pass<kKernel>(ps, lists, h, fluid, boundary, within, pairs_summed);
   };
   switch (fluid.kernel) {
     case KernelKind::Cubic:
@@ -996,10 +1030,24 @@ double lattice_mass(double rest_density, double spacing, double h, KernelKind ke
   return rest_density / sum;
 }
 
+template <int D, std::floating_point R>
+std::unique_ptr<PairDensity<D, R>> make_pair_density(R h, const FluidParams& fluid) {
+  switch (fluid.kernel) {
+    case KernelKind::Cubic:
+      return std::make_unique<KernelPairDensity<KernelKind::Cubic, D, R>>(h);
+    case KernelKind::Wendland:
+      return std::make_unique<KernelPairDensity<KernelKind::Wendland, D, R>>(h);
+    case KernelKind::Paper:
+      break;
+  }
+  return std::make_unique<KernelPairDensity<KernelKind::Paper, D, R>>(h);
+}
+
 #define SPH_INSTANTIATE(D, R)                                                                                       \
   template std::uint64_t compute_density_pressure<D, R>(ParticleSet<D, R>&, const NeighborLists&, R,                \
                                                         const FluidParams&, const BoundaryView<D, R>&,              \
-                                                        const ClusterPairs<D, R>*);                                 \
+                                                        const ClusterPairs<D, R>*, bool);                           \
+  template std::unique_ptr<PairDensity<D, R>> make_pair_density<D, R>(R, const FluidParams&);                       \
   template void compute_accelerations<D, R>(ParticleSet<D, R>&, const NeighborLists&, R, const FluidParams&,        \
                                             const Vec<D, R>&, const WallContact<D, R>&, std::span<std::uint8_t>, R, \
                                             const BoundaryView<D, R>&, R, bool, const ClusterPairs<D, R>*);

@@ -4,11 +4,13 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <memory>
 #include <span>
 #include <vector>
 
 #include <sph/core/particle_set.h>
 #include <sph/neighbors/cluster_pairs.h>
+#include <sph/neighbors/list_builder.h>
 #include <sph/neighbors/neighbor_lists.h>
 #include <sph/solver/params.h>
 
@@ -75,10 +77,40 @@ struct BoundaryView {
 /// With `clusters` (cluster pairs covering every fluid pair within h: the verlet_clusters mode)
 /// the fluid pairs are taken from them and `lists` is not read. The sums are the same terms,
 /// added in another order: results agree with the per-particle lists' to rounding.
+///
+/// With `pairs_summed` (not with clusters), ps.density already holds each particle's sum over
+/// its fluid pairs, made by a PairDensity while `lists` were built: the pass adds the rest (its
+/// own mass's term, the boundary samples') and the pressure, and returns the lists' entries
+/// (every entry is then closer than h). The same bits as the pass that sums over the lists.
 template <int D, std::floating_point R>
 std::uint64_t compute_density_pressure(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                                        const BoundaryView<D, R>& boundary = {},
-                                       const ClusterPairs<D, R>* clusters = nullptr);
+                                       const ClusterPairs<D, R>* clusters = nullptr, bool pairs_summed = false);
+
+/// The density sums over the fluid pairs, made while the lists are built
+/// (NeighborStrategy::visit_pairs_with), from the squared distances the list build computed:
+/// each list's sum_j m W(|x_ij|), the same terms added in the same lanes and order as
+/// compute_density_pressure's pass over the lists (the same bits), without gathering the
+/// neighbors' positions again. Each sum goes to the aimed set's density field, for
+/// compute_density_pressure(..., pairs_summed = true) to complete. Lists must hold pairs closer
+/// than h only (the standard mode's).
+template <int D, std::floating_point R>
+class PairDensity : public PairVisitor<R> {
+ public:
+  /// The set whose lists the next build makes (its density field receives the sums).
+  void aim(ParticleSet<D, R>& ps) {
+    density_ = ps.density.data();
+    mass_ = ps.mass;
+  }
+
+ protected:
+  R* density_ = nullptr;
+  R mass_ = 0;
+};
+
+/// The PairDensity of the fluid's density kernel with support h.
+template <int D, std::floating_point R>
+std::unique_ptr<PairDensity<D, R>> make_pair_density(R h, const FluidParams& fluid);
 
 /// The damped penalty acceleration of the container walls and the obstacles on one particle.
 /// A particle interacts with a wall plane when closer than `particle_radius` to it; the contact

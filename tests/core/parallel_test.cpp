@@ -1,7 +1,7 @@
 // The parallel loops' split between threads: balance_loops gives each thread a contiguous run
 // of items holding about an equal share of the work (parallel_chunks: the nearest run of
-// chunks), every item is still visited exactly once
-// (by parallel_for and parallel_chunks, under the split, for other counts and for a team of
+// chunks; parallel_runs: the same runs as parallel_for), every item is still visited exactly once
+// (by parallel_for, parallel_chunks and parallel_runs, under the split, for other counts and for a team of
 // another size), and clear_balance splits evenly again.
 
 #include <algorithm>
@@ -19,15 +19,25 @@ namespace {
 
 using test::ThreadCount;
 
-/// The thread that ran each item of parallel_for(n), and of parallel_chunks(n) (by chunk); every
-/// entry is checked to have been written exactly once.
+/// The thread that ran each item of parallel_for(n), of parallel_chunks(n) (by chunk) and of
+/// parallel_runs(n) (by run); every entry is checked to have been written exactly once.
 struct Owners {
-  std::vector<int> of_item, of_chunk_item;
+  std::vector<int> of_item, of_chunk_item, of_run_item;
 };
 
 Owners run_loops(std::size_t n) {
-  Owners o{std::vector<int>(n, -1), std::vector<int>(n, -1)};
-  std::vector<int> visits(n, 0), chunk_visits(n, 0);
+  Owners o{std::vector<int>(n, -1), std::vector<int>(n, -1), std::vector<int>(n, -1)};
+  std::vector<int> visits(n, 0), chunk_visits(n, 0), run_visits(n, 0);
+  std::vector<int> runs(static_cast<std::size_t>(num_threads()), 0);
+  parallel_runs(n, [&](std::size_t first, std::size_t last) {
+    EXPECT_LT(first, last) << "an empty run";
+    ++runs[static_cast<std::size_t>(thread_index())];
+    for (std::size_t i = first; i < last; ++i) {
+      o.of_run_item[i] = thread_index();
+      ++run_visits[i];
+    }
+  });
+  for (int r : runs) EXPECT_LE(r, 1) << "one run a thread";
   parallel_for(n, [&](std::size_t i) {
     o.of_item[i] = thread_index();
     ++visits[i];
@@ -43,6 +53,7 @@ Owners run_loops(std::size_t n) {
   for (std::size_t i = 0; i < n; ++i) {
     EXPECT_EQ(visits[i], 1) << "parallel_for, item " << i;
     EXPECT_EQ(chunk_visits[i], 1) << "parallel_chunks, item " << i;
+    EXPECT_EQ(run_visits[i], 1) << "parallel_runs, item " << i;
   }
   return o;
 }
@@ -64,6 +75,7 @@ TEST(BalanceLoops, SplitsTheWorkNotTheItems) {
   const Owners balanced = run_loops(n);
   const std::size_t items_first = 6 * kChunkSize + kChunkSize * 2 / 3;  // (the item 6 2/3 chunks in)
   EXPECT_EQ(first_of_thread_one(balanced.of_item), items_first);
+  EXPECT_EQ(balanced.of_run_item, balanced.of_item) << "parallel_runs runs parallel_for's runs";
   EXPECT_EQ(first_of_thread_one(balanced.of_chunk_item), 7 * kChunkSize) << "the chunk boundary nearest to it";
   // One contiguous run each: thread 0 before the first item of thread 1, thread 1 from it.
   for (const auto* owner : {&balanced.of_item, &balanced.of_chunk_item}) {
@@ -83,6 +95,7 @@ TEST(BalanceLoops, SplitsTheWorkNotTheItems) {
   clear_balance();
   const Owners even = run_loops(n);
   EXPECT_NEAR(static_cast<double>(first_of_thread_one(even.of_item)), n / 2.0, 1.0);
+  EXPECT_NEAR(static_cast<double>(first_of_thread_one(even.of_run_item)), n / 2.0, 1.0);
   EXPECT_NEAR(static_cast<double>(first_of_thread_one(even.of_chunk_item)), n / 2.0, kChunkSize);
 }
 

@@ -96,6 +96,20 @@ std::size_t chunk_count(std::size_t n) {
   return (n + Size - 1) / Size;
 }
 
+/// Calls f(begin, end) once in each thread with the thread's contiguous run [begin, end) of
+/// [0, n) (parallel_for's runs: balanced by balance_loops when it applies to n), none empty, in
+/// parallel: for loops that handle their items a few at a time. f must only write data owned by
+/// the indices of its run.
+template <class F>
+void parallel_runs(std::size_t n, F&& f) {
+  const detail::LoopSplit& split = detail::loop_split();
+#pragma omp parallel
+  {
+    const auto [first, last] = detail::item_run(split, n);
+    if (first < last) f(first, last);
+  }
+}
+
 /// Calls f(chunk, begin, end) for each chunk of [0, n) of size Size, in parallel.
 /// The chunks are the same for any thread count, so per-chunk partial results combined in
 /// chunk order give thread-count-independent results. Each thread takes one contiguous run of

@@ -197,4 +197,73 @@ inline R sum_lanes(const Pack<R>& p) {
   return s;
 }
 
+/// sum_lanes of a register's worth of packs at once: out[k] = sum_lanes(p[k]) for k < count, bit
+/// for bit (the same additions in the same order), p holding kLanes<R> packs (those from count on
+/// are read, their sums not written). With AVX-512 the packs are transposed, so that lane k of
+/// the j-th register holds lane j of p[k], and the registers are added in lane order: a register's
+/// sums in kLanes<R> vector additions instead of one chain of scalar ones per pack.
+template <class R>
+inline void sum_lanes_each(const Pack<R>* p, int count, R* out) {
+#if SPH_SIMD_AVX512
+  // (maskz forms throughout: GCC 12's plain ones start from an undefined register, and warn)
+  R sums[kLanes<R>];
+  if constexpr (sizeof(R) == 4) {
+    // r_k = p[k]. Within each 128-bit block j: 32-bit, then 64-bit interleaves (u[4g + m] holds
+    // rows 4g..4g+3 of element 4j + m), then the blocks gathered across four registers.
+    __m512 t[16], u[16];
+    for (int g = 0; g < 8; ++g) {
+      t[2 * g] = _mm512_maskz_unpacklo_ps(0xffff, p[2 * g].v, p[2 * g + 1].v);
+      t[2 * g + 1] = _mm512_maskz_unpackhi_ps(0xffff, p[2 * g].v, p[2 * g + 1].v);
+    }
+    for (int g = 0; g < 4; ++g) {
+      const __m512d a = _mm512_castps_pd(t[4 * g]), b = _mm512_castps_pd(t[4 * g + 2]);
+      const __m512d c = _mm512_castps_pd(t[4 * g + 1]), d = _mm512_castps_pd(t[4 * g + 3]);
+      u[4 * g] = _mm512_castpd_ps(_mm512_maskz_unpacklo_pd(0xff, a, b));
+      u[4 * g + 1] = _mm512_castpd_ps(_mm512_maskz_unpackhi_pd(0xff, a, b));
+      u[4 * g + 2] = _mm512_castpd_ps(_mm512_maskz_unpacklo_pd(0xff, c, d));
+      u[4 * g + 3] = _mm512_castpd_ps(_mm512_maskz_unpackhi_pd(0xff, c, d));
+    }
+    __m512 f[16];  // f[e]: lane k = element e of row k
+    for (int m = 0; m < 4; ++m) {
+      const __m512 p0 = _mm512_maskz_shuffle_f32x4(0xffff, u[m], u[4 + m], _MM_SHUFFLE(2, 0, 2, 0));
+      const __m512 p1 = _mm512_maskz_shuffle_f32x4(0xffff, u[m], u[4 + m], _MM_SHUFFLE(3, 1, 3, 1));
+      const __m512 q0 = _mm512_maskz_shuffle_f32x4(0xffff, u[8 + m], u[12 + m], _MM_SHUFFLE(2, 0, 2, 0));
+      const __m512 q1 = _mm512_maskz_shuffle_f32x4(0xffff, u[8 + m], u[12 + m], _MM_SHUFFLE(3, 1, 3, 1));
+      f[m] = _mm512_maskz_shuffle_f32x4(0xffff, p0, q0, _MM_SHUFFLE(2, 0, 2, 0));
+      f[8 + m] = _mm512_maskz_shuffle_f32x4(0xffff, p0, q0, _MM_SHUFFLE(3, 1, 3, 1));
+      f[4 + m] = _mm512_maskz_shuffle_f32x4(0xffff, p1, q1, _MM_SHUFFLE(2, 0, 2, 0));
+      f[12 + m] = _mm512_maskz_shuffle_f32x4(0xffff, p1, q1, _MM_SHUFFLE(3, 1, 3, 1));
+    }
+    __m512 s = _mm512_setzero_ps();
+    for (int e = 0; e < 16; ++e) s = _mm512_add_ps(s, f[e]);
+    _mm512_storeu_ps(sums, s);
+  } else {
+    // Within each 128-bit block j: a 64-bit interleave (t[2g + m] holds rows 2g, 2g + 1 of
+    // element 2j + m), then the blocks gathered across four registers.
+    __m512d t[8];
+    for (int g = 0; g < 4; ++g) {
+      t[2 * g] = _mm512_maskz_unpacklo_pd(0xff, p[2 * g].v, p[2 * g + 1].v);
+      t[2 * g + 1] = _mm512_maskz_unpackhi_pd(0xff, p[2 * g].v, p[2 * g + 1].v);
+    }
+    __m512d f[8];
+    for (int m = 0; m < 2; ++m) {
+      const __m512d p0 = _mm512_maskz_shuffle_f64x2(0xff, t[m], t[2 + m], _MM_SHUFFLE(2, 0, 2, 0));
+      const __m512d p1 = _mm512_maskz_shuffle_f64x2(0xff, t[m], t[2 + m], _MM_SHUFFLE(3, 1, 3, 1));
+      const __m512d q0 = _mm512_maskz_shuffle_f64x2(0xff, t[4 + m], t[6 + m], _MM_SHUFFLE(2, 0, 2, 0));
+      const __m512d q1 = _mm512_maskz_shuffle_f64x2(0xff, t[4 + m], t[6 + m], _MM_SHUFFLE(3, 1, 3, 1));
+      f[m] = _mm512_maskz_shuffle_f64x2(0xff, p0, q0, _MM_SHUFFLE(2, 0, 2, 0));
+      f[4 + m] = _mm512_maskz_shuffle_f64x2(0xff, p0, q0, _MM_SHUFFLE(3, 1, 3, 1));
+      f[2 + m] = _mm512_maskz_shuffle_f64x2(0xff, p1, q1, _MM_SHUFFLE(2, 0, 2, 0));
+      f[6 + m] = _mm512_maskz_shuffle_f64x2(0xff, p1, q1, _MM_SHUFFLE(3, 1, 3, 1));
+    }
+    __m512d s = _mm512_setzero_pd();
+    for (int e = 0; e < 8; ++e) s = _mm512_add_pd(s, f[e]);
+    _mm512_storeu_pd(sums, s);
+  }
+  for (int k = 0; k < count; ++k) out[k] = sums[k];
+#else
+  for (int k = 0; k < count; ++k) out[k] = sum_lanes(p[k]);
+#endif
+}
+
 }  // namespace sph::simd

@@ -40,8 +40,9 @@ struct ListFilter {
 /// Sees each list ListBuilder::build() gathers, with the squared distances of its entries (the
 /// same values the distance test compared, in the list's order), while they are at hand: the
 /// standard mode's density sums are made there (wcsph.h, PairDensity), without gathering the
-/// neighbors' positions again. Called from the thread that builds the list; `r2` is readable
-/// (stale values) for NeighborLists::kPadding entries past its end.
+/// neighbors' positions again. Called from the thread that builds the list: the lists of a chunk
+/// of kChunkSize particles (parallel.h) one after the other, in particle order, in one thread.
+/// `r2` is readable (stale values) for NeighborLists::kPadding entries past its end.
 template <std::floating_point R>
 struct PairVisitor {
   virtual ~PairVisitor() = default;

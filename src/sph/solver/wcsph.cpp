@@ -206,13 +206,23 @@ simd::Pack<R> density_sum_of(std::span<const R> r2s, R mass, const DensityKernel
   return sum;
 }
 
+/// Each list's lanes are kept until a register's worth of consecutive particles have theirs
+/// (a group of kLanes starts at a multiple of kLanes, so lies within one chunk, which one thread
+/// visits in order), then the group's lanes are summed at once (simd::sum_lanes_each: the same
+/// bits as one sum_lanes each, without a chain of scalar additions per particle).
 template <KernelKind K, int D, std::floating_point R>
 class KernelPairDensity final : public PairDensity<D, R> {
  public:
   explicit KernelPairDensity(R h) : dk_(h) {}
   void visit(std::size_t i, std::span<const std::uint32_t> list, std::span<const R> r2) const override {
     (void)list;
-    this->density_[i] = simd::sum_lanes(density_sum_of<K, D>(r2, this->mass_, dk_));
+    constexpr std::size_t W = simd::kLanes<R>;
+    static_assert(kChunkSize % W == 0, "a group of particles lies within one chunk");
+    thread_local simd::Pack<R> group[W];  // (the calling thread's group of particles)
+    const std::size_t slot = i % W;
+    group[slot] = density_sum_of<K, D>(r2, this->mass_, dk_);
+    if (slot == W - 1 || i + 1 == this->particles_)
+      simd::sum_lanes_each(group, static_cast<int>(slot + 1), this->density_ + (i - slot));
   }
 
  private:
@@ -584,31 +594,47 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
   // Every particle's mass, broadcast rather than gathered. (Captured as a real by value: a
   // register of it captured by reference made the 1M bench's force pass 8 % slower.)
   const R m = ps.mass;
-  parallel_for(ps.size(), [&, m](std::size_t i) {
-    const ForceSide<D, R> side = terms.side(i);
-    P acc[D];
-    for (int d = 0; d < D; ++d) acc[d] = P::set1(R(0));
-    bool flag_i = false;
-    const auto nb = lists.of(i);
-    const std::uint32_t* idx = nb.data();
-    for (std::size_t k0 = 0; k0 < nb.size(); k0 += W) {
-      const Mask valid = simd::first_lanes<R>(nb.size() - k0);
-      ForceOther<D, R> j;
-      j.r2 = pair_offsets<D>(side.x, pos, idx + k0, j.rij);
-      j.rho = P::template gather<1>(rho, idx + k0, 0);
-      j.inv_rho = P::set1(R(1)) / j.rho;
-      j.mass = P::set1(m);
-      for (int d = 0; d < D; ++d) j.v[d] = P::template gather<D>(vel, idx + k0, d);
-      if constexpr (kPressure) j.p = P::template gather<1>(prs, idx + k0, 0);
-      terms.pairs(side, j, valid, acc);
-      if constexpr (kExitTest) flag_i = terms.exit_test(side, j, valid, idx + k0) || flag_i;
+  // Each thread's particles a register's worth at a time: their sums' lanes are added together
+  // (simd::sum_lanes_each, the same bits as one sum_lanes each), then each particle finished.
+  parallel_runs(ps.size(), [&, m](std::size_t first, std::size_t last) {
+    P group[D][W];  // (all set: the sums read every pack of a group, used or not)
+    for (auto& packs : group)
+      for (P& pack : packs) pack = P::set1(R(0));
+    std::size_t grouped = 0;
+    for (std::size_t i = first; i < last; ++i) {
+      const ForceSide<D, R> side = terms.side(i);
+      P acc[D];
+      for (int d = 0; d < D; ++d) acc[d] = P::set1(R(0));
+      bool flag_i = false;
+      const auto nb = lists.of(i);
+      const std::uint32_t* idx = nb.data();
+      for (std::size_t k0 = 0; k0 < nb.size(); k0 += W) {
+        const Mask valid = simd::first_lanes<R>(nb.size() - k0);
+        ForceOther<D, R> j;
+        j.r2 = pair_offsets<D>(side.x, pos, idx + k0, j.rij);
+        j.rho = P::template gather<1>(rho, idx + k0, 0);
+        j.inv_rho = P::set1(R(1)) / j.rho;
+        j.mass = P::set1(m);
+        for (int d = 0; d < D; ++d) j.v[d] = P::template gather<D>(vel, idx + k0, d);
+        if constexpr (kPressure) j.p = P::template gather<1>(prs, idx + k0, 0);
+        terms.pairs(side, j, valid, acc);
+        if constexpr (kExitTest) flag_i = terms.exit_test(side, j, valid, idx + k0) || flag_i;
+      }
+      if (terms.solid()) flag_i = terms.boundary(i, side, acc) || flag_i;
+      if constexpr (kExitTest)
+        if (flag_i) terms.set_flag(i);
+      for (int d = 0; d < D; ++d) group[d][grouped] = acc[d];
+      if (++grouped < static_cast<std::size_t>(W) && i + 1 < last) continue;
+      R sums[D][W];
+      for (int d = 0; d < D; ++d) simd::sum_lanes_each(group[d], static_cast<int>(grouped), sums[d]);
+      const std::size_t b = i + 1 - grouped;
+      for (std::size_t k = 0; k < grouped; ++k) {
+        Vec<D, R> total;
+        for (int d = 0; d < D; ++d) total[d] = sums[d][k];
+        terms.finish(b + k, total);
+      }
+      grouped = 0;
     }
-    if (terms.solid()) flag_i = terms.boundary(i, side, acc) || flag_i;
-    if constexpr (kExitTest)
-      if (flag_i) terms.set_flag(i);
-    Vec<D, R> sums;
-    for (int d = 0; d < D; ++d) sums[d] = simd::sum_lanes(acc[d]);
-    terms.finish(i, sums);
   });
 }
 

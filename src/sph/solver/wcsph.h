@@ -101,11 +101,13 @@ class PairDensity : public PairVisitor<R> {
   void aim(ParticleSet<D, R>& ps) {
     density_ = ps.density.data();
     mass_ = ps.mass;
+    particles_ = ps.size();
   }
 
  protected:
   R* density_ = nullptr;
   R mass_ = 0;
+  std::size_t particles_ = 0;
 };
 
 /// The PairDensity of the fluid's density kernel with support h.

@@ -274,14 +274,33 @@ std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
   const DensityKernel<K, D, R> dk(h);
   const R* pos = flat(ps.position);
   within.assign(chunk_count(ps.size()), 0);
+  constexpr std::size_t W = simd::kLanes<R>;
+  // A register's worth of particles at a time: their lanes are added together
+  // (simd::sum_lanes_each: the same bits as one sum_lanes each), then each is stored.
   parallel_chunks(ps.size(), [&](std::size_t c, std::size_t b, std::size_t e) {
     std::uint64_t count = 0, boundary_count = 0;
-    for (std::size_t i = b; i < e; ++i) {
-      P xi[D];
+    P group[W];  // (all set: the sums read every pack of a group, used or not)
+    for (P& pack : group) pack = P::set1(R(0));
+    R pairs[W];
+    P xi[D];
+    const auto at = [&](std::size_t i) {
       for (int d = 0; d < D; ++d) xi[d] = P::set1(ps.position[i][d]);
-      const R pairs =
-          pairs_summed ? ps.density[i] : simd::sum_lanes(density_sum<K, D>(xi, pos, ps.mass, lists.of(i), dk, count));
-      store(i, xi, pairs, boundary_count);
+    };
+    for (std::size_t g = b; g < e; g += W) {
+      const std::size_t size = std::min(e - g, W);
+      if (pairs_summed) {
+        std::copy_n(ps.density.data() + g, size, pairs);
+      } else {
+        for (std::size_t k = 0; k < size; ++k) {
+          at(g + k);
+          group[k] = density_sum<K, D>(xi, pos, ps.mass, lists.of(g + k), dk, count);
+        }
+        simd::sum_lanes_each(group, static_cast<int>(size), pairs);
+      }
+      for (std::size_t k = 0; k < size; ++k) {
+        at(g + k);
+        store(g + k, xi, pairs[k], boundary_count);
+      }
     }
     within[c] = count;
   });

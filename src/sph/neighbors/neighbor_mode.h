@@ -45,7 +45,7 @@ inline constexpr NeighborModeInfo kNeighborModes[] = {
     {NeighborMode::VerletClusters, "verlet_clusters",
      "verlet's exact lists (h + skin, all rebuilt once a particle moved half the skin) held as pairs of clusters of 4 "
      "particles, so that the density and force passes load a neighbor cluster instead of gathering each neighbor: "
-     "the fastest mode on large scenes, slower than verlet on small 3D ones in double (docs/neighbor-modes.md)",
+     "exact as verlet, and slower than it on every scene measured (docs/neighbor-modes.md)",
      true, false, true},
     {NeighborMode::BruteForce, "brute_force", "compares every pair, O(N^2): the tests' oracle, for tiny scenes", false},
 };

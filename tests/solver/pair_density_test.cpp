@@ -4,9 +4,7 @@
 // boundary samples, and for any thread count.
 
 #include <algorithm>
-#include <cmath>
 #include <cstring>
-#include <random>
 
 #include <gtest/gtest.h>
 
@@ -17,6 +15,7 @@
 #include <sph/solver/smoothing.h>
 #include <sph/solver/wcsph.h>
 
+#include "support/blob.h"
 #include "support/thread_count.h"
 
 namespace sph {
@@ -24,41 +23,16 @@ namespace {
 
 using test::ThreadCount;
 
-/// A jittered lattice block of spacing dx (h = 2 spacings), a few coincident pairs and a stray
-/// particle with no neighbor, and boundary samples on a plane below it.
+/// The pass tests' block (support/blob.h) with a few coincident pairs and a stray particle with
+/// no neighbor added.
 template <int D, class R>
-struct Block {
-  ParticleSet<D, R> ps;
-  std::vector<Vec<D, R>> samples;
-  std::vector<R> psi;
-  double dx = 0.02, h = 0.04;
-
-  Block(int side, unsigned seed) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> jit(-0.3 * dx, 0.3 * dx);
-    const int nz = D == 3 ? side : 1;
-    ps.mass = static_cast<R>(1000 * std::pow(dx, D));
-    for (int k = 0; k < nz; ++k)
-      for (int j = 0; j < side; ++j)
-        for (int i = 0; i < side; ++i) {
-          Vec<D, R> x;
-          const int c[3] = {i, j, k};
-          for (int d = 0; d < D; ++d) x[d] = static_cast<R>(c[d] * dx + jit(rng));
-          ps.add(x, Vec<D, R>{});
-        }
+struct Block : test::Blob<D, R> {
+  Block(int side, unsigned seed) : test::Blob<D, R>(side, seed) {
+    ParticleSet<D, R>& ps = this->ps;
     for (int q = 0; q < 5; ++q) ps.add(ps.position[static_cast<std::size_t>(q) * 7], Vec<D, R>{});  // coincident
     Vec<D, R> far;
-    far[0] = static_cast<R>(-10 * h);
+    far[0] = static_cast<R>(-10 * this->h);
     ps.add(far, Vec<D, R>{});
-    for (int b = 0; b < 2 * side; ++b)
-      for (int a = 0; a < (D == 3 ? 2 * side : 1); ++a) {
-        Vec<D, R> x;
-        x[0] = static_cast<R>(b * dx / 2);
-        if constexpr (D == 3) x[1] = static_cast<R>(a * dx / 2);
-        x[D - 1] = static_cast<R>(-dx);
-        samples.push_back(x);
-        psi.push_back(static_cast<R>(0.4) * ps.mass);
-      }
   }
 };
 

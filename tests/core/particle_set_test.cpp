@@ -46,6 +46,19 @@ TEST(ParticleSet, ASetWithoutInitialPositionsLeavesThemOutOfEveryOperation) {
   EXPECT_THROW(ps.keep_initial_positions(true), std::logic_error) << "the positions they were added at are gone";
 }
 
+TEST(ParticleSet, AddingOneOfItsOwnPositionsIsSafeWhileTheArraysGrow) {
+  ParticleSet<3, double> ps;
+  ps.add({1.5, -2.0, 0.25}, {0.1, 0.2, 0.3});
+  for (int k = 0; k < 100; ++k) ps.add(ps.position[0], ps.velocity[0]);  // (the arrays move as they grow)
+  ASSERT_EQ(ps.size(), 101u);
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    EXPECT_EQ(ps.position[i][0], 1.5) << i;
+    EXPECT_EQ(ps.position[i][2], 0.25) << i;
+    EXPECT_EQ(ps.velocity[i][1], 0.2) << i;
+    EXPECT_EQ(ps.initial_position[i][1], -2.0) << i;
+  }
+}
+
 TEST(ParticleSet, PermutationOfWrongSizeIsABug) {
   ParticleSet<2, double> ps;
   ps.add({}, {});

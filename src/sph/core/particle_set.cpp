@@ -74,7 +74,7 @@ void ParticleSet<D, R>::reserve(std::size_t n) {
 }
 
 template <int D, std::floating_point R>
-std::uint64_t ParticleSet<D, R>::add(const V& x, const V& v) {
+std::uint64_t ParticleSet<D, R>::add(V x, V v) {
   SPH_CHECK(next_id_ <= std::numeric_limits<std::uint32_t>::max(), "more particles than 32-bit ids number");
   for_each_field([](const FieldDesc&, auto& column) { column.emplace_back(); });  // zeros
   position.back() = x;

@@ -108,8 +108,9 @@ class ParticleSet {
 
   /// Appends one particle (of the set's `mass`) at rest state (zero acceleration, density,
   /// pressure and added fields) and returns its stable id. Its initial position is x (where the
-  /// set keeps initial positions).
-  std::uint64_t add(const V& x, const V& v);
+  /// set keeps initial positions). x and v are taken by value: one of the set's own positions may
+  /// be passed, though adding moves the arrays.
+  std::uint64_t add(V x, V v);
 
   /// The id the next added particle will get.
   std::uint64_t next_id() const { return next_id_; }

@@ -1,8 +1,10 @@
 // simd::sum_lanes_each against sum_lanes, bit for bit: the transposed sums add each pack's lanes in
-// the same order, on data where another order gives other bits.
+// the same order, on data where another order gives other bits. simd::gather_vectors against the
+// gathers it replaces.
 
 #include <cstring>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -48,6 +50,39 @@ void expect_each_sum_is_sum_lanes() {
 
 TEST(Simd, SumLanesEachIsSumLanesBitForBitFloat) { expect_each_sum_is_sum_lanes<float>(); }
 TEST(Simd, SumLanesEachIsSumLanesBitForBitDouble) { expect_each_sum_is_sum_lanes<double>(); }
+
+// simd::gather_vectors: lane l of out[d] is base[D idx[l] + d], as D gathers would give, for indices
+// anywhere in the array (its last vector included, repeated indices too), each value distinct.
+template <int D, class R>
+void expect_gather_vectors_reads_each_lanes_vector() {
+  constexpr int W = simd::kLanes<R>;
+  constexpr std::uint32_t kVectors = 37;
+  std::vector<R> base(D * kVectors);  // exactly the vectors: the last one ends the array
+  for (std::size_t k = 0; k < base.size(); ++k) base[k] = static_cast<R>(0.5 + static_cast<double>(k) * 1.25);
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 100; ++trial) {
+    std::uint32_t idx[W];
+    for (int l = 0; l < W; ++l) idx[l] = trial % 3 == 0 && l % 4 == 1 ? kVectors - 1 : rng() % kVectors;
+    simd::Pack<R> out[D];
+    simd::gather_vectors<D>(base.data(), idx, out);
+    for (int d = 0; d < D; ++d) {
+      R lanes[W], gathered[W];
+      out[d].store(lanes);
+      simd::Pack<R>::template gather<D>(base.data(), idx, d).store(gathered);
+      for (int l = 0; l < W; ++l) {
+        EXPECT_EQ(lanes[l], base[D * idx[l] + d]) << "component " << d << ", lane " << l << ", trial " << trial;
+        EXPECT_EQ(lanes[l], gathered[l]);
+      }
+    }
+  }
+}
+
+TEST(Simd, GatherVectorsReadsEachLanesVector) {
+  expect_gather_vectors_reads_each_lanes_vector<2, float>();
+  expect_gather_vectors_reads_each_lanes_vector<3, float>();
+  expect_gather_vectors_reads_each_lanes_vector<2, double>();
+  expect_gather_vectors_reads_each_lanes_vector<3, double>();
+}
 
 }  // namespace
 }  // namespace sph

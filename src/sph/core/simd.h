@@ -197,6 +197,63 @@ inline R sum_lanes(const Pack<R>& p) {
   return s;
 }
 
+/// out[d] = Pack<R>::gather<D>(base, idx, d) for every d < D (lane l of out[d] is
+/// base[D idx[l] + d]): a register of D-vectors stored one after another (x0 y0 z0 x1 y1 z1 ...),
+/// the same values. With AVX-512 and D of 2 or 3 each vector is one masked load of its D scalars
+/// (nothing beyond them is read), the loads put side by side and transposed into the D registers:
+/// a gather instruction per component costs several times as much.
+template <int D, class R>
+inline void gather_vectors(const R* base, const std::uint32_t* idx, Pack<R> (&out)[D]) {
+#if SPH_SIMD_AVX512
+  if constexpr (D == 2 || D == 3) {
+    constexpr unsigned kRow = (1u << D) - 1;  // a row's D scalars
+    const auto row = [&](int l) { return base + static_cast<std::size_t>(idx[l]) * D; };
+    if constexpr (sizeof(R) == 4) {
+      // z[a] holds rows a, a + 4, a + 8, a + 12, one per 128-bit block (x y z 0); a 4 x 4
+      // transpose within each block then gives lanes 4b..4b+3 of each component.
+      __m512 z[4];
+      for (int a = 0; a < 4; ++a) {
+        __m512 r = _mm512_castps128_ps512(_mm_maskz_loadu_ps(kRow, row(a)));
+        r = _mm512_maskz_insertf32x4(0xffff, r, _mm_maskz_loadu_ps(kRow, row(a + 4)), 1);
+        r = _mm512_maskz_insertf32x4(0xffff, r, _mm_maskz_loadu_ps(kRow, row(a + 8)), 2);
+        z[a] = _mm512_maskz_insertf32x4(0xffff, r, _mm_maskz_loadu_ps(kRow, row(a + 12)), 3);
+      }
+      const __m512 xy01 = _mm512_maskz_unpacklo_ps(0xffff, z[0], z[1]);  // x0 x1 y0 y1 per block
+      const __m512 xy23 = _mm512_maskz_unpacklo_ps(0xffff, z[2], z[3]);
+      out[0].v = _mm512_maskz_shuffle_ps(0xffff, xy01, xy23, _MM_SHUFFLE(1, 0, 1, 0));
+      out[1].v = _mm512_maskz_shuffle_ps(0xffff, xy01, xy23, _MM_SHUFFLE(3, 2, 3, 2));
+      if constexpr (D == 3) {
+        const __m512 zw01 = _mm512_maskz_unpackhi_ps(0xffff, z[0], z[1]);
+        const __m512 zw23 = _mm512_maskz_unpackhi_ps(0xffff, z[2], z[3]);
+        out[2].v = _mm512_maskz_shuffle_ps(0xffff, zw01, zw23, _MM_SHUFFLE(1, 0, 1, 0));
+      }
+    } else {
+      // z[a] holds rows a, a + 4, one per 256-bit half (x y | z 0); 64-bit interleaves, then
+      // each component's 128-bit pieces put in lane order.
+      __m512d z[4];
+      for (int a = 0; a < 4; ++a) {
+        const __m512d r = _mm512_castpd256_pd512(_mm256_maskz_loadu_pd(kRow, row(a)));
+        z[a] = _mm512_maskz_insertf64x4(0xff, r, _mm256_maskz_loadu_pd(kRow, row(a + 4)), 1);
+      }
+      // lo: (x_a x_a+1) (z_a z_a+1) (x_a+4 x_a+5) (z_a+4 z_a+5); hi: the same of y and the padding
+      const __m512d lo01 = _mm512_maskz_unpacklo_pd(0xff, z[0], z[1]),
+                    lo23 = _mm512_maskz_unpacklo_pd(0xff, z[2], z[3]);
+      const __m512d hi01 = _mm512_maskz_unpackhi_pd(0xff, z[0], z[1]),
+                    hi23 = _mm512_maskz_unpackhi_pd(0xff, z[2], z[3]);
+      const __m512i first = _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13);
+      out[0].v = _mm512_maskz_permutex2var_pd(0xff, lo01, first, lo23);
+      out[1].v = _mm512_maskz_permutex2var_pd(0xff, hi01, first, hi23);
+      if constexpr (D == 3) {
+        const __m512i second = _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15);
+        out[2].v = _mm512_maskz_permutex2var_pd(0xff, lo01, second, lo23);
+      }
+    }
+    return;
+  }
+#endif
+  for (int d = 0; d < D; ++d) out[d] = Pack<R>::template gather<D>(base, idx, d);
+}
+
 /// sum_lanes of a register's worth of packs at once: out[k] = sum_lanes(p[k]) for k < count, bit
 /// for bit (the same additions in the same order), p holding kLanes<R> packs (those from count on
 /// are read, their sums not written). With AVX-512 the packs are transposed, so that lane k of

@@ -83,9 +83,11 @@ std::uint32_t TrackedNeighbors<D, R>::PathFilter::keep(std::size_t i, std::uint3
     const std::uint32_t lanes = std::min<std::uint32_t>(kW, len - k);
     for (int l = 0; l < kW; ++l) idx[l] = list[k + std::min<std::uint32_t>(static_cast<std::uint32_t>(l), lanes - 1)];
     P r0[D], dw[D];
+    simd::gather_vectors<D>(path, idx, r0);
+    simd::gather_vectors<D>(w, idx, dw);
     for (int d = 0; d < D; ++d) {
-      r0[d] = xi[d] - P::template gather<D>(path, idx, d);
-      dw[d] = wi[d] - P::template gather<D>(w, idx, d);
+      r0[d] = xi[d] - r0[d];
+      dw[d] = wi[d] - dw[d];
     }
     P d2 = r0[0] * r0[0], b = r0[0] * dw[0], a = dw[0] * dw[0];
     for (int d = 1; d < D; ++d) d2 = d2 + r0[d] * r0[d], b = b + r0[d] * dw[d], a = a + dw[d] * dw[d];

@@ -64,8 +64,10 @@ simd::Pack<R> pair_offsets(const simd::Pack<R> (&xi)[D], const R* pos, const std
                            simd::Pack<R> (&rij)[D]) {
   using P = simd::Pack<R>;
   P r2 = P::set1(R(0));
+  P xj[D];
+  simd::gather_vectors<D>(pos, idx, xj);
   for (int d = 0; d < D; ++d) {
-    rij[d] = xi[d] - P::template gather<D>(pos, idx, d);
+    rij[d] = xi[d] - xj[d];
     r2 = r2 + rij[d] * rij[d];
   }
   return r2;
@@ -534,7 +536,12 @@ class ForceTerms {
       const P psib = P::template gather<1>(boundary_.psi.data(), bidx + k0, 0);
       // The velocity relative to the sample's (moving obstacles), else the particle's own.
       P vib[D];
-      for (int d = 0; d < D; ++d) vib[d] = bvel_ ? s.v[d] - P::template gather<D>(bvel_, bidx + k0, d) : s.v[d];
+      if (bvel_) {
+        simd::gather_vectors<D>(bvel_, bidx + k0, vib);
+        for (int d = 0; d < D; ++d) vib[d] = s.v[d] - vib[d];
+      } else {
+        for (int d = 0; d < D; ++d) vib[d] = s.v[d];
+      }
       P vr = zero;
       for (int d = 0; d < D; ++d) vr = vr + vib[d] * rib[d];
       const P pi_ib = minus_one * nu_i * select(vr < zero, vr, zero) / (r2 + eps_h2_);
@@ -634,7 +641,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
         j.rho = P::template gather<1>(rho, idx + k0, 0);
         j.inv_rho = P::set1(R(1)) / j.rho;
         j.mass = P::set1(m);
-        for (int d = 0; d < D; ++d) j.v[d] = P::template gather<D>(vel, idx + k0, d);
+        simd::gather_vectors<D>(vel, idx + k0, j.v);
         if constexpr (kPressure) j.p = P::template gather<1>(prs, idx + k0, 0);
         terms.pairs(side, j, valid, acc);
         if constexpr (kExitTest) flag_i = terms.exit_test(side, j, valid, idx + k0) || flag_i;

@@ -10,7 +10,9 @@
 #include <sph/core/parallel.h>
 #include <sph/neighbors/adaptive.h>
 #include <sph/neighbors/audit.h>
+#include <sph/neighbors/neighbor_mode.h>
 #include <sph/neighbors/standard.h>
+#include <sph/neighbors/strategy.h>
 #include <sph/neighbors/verlet.h>
 
 #include "support/thread_count.h"
@@ -44,6 +46,44 @@ void jitter(ParticleSet<3, double>& ps, double amount, unsigned seed) {
 using test::ThreadCount;
 
 constexpr double kH = 0.1;
+
+// NeighborStrategy::scratch_until_update: memory the solver may overwrite between updates (the
+// force pass's copy of 1 / rho and p). Every strategy with a grid but verlet_clusters lends its grid's; the
+// lists of the updates after it is filled with garbage (NaN coordinates, indices past the
+// particles) equal those of the same strategy left alone, full and partial rebuilds included.
+TEST(NeighborStrategy, LentScratchIsNotReadByTheNextUpdates) {
+  for (NeighborMode mode : neighbor_modes(NeighborModeSet::All)) {
+    SCOPED_TRACE(to_string(mode));
+    NeighborOptions opt;
+    opt.radius = kH;
+    opt.full_rebuild_period = 3;
+    opt.time_step = 1e-3;
+    const auto lent = make_neighbor_strategy<3, double>(mode, opt);
+    const auto kept = make_neighbor_strategy<3, double>(mode, opt);
+    auto ps = random_particles(2000, 1.0, 7);
+    for (int step = 0; step < 8; ++step) {
+      for (NeighborStrategy<3, double>* s : {lent.get(), kept.get()}) {
+        // (adaptive: a partial rebuild of every seventh list between the full ones)
+        const std::span<std::uint8_t> flags = s->pair_exit_flags();
+        for (std::size_t i = 0; i < flags.size(); i += 7) flags[i] = 1;
+        s->update(ps);
+      }
+      ScratchBuffer* scratch = lent->scratch_until_update();
+      // (brute_force has no grid to lend)
+      ASSERT_EQ(scratch != nullptr, lent->fluid_grid() != nullptr && mode != NeighborMode::VerletClusters);
+      const NeighborLists& a = lent->lists();
+      const NeighborLists& b = kept->lists();
+      ASSERT_EQ(a.particle_count(), ps.size());
+      for (std::size_t i = 0; i < ps.size(); ++i) ASSERT_TRUE(std::ranges::equal(a.of(i), b.of(i))) << "step " << step;
+      if (scratch) {
+        ASSERT_GE(scratch->capacity(), 2 * ps.size() * sizeof(double));
+        std::uint8_t* bytes = scratch->place<std::uint8_t>(0, scratch->capacity());
+        std::fill_n(bytes, scratch->capacity(), std::uint8_t{0xff});
+      }
+      jitter(ps, 0.03 * kH, 100 + static_cast<unsigned>(step));
+    }
+  }
+}
 
 TEST(Adaptive, FirstUpdateBuildsEveryListExactly) {
   auto ps = random_particles(3000, 1.0, 1);

@@ -1,18 +1,80 @@
 // Paper Eq. 7 inside the force pass: exactly the particles of listed pairs whose predicted
 // distance |x_i - x_j + dt (u_i - u_j)| exceeds h are flagged, both i and j, even when only
 // one of them lists the other; the pairs-within-h count; and the simulation-level contract
-// that adaptive with a full-rebuild period of 1 is the standard algorithm, bit for bit.
+// that adaptive with a full-rebuild period of 1 is the standard algorithm, bit for bit; the force
+// pass's copy of 1 / rho and p in lent memory.
+
+#include <algorithm>
+#include <cstring>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include <sph/core/parallel.h>
+#include <sph/core/storage.h>
+#include <sph/neighbors/standard.h>
 #include <sph/solver/simulation.h>
 #include <sph/solver/wcsph.h>
+
+#include "support/blob.h"
 
 namespace sph {
 namespace {
 
 using V2 = Vec<2, double>;
+
+// The force pass over lists reads each neighbor's 1 / rho and p from a copy it makes in the memory
+// it is given (NeighborStrategy::scratch_until_update): the accelerations are the same bits with
+// lent memory that held anything (NaN bytes here), lent memory too small (it grows), and none (the
+// pass's own), with Eq. 6's viscosity and with Monaghan's (which also reads each rho_j).
+template <int D, class R>
+void expect_forces_whatever_the_scratch_held(ViscosityModel model) {
+  test::Blob<D, R> blob(D == 3 ? 10 : 30, 5);
+  const R h = static_cast<R>(blob.h);
+  FluidParams fluid;
+  fluid.stiffness = 200;
+  fluid.rest_density = 1000;
+  fluid.viscosity = 0.5;
+  fluid.negative_pressure = NegativePressure::Allow;
+  fluid.viscosity_model = model;
+  StandardNeighbors<D, R> neighbors(h);
+  neighbors.update(blob.ps);
+  compute_density_pressure<D, R>(blob.ps, neighbors.lists(), h, fluid, {});
+  const std::vector<Box<D>> no_obstacles;
+  Box<D> box;
+  for (int d = 0; d < D; ++d) box.lo[d] = -10, box.hi[d] = 10;
+  const WallContact<D, R> walls(box, no_obstacles, R(0), WallParams{});
+  Vec<D, R> g{};
+  g[D - 1] = R(-9.81);
+  const auto accelerations = [&](ScratchBuffer* scratch) {
+    ParticleSet<D, R> ps = blob.ps;
+    compute_accelerations<D, R>(ps, neighbors.lists(), h, fluid, g, walls, {}, R(1e-4), {}, R(0), true, nullptr,
+                                scratch);
+    return ps.acceleration;
+  };
+  const std::vector<Vec<D, R>> own = accelerations(nullptr);
+  ScratchBuffer garbage, small;
+  garbage.reserve(2 * blob.ps.size() * sizeof(R));
+  std::uint8_t* bytes = garbage.place<std::uint8_t>(0, garbage.capacity());
+  std::fill_n(bytes, garbage.capacity(), std::uint8_t{0xff});
+  small.reserve(64);
+  const auto same = [](const std::vector<Vec<D, R>>& a, const std::vector<Vec<D, R>>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec<D, R>)) == 0;
+  };
+  EXPECT_TRUE(same(own, accelerations(&garbage)));
+  EXPECT_TRUE(same(own, accelerations(&small)));
+  EXPECT_GE(small.capacity(), 2 * blob.ps.size() * sizeof(R));
+  double largest = 0;
+  for (const auto& a : own) largest = std::max(largest, static_cast<double>(norm(a)));
+  EXPECT_GT(largest, 1.0) << "the block's pressures and viscosity must move it";
+}
+
+TEST(ForcePass, AccelerationsAreTheSameWhateverTheLentMemoryHeld) {
+  for (ViscosityModel model : {ViscosityModel::Paper, ViscosityModel::Artificial}) {
+    expect_forces_whatever_the_scratch_held<3, float>(model);
+    expect_forces_whatever_the_scratch_held<2, double>(model);
+  }
+}
 
 TEST(PairExitTest, FlagsBothParticlesOfExactlyThePairsPredictedToLeave) {
   const double h = 1.0, dt = 0.2;

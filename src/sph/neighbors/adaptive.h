@@ -35,6 +35,7 @@ class AdaptiveNeighbors final : public NeighborStrategy<D, R> {
   /// so that this costs nothing extra).
   void invalidate() override { invalid_ = true; }
   UniformGrid<D, R>* fluid_grid() override { return &grid_; }
+  ScratchBuffer* scratch_until_update() override { return &grid_.lend_scratch(0); }  // (built before each read)
   void save_state(StateWriter& out) const override;
   void load_state(StateReader& in, std::size_t particles) override;
 

@@ -17,6 +17,7 @@ class StandardNeighbors final : public NeighborStrategy<D, R> {
   const NeighborCounters& counters() const override { return counters_; }
   void invalidate() override {}  // every update rebuilds everything anyway
   UniformGrid<D, R>* fluid_grid() override { return &grid_; }
+  ScratchBuffer* scratch_until_update() override { return &grid_.lend_scratch(0); }  // (built before each read)
   bool visit_pairs_with(const PairVisitor<R>* visitor) override {
     builder_.set_pair_visitor(visitor);
     return true;

@@ -111,6 +111,11 @@ class NeighborStrategy {
   /// (UniformGrid::lend_scratch) after invalidate(): its next update() builds it again before
   /// reading it. Null for a strategy without one.
   virtual UniformGrid<D, R>* fluid_grid() { return nullptr; }
+  /// Memory the solver may use from now until the next update(): the fluid grid's
+  /// (UniformGrid::lend_scratch), for a strategy that builds its grid again before it next reads
+  /// it, at least 2 reals a particle; null otherwise (verlet_clusters: its per-particle lists are
+  /// built from the grid when asked for, which may be later).
+  virtual ScratchBuffer* scratch_until_update() { return nullptr; }
 
   /// Writes what the strategy carries from one update() to the next (checkpoints: lists,
   /// flags, reference positions), so that a resumed run makes exactly the choices the

@@ -64,6 +64,7 @@ class TrackedNeighbors final : public NeighborStrategy<D, R> {
   }
   void invalidate() override { invalid_ = true; }
   UniformGrid<D, R>* fluid_grid() override { return &grid_; }
+  ScratchBuffer* scratch_until_update() override { return &grid_.lend_scratch(0); }  // (built before each read)
   void set_time(double t) override { time_ = t; }
   void save_state(StateWriter& out) const override;
   void load_state(StateReader& in, std::size_t particles) override;

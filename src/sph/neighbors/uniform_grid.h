@@ -114,7 +114,8 @@ class UniformGrid {
   /// is queried (the Morton reorder's sort: the reorder invalidates the lists, so the next update
   /// builds the grid first). Its contents are lost. It gets the room a build of n points needs
   /// first, so that the build after the caller's use does not allocate (a block outgrown and
-  /// freed can stay resident).
+  /// freed can stay resident); with n = 0, the room it has (the last build's). Also lent between a
+  /// neighbor strategy's updates (NeighborStrategy::scratch_until_update).
   ScratchBuffer& lend_scratch(std::size_t n) {
     store_.reserve(bytes_for(n));
     sorted_ = nullptr;

@@ -29,6 +29,9 @@ class VerletNeighbors final : public NeighborStrategy<D, R> {
   const NeighborCounters& counters() const override { return counters_; }
   void invalidate() override { built_at_.clear(); }  // the next update rebuilds
   UniformGrid<D, R>* fluid_grid() override { return &grid_; }
+  // (verlet builds its grid again at each rebuild, before reading it; with clusters its lists are
+  // built from the grid when they are first asked for)
+  ScratchBuffer* scratch_until_update() override { return clusters_ ? nullptr : &grid_.lend_scratch(0); }
   void save_state(StateWriter& out) const override;
   void load_state(StateReader& in, std::size_t particles) override;
 

@@ -602,7 +602,8 @@ const StepInfo& Simulation<D, R>::step() {
                                 params_.walls, params_.boundary.handling == BoundaryHandling::Penalty, poses_, moving_,
                                 obstacle_body_, params_.shapes);
   compute_accelerations(particles_, lists, h, params_.fluid, vec_cast<R>(params_.gravity), walls,
-                        neighbors_->pair_exit_flags(), dt, solid, neighbors_->pair_exit_radius(), !dfsph_, clusters);
+                        neighbors_->pair_exit_flags(), dt, solid, neighbors_->pair_exit_radius(), !dfsph_, clusters,
+                        clusters ? nullptr : neighbors_->scratch_until_update());
   info.seconds.forces = watch.lap();
   // The viscosity backward in time, after every other acceleration of the step (DFSPH's density
   // solve then sees the velocities it leaves).

@@ -259,11 +259,15 @@ class WallContact {
 ///
 /// `clusters`: as for compute_density_pressure (no Eq. 7 test then: exit_flags must be empty).
 /// `lists` is read only by the gradient correction's pass.
+///
+/// `scratch`: memory the pass over lists may use for its copy of each particle's 1 / rho and p
+/// (2 reals a particle; NeighborStrategy::scratch_until_update), else a buffer of its own, kept.
 template <int D, std::floating_point R>
 void compute_accelerations(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const FluidParams& fluid,
                            const Vec<D, R>& gravity, const WallContact<D, R>& walls,
                            std::span<std::uint8_t> exit_flags = {}, R dt = 0, const BoundaryView<D, R>& boundary = {},
-                           R exit_radius = 0, bool pressure_terms = true, const ClusterPairs<D, R>* clusters = nullptr);
+                           R exit_radius = 0, bool pressure_terms = true, const ClusterPairs<D, R>* clusters = nullptr,
+                           ScratchBuffer* scratch = nullptr);
 
 /// Particle mass such that a particle inside a lattice of spacing dx (square in 2D, cubic in
 /// 3D) has exactly density rho0 under the density kernel's sum of Eq. 4 with support h (poly6

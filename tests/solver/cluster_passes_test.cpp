@@ -74,12 +74,9 @@ void expect_cluster_passes_match(const FluidParams& fluid, bool boundary, bool p
   // The forces from the same densities and pressures.
   b.density = a.density;
   b.pressure = a.pressure;
-  const std::vector<Box<D>> no_obstacles;
-  Box<D> box;
-  for (int d = 0; d < D; ++d) box.lo[d] = -10, box.hi[d] = 10;
-  const WallContact<D, R> walls(box, no_obstacles, R(0), WallParams{});
-  Vec<D, R> g{};
-  g[D - 1] = R(-9.81);
+  const test::FarWalls<D, R> far;
+  const WallContact<D, R>& walls = far.walls;
+  const Vec<D, R>& g = far.gravity;
   compute_accelerations<D, R>(a, verlet.lists(), h, fluid, g, walls, {}, R(1e-4), view, R(0), pressure_terms);
   compute_accelerations<D, R>(b, verlet.lists(), h, fluid, g, walls, {}, R(1e-4), view, R(0), pressure_terms,
                               clusters.cluster_pairs());

@@ -40,16 +40,11 @@ void expect_forces_whatever_the_scratch_held(ViscosityModel model) {
   StandardNeighbors<D, R> neighbors(h);
   neighbors.update(blob.ps);
   compute_density_pressure<D, R>(blob.ps, neighbors.lists(), h, fluid, {});
-  const std::vector<Box<D>> no_obstacles;
-  Box<D> box;
-  for (int d = 0; d < D; ++d) box.lo[d] = -10, box.hi[d] = 10;
-  const WallContact<D, R> walls(box, no_obstacles, R(0), WallParams{});
-  Vec<D, R> g{};
-  g[D - 1] = R(-9.81);
+  const test::FarWalls<D, R> far;
   const auto accelerations = [&](ScratchBuffer* scratch) {
     ParticleSet<D, R> ps = blob.ps;
-    compute_accelerations<D, R>(ps, neighbors.lists(), h, fluid, g, walls, {}, R(1e-4), {}, R(0), true, nullptr,
-                                scratch);
+    compute_accelerations<D, R>(ps, neighbors.lists(), h, fluid, far.gravity, far.walls, {}, R(1e-4), {}, R(0), true,
+                                nullptr, scratch);
     return ps.acceleration;
   };
   const std::vector<Vec<D, R>> own = accelerations(nullptr);

@@ -1,13 +1,14 @@
 #pragma once
 // A block of fluid for the pass tests: a jittered lattice of spacing dx (h = 2 spacings) with
 // random velocities, its density a few % off rest when summed (pressures of both signs), and
-// boundary samples on a wall plane below it.
+// boundary samples on a wall plane below it; and walls far from it, with gravity.
 
 #include <cmath>
 #include <random>
 #include <vector>
 
 #include <sph/core/particle_set.h>
+#include <sph/solver/wcsph.h>
 
 namespace sph::test {
 
@@ -45,6 +46,31 @@ struct Blob {
         samples.push_back(x);
         psi.push_back(static_cast<R>(0.3 * m));
       }
+  }
+};
+
+/// Walls 10 m away on every side (no contact with a blob) and gravity along the last axis: what the
+/// force-pass tests pass to compute_accelerations.
+template <int D, class R>
+struct FarWalls {
+  FarWalls() = default;
+  FarWalls(const FarWalls&) = delete;  // (walls refers to the members)
+  FarWalls& operator=(const FarWalls&) = delete;
+
+  std::vector<Box<D>> no_obstacles;
+  Box<D> box = far_box();
+  WallContact<D, R> walls{box, no_obstacles, R(0), WallParams{}};
+  Vec<D, R> gravity = down();
+
+  static Box<D> far_box() {
+    Box<D> b;
+    for (int d = 0; d < D; ++d) b.lo[d] = -10, b.hi[d] = 10;
+    return b;
+  }
+  static Vec<D, R> down() {
+    Vec<D, R> g{};
+    g[D - 1] = R(-9.81);
+    return g;
   }
 };
 

@@ -28,11 +28,12 @@
 #ifndef SPH_BENCH_BUILD_FLAGS
 #define SPH_BENCH_BUILD_FLAGS "unknown"
 #endif
-#ifndef SPH_BENCH_GIT_COMMIT
-#define SPH_BENCH_GIT_COMMIT "unknown"
-#endif
 
 namespace sph {
+
+namespace bench_detail {
+extern const char* const kGitCommit;  // (generated at build time: cmake/git_commit.cmake)
+}  // namespace bench_detail
 
 namespace {
 
@@ -79,7 +80,7 @@ MachineInfo machine_info() {
   m.compiler = fmt::format("{} {}", SPH_BENCH_COMPILER_ID, __VERSION__);
   m.build_type = SPH_BENCH_BUILD_TYPE;
   m.build_flags = trim(SPH_BENCH_BUILD_FLAGS);
-  m.git_commit = SPH_BENCH_GIT_COMMIT;
+  m.git_commit = bench_detail::kGitCommit;
   if (m.git_commit.empty()) m.git_commit = "unknown";
   m.version = kVersion;
   const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <concepts>
 #include <cstddef>
+#include <span>
+#include <vector>
 
 namespace sph {
 
@@ -69,6 +71,18 @@ bool all_finite(const Vec<D, R>& a) {
   for (int i = 0; i < D; ++i)
     if (!std::isfinite(a[i])) return false;
   return true;
+}
+
+/// The scalars of a vector field, x0 y0 z0 x1 y1 z1 ..., so that pair loops load or gather lanes
+/// of them (simd::gather_vectors).
+template <int D, std::floating_point R>
+const R* flat(std::span<const Vec<D, R>> v) {
+  static_assert(sizeof(Vec<D, R>) == D * sizeof(R));
+  return reinterpret_cast<const R*>(v.data());
+}
+template <int D, std::floating_point R>
+const R* flat(const std::vector<Vec<D, R>>& v) {
+  return flat(std::span<const Vec<D, R>>(v));
 }
 
 /// Converts between precisions (and from double scene values to the simulation's R).

@@ -68,10 +68,9 @@ std::uint32_t TrackedNeighbors<D, R>::PathFilter::keep(std::size_t i, std::uint3
   // r0 and dw change sign, and j's path is where j is.
   using P = simd::Pack<R>;
   constexpr int kW = simd::kLanes<R>;
-  static_assert(sizeof(Vec<D, R>) == D * sizeof(R));
   const TrackedNeighbors& t = *self;
-  const R* path = reinterpret_cast<const R*>(t.path_now_.data());
-  const R* w = reinterpret_cast<const R*>(t.built_velocity_.data());
+  const R* path = flat(t.path_now_);
+  const R* w = flat(t.built_velocity_);
   const R* left = t.left_.data();
   const R reach = t.radius_ + t.skin_;
   const P reach2 = P::set1(reach * reach), zero = P::set1(R(0)), li = P::set1(t.left_[i]);

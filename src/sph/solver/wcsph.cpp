@@ -20,17 +20,6 @@ namespace {
 
 using simd::Mask;
 
-/// The scalars of a vector field, x0 y0 z0 x1 y1 z1 ..., so that pair loops gather lanes.
-template <int D, std::floating_point R>
-const R* flat(std::span<const Vec<D, R>> v) {
-  static_assert(sizeof(Vec<D, R>) == D * sizeof(R));
-  return reinterpret_cast<const R*>(v.data());
-}
-template <int D, std::floating_point R>
-const R* flat(const std::vector<Vec<D, R>>& v) {
-  return flat(std::span<const Vec<D, R>>(v));
-}
-
 /// What the pair loops assume: lists for exactly these particles, and indices times D that fit
 /// the 32-bit signed offsets of the vector gathers.
 template <int D, std::floating_point R>

@@ -99,6 +99,61 @@ TEST(Health, StatisticsAreTheSameForAnyThreadCount) {
   EXPECT_EQ(a.outside_depth, b.outside_depth);
 }
 
+TEST(Health, StatisticsMeasuredInBatchesAreThoseOfOneParticleAtATime) {
+  // The integrate pass measures the particles of a scene without obstacles in batches (a register
+  // of particles at once, then recorded in order) and those of a scene with obstacles one at a
+  // time. An obstacle that no particle comes near changes nothing else: the statistics of every
+  // step must be the same bits either way, in both precisions.
+  const auto run = [](auto real, bool obstacle) {
+    using R = decltype(real);
+    SimulationParams<2> p = tank_params();
+    p.container.hi = {{1.21, 1.2}};  // (the block's right column at r from the wall)
+    p.walls.stiffness = 1e5;         // (the thrown block presses into the wall: its springs in the energy)
+    p.walls.damping = 600;
+    if (obstacle) p.obstacles.push_back({{{1.1, 1.0}}, {{1.2, 1.1}}});  // (0.3 m above the fluid)
+    // 2,102 particles (eight full chunks and 54: whole batches and a remainder), thrown at the right
+    // wall, and one 1.5 cm past the left wall and one past the right (outside, under 1 % of them
+    // and within h).
+    ParticleSet<2, double> d = block(60, 35, 0.01, 0.01, {{3.0, 0.0}});
+    d.add(Vec<2, double>{-0.015, 0.3}, {});
+    d.add(Vec<2, double>{1.225, 0.9}, {});
+    ParticleSet<2, R> ps;
+    ps.mass = static_cast<R>(d.mass);
+    for (std::size_t i = 0; i < d.size(); ++i) ps.add(vec_cast<R>(d.position[i]), vec_cast<R>(d.velocity[i]));
+    Simulation<2, R> sim(p, std::move(ps));
+    std::vector<HealthStats> steps;
+    for (int s = 0; s < 60; ++s) steps.push_back(sim.step().health);
+    return std::pair(steps, sim.particles().position);
+  };
+  const auto compare = [&run](auto real) {
+    const auto [batched, x_batched] = run(real, false);
+    const auto [single, x_single] = run(real, true);
+    ASSERT_EQ(x_batched, x_single) << "the far obstacle changed the flow: the comparison would mean nothing";
+    std::uint64_t outside = 0;
+    double compressed = 0;
+    for (std::size_t s = 0; s < batched.size(); ++s) {
+      const HealthStats& a = batched[s];
+      const HealthStats& b = single[s];
+      EXPECT_EQ(a.energy, b.energy) << "step " << s;
+      EXPECT_EQ(a.max_mach, b.max_mach) << "step " << s;
+      EXPECT_EQ(a.mach_id, b.mach_id) << "step " << s;
+      EXPECT_EQ(a.rho_min, b.rho_min) << "step " << s;
+      EXPECT_EQ(a.rho_max, b.rho_max) << "step " << s;
+      EXPECT_EQ(a.rho_max_id, b.rho_max_id) << "step " << s;
+      EXPECT_EQ(a.outside, b.outside) << "step " << s;
+      EXPECT_EQ(a.outside_depth, b.outside_depth) << "step " << s;
+      EXPECT_EQ(a.outside_id, b.outside_id) << "step " << s;
+      EXPECT_EQ(b.inside_solid, 0u);
+      outside += a.outside;
+      compressed = std::max(compressed, a.rho_max);
+    }
+    EXPECT_GT(outside, 0u) << "a particle was outside: the count and depth were compared";
+    EXPECT_GT(compressed, 1.0) << "the block was compressed against the wall";
+  };
+  compare(0.0);
+  compare(0.0f);
+}
+
 TEST(Health, BoundaryParticleScenesGetStepAndModeAdviceNotWallSprings) {
   // A particle beyond h outside a container of boundary particles, in the adaptive mode: the advice
   // names the step and the exact modes (the wall springs do not exist).

@@ -3,6 +3,7 @@
 // particle (by id) and the physics, and every neighbor mode gives bitwise-identical results for
 // 1 and 2 threads, with reordering and in float and double.
 
+#include <array>
 #include <atomic>
 #include <cstdlib>
 #include <map>
@@ -140,31 +141,43 @@ TEST(Reorder, DoesNotChangeThePhysicsBeyondRoundOff) {
   EXPECT_NEAR(a.kinetic_energy(), b.kinetic_energy(), 1e-9 * a.kinetic_energy());
 }
 
+template <class R>
+void expect_fluid_then_walls() {
+  auto sim = dam_break<R>(8, NeighborMode::Standard, 0);
+  for (int s = 0; s < 30; ++s) sim.step();  // particles now touch the floor and the left wall
+  SimulationParams<3> p = sim.params();
+  const R h = static_cast<R>(p.kernel_radius);
+  const NeighborLists& lists = sim.neighbors().lists();
+  const std::vector<Box<3>> no_obstacles;
+  const WallContact<3, R> no_walls({Vec<3, double>::filled(-1e3), Vec<3, double>::filled(1e3)}, no_obstacles,
+                                   static_cast<R>(p.particle_radius), p.walls);
+  // The container's walls alone (the pass pushes a register of particles at a time), then with an
+  // obstacle among the particles (one particle at a time).
+  const std::vector<Box<3>> obstacles = {{{{0.05, 0.0, 0.0}}, {{0.1, 0.05, 0.16}}}};
+  for (const std::vector<Box<3>>* solid : std::array{&no_obstacles, &obstacles}) {
+    ParticleSet<3, R> a = sim.particles(), b = sim.particles();
+    std::vector<std::uint8_t> fa(a.size(), 0), fb(b.size(), 0);
+    compute_density_pressure<3, R>(a, lists, h, p.fluid);
+    compute_density_pressure<3, R>(b, lists, h, p.fluid);
+    const Vec<3, R> g = vec_cast<R>(p.gravity);
+    const R dt = static_cast<R>(p.time_step);
+    compute_accelerations<3, R>(a, lists, h, p.fluid, g, no_walls, fa, dt);
+    const WallContact<3, R> walls(p.container, *solid, static_cast<R>(p.particle_radius), p.walls);
+    for (std::size_t i = 0; i < a.size(); ++i) a.acceleration[i] += walls(a.position[i], a.velocity[i]);
+    compute_accelerations<3, R>(b, lists, h, p.fluid, g, walls, fb, dt);
+    EXPECT_TRUE(a.acceleration == b.acceleration) << solid->size() << " obstacles";
+    EXPECT_EQ(fa, fb);
+    std::size_t touching = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) touching += norm2(walls(a.position[i], a.velocity[i])) > 0 ? 1 : 0;
+    EXPECT_GT(touching, 10u) << "the walls must be part of the comparison";
+  }
+}
+
 TEST(FusedPasses, AccelerationsEqualFluidThenWallsBitForBit) {
   // compute_accelerations runs forces and walls in one pass; it must give the fluid's values
   // (the same pass with walls that touch no particle) plus each particle's wall contact.
-  auto sim = dam_break<double>(8, NeighborMode::Standard, 0);
-  for (int s = 0; s < 30; ++s) sim.step();  // particles now touch the floor and the left wall
-  ParticleSet<3, double> a = sim.particles(), b = sim.particles();
-  SimulationParams<3> p = sim.params();
-  p.obstacles.push_back({{{0.05, 0.0, 0.0}}, {{0.1, 0.05, 0.16}}});  // and an obstacle among them
-  const double h = p.kernel_radius;
-  const NeighborLists& lists = sim.neighbors().lists();
-  std::vector<std::uint8_t> fa(a.size(), 0), fb(b.size(), 0);
-  compute_density_pressure<3, double>(a, lists, h, p.fluid);
-  compute_density_pressure<3, double>(b, lists, h, p.fluid);
-  const std::vector<Box<3>> no_obstacles;
-  const WallContact<3, double> no_walls({Vec<3, double>::filled(-1e3), Vec<3, double>::filled(1e3)}, no_obstacles,
-                                        p.particle_radius, p.walls);
-  compute_accelerations<3, double>(a, lists, h, p.fluid, p.gravity, no_walls, fa, p.time_step);
-  const WallContact<3, double> walls(p.container, p.obstacles, p.particle_radius, p.walls);
-  for (std::size_t i = 0; i < a.size(); ++i) a.acceleration[i] += walls(a.position[i], a.velocity[i]);
-  compute_accelerations<3, double>(b, lists, h, p.fluid, p.gravity, walls, fb, p.time_step);
-  EXPECT_TRUE(a.acceleration == b.acceleration);
-  EXPECT_EQ(fa, fb);
-  std::size_t touching = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) touching += norm2(walls(a.position[i], a.velocity[i])) > 0 ? 1 : 0;
-  EXPECT_GT(touching, 10u) << "the walls must be part of the comparison";
+  expect_fluid_then_walls<double>();
+  expect_fluid_then_walls<float>();
 }
 
 TEST(Reorder, ParticlesEmittedOnAReorderStepAreTheLastOnes) {

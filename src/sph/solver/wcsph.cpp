@@ -573,6 +573,21 @@ class ForceTerms {
     ps_.acceleration[i] = a;
   }
 
+  /// finish() of particles b .. b + W - 1 (sums[d][l]: particle b + l's pair and boundary terms)
+  /// when the walls are the container's alone: their push a register at a time, the same bits.
+  void finish_register(std::size_t b, const R (&sums)[D][kW]) const {
+    std::uint32_t own[kW];
+    for (int l = 0; l < kW; ++l) own[l] = static_cast<std::uint32_t>(b) + static_cast<std::uint32_t>(l);
+    P x[D], v[D], push[D];
+    simd::gather_vectors<D>(flat(ps_.position), own, x);
+    simd::gather_vectors<D>(flat(ps_.velocity), own, v);
+    walls_.container_push(x, v, push);
+    R a[D][kW];
+    for (int d = 0; d < D; ++d) ((P::set1(gravity_[d]) + P::load(sums[d])) + push[d]).store(a[d]);
+    for (int l = 0; l < kW; ++l)
+      for (int d = 0; d < D; ++d) ps_.acceleration[b + static_cast<std::size_t>(l)][d] = a[d][l];
+  }
+
   void set_flag(std::size_t q) const { std::atomic_ref<std::uint8_t>(flags_[q]).store(1, std::memory_order_relaxed); }
 
  private:
@@ -653,10 +668,14 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
       R sums[D][W];
       for (int d = 0; d < D; ++d) simd::sum_lanes_each(group[d], static_cast<int>(grouped), sums[d]);
       const std::size_t b = i + 1 - grouped;
-      for (std::size_t k = 0; k < grouped; ++k) {
-        Vec<D, R> total;
-        for (int d = 0; d < D; ++d) total[d] = sums[d][k];
-        terms.finish(b + k, total);
+      if (grouped == static_cast<std::size_t>(W) && walls.container_only()) {
+        terms.finish_register(b, sums);
+      } else {
+        for (std::size_t k = 0; k < grouped; ++k) {
+          Vec<D, R> total;
+          for (int d = 0; d < D; ++d) total[d] = sums[d][k];
+          terms.finish(b + k, total);
+        }
       }
       grouped = 0;
     }

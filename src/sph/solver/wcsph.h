@@ -140,6 +140,29 @@ class WallContact {
         ks_(static_cast<R>(walls.stiffness)),
         kd_(static_cast<R>(walls.damping)) {}
 
+  /// Whether operator() is the container's walls alone (no obstacle), which container_push
+  /// computes a register of particles at a time.
+  bool container_only() const { return enabled_ && obstacles_->empty(); }
+
+  /// operator() of container_only() walls on the lanes of a register of particles (P:
+  /// simd::Pack<R>; x, v their positions and velocities): the same operations on each lane, so
+  /// the same bits (-v as v (-1)).
+  template <class P>
+  void container_push(const P (&x)[D], const P (&v)[D], P (&a)[D]) const {
+    const P zero = P::set1(R(0)), ks = P::set1(ks_), kd = P::set1(kd_), minus_one = P::set1(R(-1));
+    const auto contact = [&](const P& penetration, const P& normal_velocity) {
+      const P push = ks * penetration - kd * normal_velocity;
+      return select(zero < push, push, zero);  // (std::max(0, push))
+    };
+    for (int d = 0; d < D; ++d) {
+      a[d] = zero;
+      const P pen_lo = P::set1(lo_[d] + radius_) - x[d];
+      a[d] = select(pen_lo > zero, a[d] + contact(pen_lo, v[d]), a[d]);
+      const P pen_hi = x[d] - P::set1(hi_[d] - radius_);
+      a[d] = select(pen_hi > zero, a[d] - contact(pen_hi, v[d] * minus_one), a[d]);
+    }
+  }
+
   /// The wall acceleration of a particle at x with velocity v; with `body_row` (the particle's
   /// entries of BoundaryView::body_acceleration) each floating body's push is also added there.
   Vec<D, R> operator()(const Vec<D, R>& x, const Vec<D, R>& v, Vec<D, R>* body_row = nullptr) const {

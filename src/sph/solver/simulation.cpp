@@ -46,7 +46,6 @@ class HealthProbe {
   void add(detail::HealthChunk& c, std::size_t i, const Vec<D, R>& xr, const Vec<D, R>& vr, R m, R rho) const {
     const Vec<D, double> x = vec_cast<double>(xr), x_world = x;
     const double v2 = static_cast<double>(norm2(vr)), md = static_cast<double>(m);
-    if (v2 > c.v2) c.v2 = v2, c.v_i = i;
     double out = -kNoLimit, springs = 0;  // signed distance past the container's planes
     for (int d = 0; d < D; ++d) {
       out = std::max({out, p_.container.lo[d] - x[d], x[d] - p_.container.hi[d]});
@@ -54,8 +53,6 @@ class HealthProbe {
         springs +=
             squared_positive(p_.container.lo[d] + r_ - x[d]) + squared_positive(x[d] - (p_.container.hi[d] - r_));
     }
-    if (out > tol_) ++c.outside;
-    if (out > 0 && out > c.outside_depth) c.outside_depth = out, c.outside_i = i;
     for (std::size_t k = 0; k < p_.obstacles.size(); ++k) {
       const Box<D>& b = p_.obstacles[k];
       // (a moving obstacle: measured in its own frame, where its pose puts the particle)
@@ -78,12 +75,8 @@ class HealthProbe {
     if constexpr (kInternal)
       if (ratio > 1 || (tension_ && ratio > 0))
         c.internal += md * p_.fluid.stiffness * (std::log(ratio) + 1 / ratio - 1);
-    if (rho > m * w0_) {  // a neighbour within h added to its own contribution
-      if (ratio < c.rho_min) c.rho_min = ratio, c.rho_min_i = i;
-      if (ratio > c.rho_max) c.rho_max = ratio, c.rho_max_i = i;
-    }
-    c.energy += md * (0.5 * v2 + (low_ - dot(p_.gravity, x)) + 0.5 * p_.walls.stiffness * springs);
-    c.mass += md;
+    record(c, i, v2, out, ratio, rho > m * w0_,
+           md * (0.5 * v2 + (low_ - dot(p_.gravity, x)) + 0.5 * p_.walls.stiffness * springs), md);
   }
 
   /// add<false> of particles [b, e) in order (positions x, velocities v, densities rho), the
@@ -123,18 +116,8 @@ class HealthProbe {
         o.store(out);
         (P::load(ratio) / P::set1(p_.fluid.rest_density)).store(ratio);
         (P::set1(md) * (P::set1(0.5) * P::load(v2) + (P::set1(low_) - g) + P::set1(ks) * springs)).store(term);
-        for (std::size_t l = 0; l < kBatch; ++l) {
-          const std::size_t k = i + l;
-          if (v2[l] > c.v2) c.v2 = v2[l], c.v_i = k;
-          if (out[l] > tol_) ++c.outside;
-          if (out[l] > 0 && out[l] > c.outside_depth) c.outside_depth = out[l], c.outside_i = k;
-          if (rho[k] > with_neighbours) {
-            if (ratio[l] < c.rho_min) c.rho_min = ratio[l], c.rho_min_i = k;
-            if (ratio[l] > c.rho_max) c.rho_max = ratio[l], c.rho_max_i = k;
-          }
-          c.energy += term[l];
-          c.mass += md;
-        }
+        for (std::size_t l = 0; l < kBatch; ++l)
+          record(c, i + l, v2[l], out[l], ratio[l], rho[i + l] > with_neighbours, term[l], md);
       }
     }
     for (; i < e; ++i) add<false>(c, i, x[i], v[i], m, rho[i]);
@@ -142,6 +125,21 @@ class HealthProbe {
 
  private:
   static double squared_positive(double a) { return a > 0 ? a * a : 0.0; }
+
+  /// Records particle i's measures in c: its speed squared v2, its distance `out` past the
+  /// container's planes, its density ratio (counted when it has a neighbour within h) and energy.
+  void record(detail::HealthChunk& c, std::size_t i, double v2, double out, double ratio, bool has_neighbours,
+              double energy, double md) const {
+    if (v2 > c.v2) c.v2 = v2, c.v_i = i;
+    if (out > tol_) ++c.outside;
+    if (out > 0 && out > c.outside_depth) c.outside_depth = out, c.outside_i = i;
+    if (has_neighbours) {  // (a neighbour within h added to its own contribution)
+      if (ratio < c.rho_min) c.rho_min = ratio, c.rho_min_i = i;
+      if (ratio > c.rho_max) c.rho_max = ratio, c.rho_max_i = i;
+    }
+    c.energy += energy;
+    c.mass += md;
+  }
 
   const SimulationParams<D>& p_;
   std::span<const RigidPose<D>> poses_;

@@ -288,6 +288,41 @@ TEST(FastLists, RebuildSomeLeavesUnmarkedChunksUntouchedAndAppends) {
   }
 }
 
+// The builds find each chunk's stencils once per cell (a table of the chunk's cells). On particles
+// in random order, whose chunks each lie in up to 256 cells (the table's limit) with colliding
+// slots, every list is the one read from the grid particle by particle: the candidates of the
+// particle's cell's stencil ranges, in their order, closer than r.
+template <int D, class R>
+void expect_lists_read_from_each_particles_stencil(const std::vector<Vec<D, R>>& x, R r) {
+  UniformGrid<D, R> grid;
+  grid.build(x, r);
+  ListBuilder<D, R> b;
+  NeighborLists whole, each;
+  b.build(grid, x, r, whole);
+  b.rebuild_some(grid, x, r, std::vector<std::uint8_t>(x.size(), 1), each);  // every list, from none
+  EXPECT_GT(whole.entry_count(), x.size());
+  std::vector<std::vector<std::uint32_t>> want(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    std::uint32_t begin[UniformGrid<D, R>::kMaxRanges], end[UniformGrid<D, R>::kMaxRanges];
+    const int ranges = grid.stencil_ranges(grid.cell_containing(x[i]), begin, end);
+    for (int q = 0; q < ranges; ++q)
+      for (std::uint32_t k = begin[q]; k < end[q]; ++k) {
+        const std::uint32_t j = grid.sorted()[k];
+        if (j != i && norm2(x[i] - x[j]) < r * r) want[i].push_back(j);
+      }
+  }
+  EXPECT_TRUE(whole == NeighborLists::from(want)) << D << "D: build()";
+  EXPECT_TRUE(each == NeighborLists::from(want)) << D << "D: rebuild_some()";
+}
+
+TEST(FastLists, ChunksStencilTableGivesEachParticlesOwnStencilsLists) {
+  // 2D: 1,024 cells of 2 spacings, so a chunk of 256 shuffled particles lies in about 200.
+  expect_lists_read_from_each_particles_stencil<2, float>(jittered_lattice<2, float>(64, 0.025, 0.0025, 5, true),
+                                                          0.05f);
+  expect_lists_read_from_each_particles_stencil<3, double>(jittered_lattice<3, double>(20, 0.025, 0.0025, 9, true),
+                                                           0.05);
+}
+
 // balance_loops' work: each chunk's entries, counted for lists laid one after the other (from
 // their chunk's last end) and for lists with room of their own (list by list), after a build and
 // after a partial rebuild that appends particles (a last chunk that is not full).

@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <span>
 
 #if defined(__AVX512F__) && defined(__AVX512VL__)
 #include <immintrin.h>
@@ -198,40 +197,27 @@ inline R sum_lanes(const Pack<R>& p) {
   return s;
 }
 
-/// out[d] = Pack<R>::gather<D>(values.data(), idx, d) for every d < D (lane l of out[d] is
-/// values[D idx[l] + d]): a register of D-vectors stored one after another (x0 y0 z0 x1 y1 z1 ...,
-/// flat()), the same values. With AVX-512 and D of 2 or 3 each vector is one load (of 4 floats or
-/// 4 doubles: its D scalars and what follows them, unused), the loads put side by side and
-/// transposed into the D registers: a gather instruction per component costs several times as
-/// much. A register whose lanes include the last vector, which nothing follows, loads each vector
-/// masked to its D scalars (nothing beyond the array is read); the masked loads cost the 1M bench's
-/// density pass a fifth more on the AMD machine of docs/performance.md, so only that register
-/// takes them.
+/// out[d] = Pack<R>::gather<D>(base, idx, d) for every d < D (lane l of out[d] is
+/// base[D idx[l] + d]): a register of D-vectors stored one after another (x0 y0 z0 x1 y1 z1 ...),
+/// the same values. With AVX-512 and D of 2 or 3 each vector is one masked load of its D scalars
+/// (nothing beyond them is read), the loads put side by side and transposed into the D registers:
+/// a gather instruction per component costs several times as much.
 template <int D, class R>
-inline void gather_vectors(std::span<const R> values, const std::uint32_t* idx, Pack<R> (&out)[D]) {
-  const R* const base = values.data();
+inline void gather_vectors(const R* base, const std::uint32_t* idx, Pack<R> (&out)[D]) {
 #if SPH_SIMD_AVX512
   if constexpr (D == 2 || D == 3) {
     constexpr unsigned kRow = (1u << D) - 1;  // a row's D scalars
     const auto row = [&](int l) { return base + static_cast<std::size_t>(idx[l]) * D; };
-    const auto last = static_cast<std::int32_t>(values.size() / D - 1);
     if constexpr (sizeof(R) == 4) {
-      // z[a] holds rows a, a + 4, a + 8, a + 12, one per 128-bit block (x y z -); a 4 x 4
+      // z[a] holds rows a, a + 4, a + 8, a + 12, one per 128-bit block (x y z 0); a 4 x 4
       // transpose within each block then gives lanes 4b..4b+3 of each component.
       __m512 z[4];
-      const auto load_rows = [&]<bool kMasked>() {
-        const auto load = [&](int l) { return kMasked ? _mm_maskz_loadu_ps(kRow, row(l)) : _mm_loadu_ps(row(l)); };
-        for (int a = 0; a < 4; ++a) {
-          __m512 r = _mm512_castps128_ps512(load(a));
-          r = _mm512_maskz_insertf32x4(0xffff, r, load(a + 4), 1);
-          r = _mm512_maskz_insertf32x4(0xffff, r, load(a + 8), 2);
-          z[a] = _mm512_maskz_insertf32x4(0xffff, r, load(a + 12), 3);
-        }
-      };
-      if (_mm512_cmpeq_epi32_mask(_mm512_loadu_si512(idx), _mm512_set1_epi32(last)) == 0)
-        load_rows.template operator()<false>();
-      else
-        load_rows.template operator()<true>();
+      for (int a = 0; a < 4; ++a) {
+        __m512 r = _mm512_castps128_ps512(_mm_maskz_loadu_ps(kRow, row(a)));
+        r = _mm512_maskz_insertf32x4(0xffff, r, _mm_maskz_loadu_ps(kRow, row(a + 4)), 1);
+        r = _mm512_maskz_insertf32x4(0xffff, r, _mm_maskz_loadu_ps(kRow, row(a + 8)), 2);
+        z[a] = _mm512_maskz_insertf32x4(0xffff, r, _mm_maskz_loadu_ps(kRow, row(a + 12)), 3);
+      }
       const __m512 xy01 = _mm512_maskz_unpacklo_ps(0xffff, z[0], z[1]);  // x0 x1 y0 y1 per block
       const __m512 xy23 = _mm512_maskz_unpacklo_ps(0xffff, z[2], z[3]);
       out[0].v = _mm512_maskz_shuffle_ps(0xffff, xy01, xy23, _MM_SHUFFLE(1, 0, 1, 0));
@@ -242,21 +228,13 @@ inline void gather_vectors(std::span<const R> values, const std::uint32_t* idx, 
         out[2].v = _mm512_maskz_shuffle_ps(0xffff, zw01, zw23, _MM_SHUFFLE(1, 0, 1, 0));
       }
     } else {
-      // z[a] holds rows a, a + 4, one per 256-bit half (x y | z -); 64-bit interleaves, then
+      // z[a] holds rows a, a + 4, one per 256-bit half (x y | z 0); 64-bit interleaves, then
       // each component's 128-bit pieces put in lane order.
       __m512d z[4];
-      const auto load_rows = [&]<bool kMasked>() {
-        const auto load = [&](int l) {
-          return kMasked ? _mm256_maskz_loadu_pd(kRow, row(l)) : _mm256_loadu_pd(row(l));
-        };
-        for (int a = 0; a < 4; ++a)
-          z[a] = _mm512_maskz_insertf64x4(0xff, _mm512_castpd256_pd512(load(a)), load(a + 4), 1);
-      };
-      const __m256i lanes = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(idx));
-      if (_mm256_cmpeq_epi32_mask(lanes, _mm256_set1_epi32(last)) == 0)
-        load_rows.template operator()<false>();
-      else
-        load_rows.template operator()<true>();
+      for (int a = 0; a < 4; ++a) {
+        const __m512d r = _mm512_castpd256_pd512(_mm256_maskz_loadu_pd(kRow, row(a)));
+        z[a] = _mm512_maskz_insertf64x4(0xff, r, _mm256_maskz_loadu_pd(kRow, row(a + 4)), 1);
+      }
       // lo: (x_a x_a+1) (z_a z_a+1) (x_a+4 x_a+5) (z_a+4 z_a+5); hi: the same of y and the padding
       const __m512d lo01 = _mm512_maskz_unpacklo_pd(0xff, z[0], z[1]),
                     lo23 = _mm512_maskz_unpacklo_pd(0xff, z[2], z[3]);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <span>
 
 #if defined(__AVX512F__) && defined(__AVX512VL__)
 #include <immintrin.h>
@@ -197,27 +198,63 @@ inline R sum_lanes(const Pack<R>& p) {
   return s;
 }
 
-/// out[d] = Pack<R>::gather<D>(base, idx, d) for every d < D (lane l of out[d] is
-/// base[D idx[l] + d]): a register of D-vectors stored one after another (x0 y0 z0 x1 y1 z1 ...),
-/// the same values. With AVX-512 and D of 2 or 3 each vector is one masked load of its D scalars
-/// (nothing beyond them is read), the loads put side by side and transposed into the D registers:
-/// a gather instruction per component costs several times as much.
+#if SPH_SIMD_AVX512
+namespace detail {
+/// gather_vectors' loads of rows of D scalars (D of 2 or 3): z[a] holds rows idx[a], idx[a + 4],
+/// idx[a + 8], idx[a + 12], one per 128-bit block (x y z -); with kMasked each row's D scalars
+/// alone, otherwise the block's 4 (what follows the row's D lands in the unused lane).
+template <bool kMasked, int D>
+[[gnu::always_inline]] inline void load_rows(const float* base, const std::uint32_t* idx, __m512 (&z)[4]) {
+  constexpr unsigned kRow = (1u << D) - 1;  // a row's D scalars
+  const auto load = [base, idx](int l) {
+    const float* row = base + static_cast<std::size_t>(idx[l]) * D;
+    return kMasked ? _mm_maskz_loadu_ps(kRow, row) : _mm_loadu_ps(row);
+  };
+  for (int a = 0; a < 4; ++a) {
+    __m512 r = _mm512_castps128_ps512(load(a));
+    r = _mm512_maskz_insertf32x4(0xffff, r, load(a + 4), 1);
+    r = _mm512_maskz_insertf32x4(0xffff, r, load(a + 8), 2);
+    z[a] = _mm512_maskz_insertf32x4(0xffff, r, load(a + 12), 3);
+  }
+}
+/// The same in double, each row masked to its D scalars (plain loads of 4 doubles made the 8,000
+/// particle bench's double force pass 0.50 -> 0.70 ms): z[a] holds rows idx[a], idx[a + 4], one per
+/// 256-bit half (x y | z 0).
+template <int D>
+[[gnu::always_inline]] inline void load_rows(const double* base, const std::uint32_t* idx, __m512d (&z)[4]) {
+  constexpr unsigned kRow = (1u << D) - 1;
+  const auto load = [base, idx](int l) {
+    return _mm256_maskz_loadu_pd(kRow, base + static_cast<std::size_t>(idx[l]) * D);
+  };
+  for (int a = 0; a < 4; ++a) z[a] = _mm512_maskz_insertf64x4(0xff, _mm512_castpd256_pd512(load(a)), load(a + 4), 1);
+}
+}  // namespace detail
+#endif
+
+/// out[d] = Pack<R>::gather<D>(values.data(), idx, d) for every d < D (lane l of out[d] is
+/// values[D idx[l] + d]): a register of D-vectors stored one after another (x0 y0 z0 x1 y1 z1 ...,
+/// flat()), the same values. With AVX-512 and D of 2 or 3 each vector is one load, the loads put
+/// side by side and transposed into the D registers: a gather instruction per component costs
+/// several times as much. In float each load takes 4 scalars, the vector's D and what follows
+/// them (unused), except in a register whose lanes include the last vector, which nothing follows:
+/// there each is masked to its D (nothing beyond the array is read). The masked loads cost the 1M
+/// bench's float density pass a fifth more on the AMD machine of docs/performance.md; in double
+/// the plain loads cost more than the masked ones, which it keeps.
 template <int D, class R>
-inline void gather_vectors(const R* base, const std::uint32_t* idx, Pack<R> (&out)[D]) {
+[[gnu::always_inline]] inline void gather_vectors(std::span<const R> values, const std::uint32_t* idx,
+                                                  Pack<R> (&out)[D]) {
+  const R* const base = values.data();
 #if SPH_SIMD_AVX512
   if constexpr (D == 2 || D == 3) {
-    constexpr unsigned kRow = (1u << D) - 1;  // a row's D scalars
-    const auto row = [&](int l) { return base + static_cast<std::size_t>(idx[l]) * D; };
     if constexpr (sizeof(R) == 4) {
-      // z[a] holds rows a, a + 4, a + 8, a + 12, one per 128-bit block (x y z 0); a 4 x 4
+      // z[a] holds rows a, a + 4, a + 8, a + 12, one per 128-bit block (x y z -); a 4 x 4
       // transpose within each block then gives lanes 4b..4b+3 of each component.
       __m512 z[4];
-      for (int a = 0; a < 4; ++a) {
-        __m512 r = _mm512_castps128_ps512(_mm_maskz_loadu_ps(kRow, row(a)));
-        r = _mm512_maskz_insertf32x4(0xffff, r, _mm_maskz_loadu_ps(kRow, row(a + 4)), 1);
-        r = _mm512_maskz_insertf32x4(0xffff, r, _mm_maskz_loadu_ps(kRow, row(a + 8)), 2);
-        z[a] = _mm512_maskz_insertf32x4(0xffff, r, _mm_maskz_loadu_ps(kRow, row(a + 12)), 3);
-      }
+      const auto last = static_cast<std::int32_t>(values.size() / D - 1);
+      if (_mm512_cmpeq_epi32_mask(_mm512_loadu_si512(idx), _mm512_set1_epi32(last)) == 0)
+        detail::load_rows<false, D>(base, idx, z);
+      else
+        detail::load_rows<true, D>(base, idx, z);
       const __m512 xy01 = _mm512_maskz_unpacklo_ps(0xffff, z[0], z[1]);  // x0 x1 y0 y1 per block
       const __m512 xy23 = _mm512_maskz_unpacklo_ps(0xffff, z[2], z[3]);
       out[0].v = _mm512_maskz_shuffle_ps(0xffff, xy01, xy23, _MM_SHUFFLE(1, 0, 1, 0));
@@ -231,10 +268,7 @@ inline void gather_vectors(const R* base, const std::uint32_t* idx, Pack<R> (&ou
       // z[a] holds rows a, a + 4, one per 256-bit half (x y | z 0); 64-bit interleaves, then
       // each component's 128-bit pieces put in lane order.
       __m512d z[4];
-      for (int a = 0; a < 4; ++a) {
-        const __m512d r = _mm512_castpd256_pd512(_mm256_maskz_loadu_pd(kRow, row(a)));
-        z[a] = _mm512_maskz_insertf64x4(0xff, r, _mm256_maskz_loadu_pd(kRow, row(a + 4)), 1);
-      }
+      detail::load_rows<D>(base, idx, z);
       // lo: (x_a x_a+1) (z_a z_a+1) (x_a+4 x_a+5) (z_a+4 z_a+5); hi: the same of y and the padding
       const __m512d lo01 = _mm512_maskz_unpacklo_pd(0xff, z[0], z[1]),
                     lo23 = _mm512_maskz_unpacklo_pd(0xff, z[2], z[3]);

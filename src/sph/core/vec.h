@@ -73,15 +73,15 @@ bool all_finite(const Vec<D, R>& a) {
   return true;
 }
 
-/// The scalars of a vector field, x0 y0 z0 x1 y1 z1 ..., so that pair loops load or gather lanes
-/// of them (simd::gather_vectors).
+/// The scalars of a vector field, x0 y0 z0 x1 y1 z1 ... (D times as many), so that pair loops
+/// load or gather lanes of them (simd::gather_vectors).
 template <int D, std::floating_point R>
-const R* flat(std::span<const Vec<D, R>> v) {
+std::span<const R> flat(std::span<const Vec<D, R>> v) {
   static_assert(sizeof(Vec<D, R>) == D * sizeof(R));
-  return reinterpret_cast<const R*>(v.data());
+  return {reinterpret_cast<const R*>(v.data()), v.size() * D};
 }
 template <int D, std::floating_point R>
-const R* flat(const std::vector<Vec<D, R>>& v) {
+std::span<const R> flat(const std::vector<Vec<D, R>>& v) {
   return flat(std::span<const Vec<D, R>>(v));
 }
 

@@ -69,8 +69,7 @@ std::uint32_t TrackedNeighbors<D, R>::PathFilter::keep(std::size_t i, std::uint3
   using P = simd::Pack<R>;
   constexpr int kW = simd::kLanes<R>;
   const TrackedNeighbors& t = *self;
-  const R* path = flat(t.path_now_);
-  const R* w = flat(t.built_velocity_);
+  const std::span<const R> path = flat(t.path_now_), w = flat(t.built_velocity_);
   const R* left = t.left_.data();
   const R reach = t.radius_ + t.skin_;
   const P reach2 = P::set1(reach * reach), zero = P::set1(R(0)), li = P::set1(t.left_[i]);

@@ -49,8 +49,8 @@ void check_boundary_inputs(const ParticleSet<D, R>& ps, const BoundaryView<D, R>
 /// rij = x_i - x_j for one register of neighbors j = idx[0..lanes), gathered from the flat
 /// positions; returns |rij|^2, summed as norm2 does (the lists' distance test uses the same).
 template <int D, std::floating_point R>
-simd::Pack<R> pair_offsets(const simd::Pack<R> (&xi)[D], const R* pos, const std::uint32_t* idx,
-                           simd::Pack<R> (&rij)[D]) {
+[[gnu::always_inline]] inline simd::Pack<R> pair_offsets(const simd::Pack<R> (&xi)[D], std::span<const R> pos,
+                                                         const std::uint32_t* idx, simd::Pack<R> (&rij)[D]) {
   using P = simd::Pack<R>;
   P r2 = P::set1(R(0));
   P xj[D];
@@ -157,7 +157,7 @@ struct DensityKernel {
 /// (Not inlined: inlined into the density pass, with the mass broadcast, it made the pass slower,
 /// 0.64 -> 0.97 s in the paper's 2D dam break and 33 -> 37 ms at 1M; out of line 0.78 s and 33 ms.)
 template <KernelKind K, int D, std::floating_point R, class M>
-[[gnu::noinline]] simd::Pack<R> density_sum(const simd::Pack<R> (&xi)[D], const R* pos, M mass,
+[[gnu::noinline]] simd::Pack<R> density_sum(const simd::Pack<R> (&xi)[D], std::span<const R> pos, M mass,
                                             std::span<const std::uint32_t> nb, const DensityKernel<K, D, R>& dk,
                                             std::uint64_t& count) {
   using P = simd::Pack<R>;
@@ -235,7 +235,7 @@ class DensityStore {
         k_(static_cast<R>(fluid.stiffness)),
         clamp_(fluid.negative_pressure == NegativePressure::Clamp),
         walls_(boundary.active()),
-        bpos_(walls_ ? flat(boundary.position) : nullptr) {}
+        bpos_(walls_ ? flat(boundary.position) : std::span<const R>()) {}
 
   /// Particle i (at xi, in every lane), whose fluid pairs sum to `pairs`.
   void operator()(std::size_t i, const simd::Pack<R> (&xi)[D], R pairs, std::uint64_t& boundary_count) const {
@@ -254,7 +254,7 @@ class DensityStore {
   DensityKernel<K, D, R> dk_;
   R w0_, rho0_, k_;
   bool clamp_, walls_;
-  const R* bpos_;
+  std::span<const R> bpos_;
 };
 
 template <KernelKind K, int D, std::floating_point R>
@@ -263,7 +263,7 @@ std::uint64_t density_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R 
   using P = simd::Pack<R>;
   const DensityStore<K, D, R> store(ps, h, fluid, boundary);
   const DensityKernel<K, D, R> dk(h);
-  const R* pos = flat(ps.position);
+  const std::span<const R> pos = flat(ps.position);
   within.assign(chunk_count(ps.size()), 0);
   constexpr std::size_t W = simd::kLanes<R>;
   // A register's worth of particles at a time: their lanes are added together
@@ -399,8 +399,8 @@ class ForceTerms {
         art_i_(P::set1(R(-2) * fc_.alpha * fc_.c0 * h)),  // Monaghan's Pi_ij = -alpha c0 h mu_ij / rho_ij
         dtv_(P::set1(dt)) {
     solid_ = boundary.active();
-    bpos_ = solid_ ? flat(boundary.position) : nullptr;
-    bvel_ = solid_ && !boundary.velocity.empty() ? flat(boundary.velocity) : nullptr;
+    if (solid_) bpos_ = flat(boundary.position);
+    if (solid_) bvel_ = flat(boundary.velocity);  // (empty: the samples are at rest)
     // (floating bodies: what each body's samples give a particle is recorded, per lane)
     sample_body_ = solid_ && boundary.body_acceleration && !boundary.body.empty() ? boundary.body.data() : nullptr;
   }
@@ -525,7 +525,7 @@ class ForceTerms {
       const P psib = P::template gather<1>(boundary_.psi.data(), bidx + k0, 0);
       // The velocity relative to the sample's (moving obstacles), else the particle's own.
       P vib[D];
-      if (bvel_) {
+      if (!bvel_.empty()) {
         simd::gather_vectors<D>(bvel_, bidx + k0, vib);
         for (int d = 0; d < D; ++d) vib[d] = s.v[d] - vib[d];
       } else {
@@ -603,8 +603,7 @@ class ForceTerms {
   R lap_c_;
   P eps_h2_, art_i_, dtv_;
   bool solid_ = false;
-  const R* bpos_ = nullptr;
-  const R* bvel_ = nullptr;
+  std::span<const R> bpos_, bvel_;
   const std::uint16_t* sample_body_ = nullptr;
 };
 
@@ -620,8 +619,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
   constexpr int W = simd::kLanes<R>;
   const ForceTerms<K, kForm, kPressure, kExitTest, D, R> terms(ps, h, fluid, gravity, walls, flags, dt, boundary,
                                                                exit_radius);
-  const R* pos = flat(ps.position);
-  const R* vel = flat(ps.velocity);
+  const std::span<const R> pos = flat(ps.position), vel = flat(ps.velocity);
   const R* rho = ps.density.data();
   scratch.reserve(2 * ps.size() * sizeof(R));
   R* const inv_rho_p = scratch.place<R>(0, 2 * ps.size());
@@ -651,7 +649,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
         ForceOther<D, R> j;
         j.r2 = pair_offsets<D>(side.x, pos, idx + k0, j.rij);
         P inv_rho_and_p[2];
-        simd::gather_vectors<2>(inv_rho_p, idx + k0, inv_rho_and_p);
+        simd::gather_vectors<2>(std::span<const R>(inv_rho_p, 2 * ps.size()), idx + k0, inv_rho_and_p);
         j.inv_rho = inv_rho_and_p[0];
         if constexpr (kPressure) j.p = inv_rho_and_p[1];
         j.rho = terms.artificial() ? P::template gather<1>(rho, idx + k0, 0) : j.inv_rho;  // (unread without)

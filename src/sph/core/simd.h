@@ -218,7 +218,7 @@ template <bool kMasked, int D>
   }
 }
 /// The same in double, each row masked to its D scalars (plain loads of 4 doubles made the 8,000
-/// particle bench's double force pass 0.50 -> 0.70 ms): z[a] holds rows idx[a], idx[a + 4], one per
+/// particle bench's double force pass 0.47 -> 0.54 ms): z[a] holds rows idx[a], idx[a + 4], one per
 /// 256-bit half (x y | z 0).
 template <int D>
 [[gnu::always_inline]] inline void load_rows(const double* base, const std::uint32_t* idx, __m512d (&z)[4]) {

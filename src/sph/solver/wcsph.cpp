@@ -399,8 +399,10 @@ class ForceTerms {
         art_i_(P::set1(R(-2) * fc_.alpha * fc_.c0 * h)),  // Monaghan's Pi_ij = -alpha c0 h mu_ij / rho_ij
         dtv_(P::set1(dt)) {
     solid_ = boundary.active();
-    if (solid_) bpos_ = flat(boundary.position);
-    if (solid_) bvel_ = flat(boundary.velocity);  // (empty: the samples are at rest)
+    if (solid_) {
+      bpos_ = flat(boundary.position);
+      bvel_ = flat(boundary.velocity);  // (empty: the samples are at rest)
+    }
     // (floating bodies: what each body's samples give a particle is recorded, per lane)
     sample_body_ = solid_ && boundary.body_acceleration && !boundary.body.empty() ? boundary.body.data() : nullptr;
   }
@@ -623,6 +625,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
   const R* rho = ps.density.data();
   scratch.reserve(2 * ps.size() * sizeof(R));
   R* const inv_rho_p = scratch.place<R>(0, 2 * ps.size());
+  const std::span<const R> inv_rho_and_ps(inv_rho_p, 2 * ps.size());  // (gather_vectors' view)
   parallel_for(ps.size(), [&, inv_rho_p](std::size_t i) {
     inv_rho_p[2 * i] = R(1) / ps.density[i];
     inv_rho_p[2 * i + 1] = ps.pressure[i];
@@ -649,7 +652,7 @@ void force_pass(ParticleSet<D, R>& ps, const NeighborLists& lists, R h, const Fl
         ForceOther<D, R> j;
         j.r2 = pair_offsets<D>(side.x, pos, idx + k0, j.rij);
         P inv_rho_and_p[2];
-        simd::gather_vectors<2>(std::span<const R>(inv_rho_p, 2 * ps.size()), idx + k0, inv_rho_and_p);
+        simd::gather_vectors<2>(inv_rho_and_ps, idx + k0, inv_rho_and_p);
         j.inv_rho = inv_rho_and_p[0];
         if constexpr (kPressure) j.p = inv_rho_and_p[1];
         j.rho = terms.artificial() ? P::template gather<1>(rho, idx + k0, 0) : j.inv_rho;  // (unread without)

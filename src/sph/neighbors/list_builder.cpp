@@ -352,6 +352,7 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
     ChunkStencils<D, R> stencils;
     std::size_t used = 0, entries = 0;
     std::uint32_t cells[kChunkSize];  // the chunk's cells, in one loop
+    alignas(64) R visitor_room[PairVisitor<R>::kRoom];
     SPH_CHECK(e - b <= kChunkSize, "parallel_chunks gives chunks of kChunkSize points at most");
     query.cells(b, e, cells);
     for (std::size_t i = b; i < e; ++i) {
@@ -359,7 +360,7 @@ void ListBuilder<D, R>::build_with(const UniformGrid<D, R>& grid, std::size_t n,
       if (dist && dist->size() < st.candidates + kRoom) dist->resize(st.candidates + kRoom);
       const std::uint32_t m = gather_into(buf, used, spill, vector_, grid, st, query.x(i), query.self(i), r2, inner2(),
                                           far_room(st.candidates), filter_, i, dist ? dist->data() : nullptr);
-      if (dist) visitor_->visit(i, {buf.data() + used, m}, {dist->data(), m});
+      if (dist) visitor_->visit(i, {buf.data() + used, m}, {dist->data(), m}, visitor_room);
       if (room_) out.begin_[i] = static_cast<std::uint32_t>(used);
       out.end_[i] = static_cast<std::uint32_t>(used + m);
       entries += m;

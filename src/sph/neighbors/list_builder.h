@@ -43,10 +43,15 @@ struct ListFilter {
 /// neighbors' positions again. Called from the thread that builds the list: the lists of a chunk
 /// of kChunkSize particles (parallel.h) one after the other, in particle order, in one thread.
 /// `r2` is readable (stale values) for NeighborLists::kPadding entries past its end.
+/// `room`: kRoom reals, 64-byte aligned, that the builder keeps for the visitor through one
+/// chunk's visits and gives no one else (the visitor's state across a chunk's particles, on the
+/// building thread's stack: a `thread_local` array there cost a call to find it and the vector
+/// registers spilled around that call, for every particle).
 template <std::floating_point R>
 struct PairVisitor {
+  static constexpr std::size_t kRoom = 256;
   virtual ~PairVisitor() = default;
-  virtual void visit(std::size_t i, std::span<const std::uint32_t> list, std::span<const R> r2) const = 0;
+  virtual void visit(std::size_t i, std::span<const std::uint32_t> list, std::span<const R> r2, R* room) const = 0;
 };
 
 template <int D, std::floating_point R>

@@ -197,23 +197,28 @@ simd::Pack<R> density_sum_of(std::span<const R> r2s, R mass, const DensityKernel
   return sum;
 }
 
-/// Each list's lanes are kept until a register's worth of consecutive particles have theirs
-/// (a group of kLanes starts at a multiple of kLanes, so lies within one chunk, which one thread
-/// visits in order), then the group's lanes are summed at once (simd::sum_lanes_each: the same
-/// bits as one sum_lanes each, without a chain of scalar additions per particle).
+/// Each list's lanes are kept (in the builder's room for the chunk) until a register's worth of
+/// consecutive particles have theirs (a group of kLanes starts at a multiple of kLanes, so lies
+/// within one chunk, which one thread visits in order), then the group's lanes are summed at once
+/// (simd::sum_lanes_each: the same bits as one sum_lanes each, without a chain of scalar
+/// additions per particle).
 template <KernelKind K, int D, std::floating_point R>
 class KernelPairDensity final : public PairDensity<D, R> {
  public:
   explicit KernelPairDensity(R h) : dk_(h) {}
-  void visit(std::size_t i, std::span<const std::uint32_t> list, std::span<const R> r2) const override {
+  void visit(std::size_t i, std::span<const std::uint32_t> list, std::span<const R> r2, R* room) const override {
     (void)list;
+    using P = simd::Pack<R>;
     constexpr std::size_t W = simd::kLanes<R>;
     static_assert(kChunkSize % W == 0, "a group of particles lies within one chunk");
-    thread_local simd::Pack<R> group[W];  // (the calling thread's group of particles)
+    static_assert(W * W <= PairVisitor<R>::kRoom, "a group's lanes fit the builder's room");
     const std::size_t slot = i % W;
-    group[slot] = density_sum_of<K, D>(r2, this->mass_, dk_);
-    if (slot == W - 1 || i + 1 == this->particles_)
+    density_sum_of<K, D>(r2, this->mass_, dk_).store(room + slot * W);
+    if (slot == W - 1 || i + 1 == this->particles_) {
+      P group[W];  // (all set: sum_lanes_each reads every pack of a group, used or not)
+      for (std::size_t k = 0; k < W; ++k) group[k] = k <= slot ? P::load(room + k * W) : P::set1(R(0));
       simd::sum_lanes_each(group, static_cast<int>(slot + 1), this->density_ + (i - slot));
+    }
   }
 
  private:

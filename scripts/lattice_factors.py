@@ -12,7 +12,10 @@ particle spacings, on the square (cubic) lattice of spacing 1 with one particle 
 - "gradient": sum_j V |W'(r_j)| x_j^2 / r_j, the lattice's factor on the gradient of a linear
   field (1 in the continuum);
 - "sum / gradient": what a resting tank on its initial lattice reads as p / (rho0 g d) in its
-  interior. With the default mass m = rho0 V / sum, a symmetric pressure force
+  interior.
+Then the same in 3D for the face-centred cubic lattice at the same number of particles per unit
+volume (cubic cells of edge 4^(1/3), 4 particles each), h in the same unit (scripts/fcc_tank.py
+starts the 3D DFSPH tank from it). With the default mass m = rho0 V / sum, a symmetric pressure force
   -sum_j m (p_i + p_j) / rho0^2 grad W_ij on a linear p of gradient G is G (m / V) gradient /
   rho0^2 = G gradient / (rho0 sum), which balances g where G = rho0 g sum / gradient.
 """
@@ -67,6 +70,20 @@ def main():
                     print(f"| {dim} | {h:g} | {kind} | - | {grad:.4f} | - |")
                 else:
                     print(f"| {dim} | {h:g} | {kind} | {total:.4f} | {grad:.4f} | {total / grad:.4f} |")
+    print()
+    print("| lattice | h (spacings) | kernel | sum | gradient | sum / gradient |")
+    print("| --- | ---: | --- | ---: | ---: | ---: |")
+    edge = 4 ** (1 / 3)
+    basis = [(0, 0, 0), (0.5, 0.5, 0), (0.5, 0, 0.5), (0, 0.5, 0.5)]
+    for h in supports:
+        n = int(math.ceil(h / edge)) + 1
+        points = np.array([[edge * (c[k] + b[k]) for k in range(3)] for c in itertools.product(range(-n, n + 1), repeat=3)
+                           for b in basis if any(c) or any(b)], float)
+        r = np.linalg.norm(points, axis=1)
+        for kind in ("cubic", "wendland"):
+            total = float(np.sum(kernel(kind, r, h, 3)) + kernel(kind, np.array(0.0), h, 3))
+            grad = float(np.sum(-derivative(kind, r, h, 3) * points[:, 0] ** 2 / r))
+            print(f"| fcc | {h:g} | {kind} | {total:.4f} | {grad:.4f} | {total / grad:.4f} |")
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds one of the stand-alone measuring programs scripts/NAME.cpp with the project's flags
 # (-O3 -march=native -ffp-contract=off -fno-math-errno, src/ on the include path) and runs it RUNS
-# times. pair_bound.sh and gather_cost.sh call it.
+# times. pair_bound.sh, gather_cost.sh and core_share.sh call it.
 #   bash scripts/probe.sh NAME [RUNS]      (RUNS default 1)
 set -euo pipefail
 cd "$(dirname "$0")/.."

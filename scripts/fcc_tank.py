@@ -14,19 +14,24 @@ spacing in). That is 9.8 % more particles per cubic metre than the scene's 8,000
 gives each particle of the infinite lattice exactly rho0 (sph's cubic spline, support h), and
 the kernel radius is 2.15 equivalent spacings (the scene's ratio) unless given.
 
-Prints what scripts/tank_bins.py prints for the scene (the run's last tenth averaged; the surface
-is the columns' top particles plus a / 4, half the lattice's plane spacing), and the kinetic
+Prints tank_bins.py's bins for the scene (the run's last tenth averaged; the surface is the
+columns' top particles plus a / 4, half the lattice's plane spacing), and the kinetic
 energy against its early peak (the largest of the first twentieth of the steps) at a few times, and
 the last time it was above 1 % of it: whether the tank settles.
 """
 import itertools
 import math
+import os
 import sys
 
 import numpy as np
 import sph
 
-SCENE = "scenes/validation/hydrostatic_3d_dfsph.json"
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from tank_bins import average_last_tenth, print_bins, surface_of, tank_geometry, wall_distance  # noqa: E402
+
+SCENE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes", "validation",
+                     "hydrostatic_3d_dfsph.json")
 CELLS = 13  # cubic cells per side of the 0.1 m cube
 SIDE = 0.1
 BASIS = np.array([(0, 0, 0), (0.5, 0.5, 0), (0.5, 0, 0.5), (0, 0.5, 0.5)])
@@ -62,41 +67,14 @@ def main():
     if len(sim.positions) != len(positions):
         sys.exit(f"the scene made {len(sim.positions)} particles, not {len(positions)}")
     sim.positions = positions
-    d = scene.to_dict()
-    dx = 2 * d["Configuration"]["particleRadius"]
-    g = -d["Configuration"]["gravitation"][1]
-    rho0 = d["Fluid"]["density0"]
-    lo, hi = d["Container"]["start"], d["Container"]["end"]
-    end = d["Configuration"]["stopAt"]
+    dim, dx, g, rho0, lo, hi, end = tank_geometry(scene)
     energy = []
     while sim.time < 0.9 * end:
         sim.step(1)
         energy.append((sim.time, sim.counters["kinetic_energy"], sim.counters["max_speed"]))
-    sums, n = None, 0
-    while sim.time < end * (1 - 1e-12):  # the last tenth, by particle id
-        sim.step(1)
-        order = np.argsort(np.asarray(sim.ids))
-        now = [np.asarray(f)[order] for f in (sim.pressures, sim.positions, sim.densities)]
-        sums = now if sums is None else [s + f for s, f in zip(sums, now)]
-        n += 1
-    p, x, rho = (s / n for s in sums)
-    tops = {}
-    for xx in x:
-        key = (int(np.floor(xx[0] / dx)), int(np.floor(xx[2] / dx)))
-        tops[key] = max(tops.get(key, -np.inf), xx[1])
-    surface = float(np.mean(list(tops.values()))) + a / 4
-    depth = surface - x[:, 1]
-    wall = np.minimum.reduce([x[:, 0] - lo[0], hi[0] - x[:, 0], x[:, 2] - lo[2], hi[2] - x[:, 2]])
-    print(f"{n} steps averaged, surface {surface:.4f} m, mean |rho - rho0| / rho0 "
-          f"{np.mean(np.abs(rho - rho0)) / rho0:.2e}")
-    deep = depth > 2 * dx
-    bins = np.floor((depth - 2 * dx) / (2 * dx)).astype(int)
-    for k in np.unique(bins[deep]):
-        whole = deep & (bins == k)
-        inner = whole & (wall > 3 * dx)
-        print(f"bin {k:2d}  depth {depth[whole].mean():.4f} m  "
-              f"whole {p[whole].mean() / (rho0 * g * depth[whole].mean()):.3f} ({whole.sum()})  "
-              f"interior {p[inner].mean() / (rho0 * g * depth[inner].mean()):.3f} ({inner.sum()})")
+    p, x, rho, n = average_last_tenth(
+        sim, end, lambda *_: energy.append((sim.time, sim.counters["kinetic_energy"], sim.counters["max_speed"])))
+    print_bins(p, x, rho, n, surface_of(x, dim, dx, a / 4), wall_distance(x, dim, lo, hi), dx, rho0, g)
     energy = np.array(energy)
     peak = float(np.max(energy[: max(10, len(energy) // 20), 1]))
     for t in (0.05, 0.1, 0.2, 0.3, 0.4, 0.6, 1.0, 1.5):

@@ -22,54 +22,56 @@ import numpy as np
 import sph
 
 
-def main():
-    overrides = {}
-    for arg in sys.argv[2:]:
-        key, value = arg.split("=", 1)
-        try:
-            overrides[key] = json.loads(value)
-        except ValueError:
-            overrides[key] = value
-    scene = sph.load_scene(sys.argv[1], overrides=overrides)
+def tank_geometry(scene):
+    """What the measures need of a tank's scene: dimension, spacing, g, rho0, container corners,
+    end time."""
     d = scene.to_dict()
-    dim = d["dimension"]
-    dx = 2 * d["Configuration"]["particleRadius"]
-    g = -d["Configuration"]["gravitation"][1]
-    rho0 = d["Fluid"]["density0"]
-    lo, hi = d["Container"]["start"], d["Container"]["end"]
     c = d["Configuration"]
     end = c["stopAt"] if "stopAt" in c else c["numberOfSteps"] * c["timeStepSize"]
-    sim = sph.Simulation(scene)
+    return (d["dimension"], 2 * c["particleRadius"], -c["gravitation"][1], d["Fluid"]["density0"],
+            d["Container"]["start"], d["Container"]["end"], end)
+
+
+def surface_of(x, dim, dx, above):
+    """The free surface: the mean of each column's (dx wide) top particle, plus `above`."""
+    tops = {}
+    for xx in x:
+        key = (int(np.floor(xx[0] / dx)), int(np.floor(xx[2] / dx)) if dim == 3 else 0)
+        tops[key] = max(tops.get(key, -np.inf), xx[1])
+    return float(np.mean(list(tops.values()))) + above
+
+
+def wall_distance(x, dim, lo, hi):
+    """Each particle's distance to the nearest side wall."""
+    wall = np.full(len(x), np.inf)
+    for a in [0] + ([2] if dim == 3 else []):
+        wall = np.minimum(wall, np.minimum(x[:, a] - lo[a], hi[a] - x[:, a]))
+    return wall
+
+
+def average_last_tenth(sim, end, each_step=None):
+    """Runs sim to `end`, averaging each particle's pressure, position and density (by particle id)
+    over the steps of the last tenth; `each_step(pressures, positions)` sees each of those steps'.
+    Returns p, x, rho and the number of steps averaged."""
     while sim.time < 0.9 * end:
         sim.step(1)
-
-    def surface_of(x):
-        tops = {}
-        for xx in x:
-            key = (int(np.floor(xx[0] / dx)), int(np.floor(xx[2] / dx)) if dim == 3 else 0)
-            tops[key] = max(tops.get(key, -np.inf), xx[1])
-        return float(np.mean(list(tops.values()))) + dx / 2
-
-    def wall_distance(x):
-        wall = np.full(len(x), np.inf)
-        for a in [0] + ([2] if dim == 3 else []):
-            wall = np.minimum(wall, np.minimum(x[:, a] - lo[a], hi[a] - x[:, a]))
-        return wall
-
-    sums, n, steps = None, 0, []
-    while sim.time < end * (1 - 1e-12):  # the last tenth, by particle id
+    sums, n = None, 0
+    while sim.time < end * (1 - 1e-12):
         sim.step(1)
         order = np.argsort(np.asarray(sim.ids))
         now = [np.asarray(a)[order] for a in (sim.pressures, sim.positions, sim.densities)]
         sums = now if sums is None else [s + a for s, a in zip(sums, now)]
         n += 1
-        d = surface_of(now[1]) - now[1][:, 1]
-        inner = (d > 2 * dx) & (wall_distance(now[1]) > 3 * dx) & (now[1][:, 1] - lo[1] > 2 * dx)
-        steps.append(np.mean(now[0][inner] / (rho0 * g * d[inner])))
+        if each_step:
+            each_step(now[0], now[1])
     p, x, rho = (s / n for s in sums)
-    surface = surface_of(x)
+    return p, x, rho, n
+
+
+def print_bins(p, x, rho, n, surface, wall, dx, rho0, g):
+    """The averages' summary line and each 2-spacing depth bin below the second layer: the mean
+    p / (rho0 g d) of the whole bin and of its interior (at least 3 spacings from the side walls)."""
     depth = surface - x[:, 1]
-    wall = wall_distance(x)
     print(f"{n} steps averaged, surface {surface:.4f} m, mean |rho - rho0| / rho0 "
           f"{np.mean(np.abs(rho - rho0)) / rho0:.2e}")
     deep = depth > 2 * dx
@@ -81,6 +83,30 @@ def main():
         inside = p[inner].mean() / (rho0 * g * depth[inner].mean()) if inner.any() else float("nan")
         print(f"bin {k:2d}  depth {depth[whole].mean():.4f} m  whole {ratio:.3f} ({whole.sum()})  "
               f"interior {inside:.3f} ({inner.sum()})")
+
+
+def main():
+    overrides = {}
+    for arg in sys.argv[2:]:
+        key, value = arg.split("=", 1)
+        try:
+            overrides[key] = json.loads(value)
+        except ValueError:
+            overrides[key] = value
+    scene = sph.load_scene(sys.argv[1], overrides=overrides)
+    dim, dx, g, rho0, lo, hi, end = tank_geometry(scene)
+    sim = sph.Simulation(scene)
+    steps = []
+
+    def interior_mean(p, x):  # one step's interior mean p / (rho0 g d)
+        d = surface_of(x, dim, dx, dx / 2) - x[:, 1]
+        inner = (d > 2 * dx) & (wall_distance(x, dim, lo, hi) > 3 * dx) & (x[:, 1] - lo[1] > 2 * dx)
+        steps.append(np.mean(p[inner] / (rho0 * g * d[inner])))
+
+    p, x, rho, n = average_last_tenth(sim, end, interior_mean)
+    surface = surface_of(x, dim, dx, dx / 2)
+    depth = surface - x[:, 1]
+    print_bins(p, x, rho, n, surface, wall_distance(x, dim, lo, hi), dx, rho0, g)
     # Layer by layer (bins of one spacing from the surface): what the two-spacing bins average out.
     layers = np.floor(depth / dx).astype(int) + 1
     for k in range(1, 11):

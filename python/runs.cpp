@@ -18,6 +18,7 @@
 #include <sph/core/parallel.h>
 #include <sph/io/frames.h>
 #include <sph/io/run_directory.h>
+#include <sph/io/run_output.h>
 #include <sph/neighbors/neighbor_mode.h>
 #include <sph/run/driver.h>
 #include <sph/run/memory.h>
@@ -80,18 +81,12 @@ bool python_signal(std::optional<py::error_already_set>& pending) {
 py::dict run_scene(const Scene& scene, const std::string& output, const py::object& neighbors, const py::object& steps,
                    const py::object& threads, std::int64_t checkpoint_every, bool strict, bool overwrite,
                    const py::object& progress_arg) {
-  if (output.empty()) throw Error("expected an output directory", "output");
   if (checkpoint_every < 0) throw py::value_error("checkpoint_every must be 0 or more steps");
   const SceneDesc desc = with_overrides(scene.desc, run_overrides(neighbors, steps));
   const int n_threads = thread_count(threads);
   const Progress progress(progress_arg);
   const fs::path dir(output);
-  if (!overwrite)
-    if (const std::optional<std::string> unfinished = unfinished_run(dir))
-      throw Error("holds " + *unfinished +
-                      "; give overwrite=True to delete it (with the run's frames, stats and summary) and start this "
-                      "run there",
-                  dir.string());
+  check_new_run_directory(dir, overwrite, "output", "overwrite=True", "");
   std::optional<py::error_already_set> interrupt;
   std::optional<py::error_already_set> callback_error;
   RunResult result;
@@ -175,7 +170,10 @@ py::dict compare_scene(const Scene& scene, const py::object& output, const py::o
   const int n_threads = thread_count(threads);
   const Progress progress(progress_arg);
   std::optional<fs::path> dir;
-  if (!output.is_none()) dir = fs::path(py::cast<std::string>(py::str(output)));
+  if (!output.is_none()) {
+    dir = fs::path(py::cast<std::string>(py::str(output)));
+    check_output_path(dir->string(), "output");
+  }
   std::optional<py::error_already_set> callback_error;
   CompareResult result;
   {
@@ -311,11 +309,12 @@ run raises sph.SimulationError (the frames before the failure are kept).)doc");
         py::arg("progress") = py::none(),
         R"doc(Runs the neighbor modes on the scene and compares them, as `sph compare` does.
 
-modes: names of sph.NEIGHBOR_MODES that are compared (default: all of them; standard, the
-reference, is always run); output: the report's directory (report.md, CSVs, images and, with
+modes: names of sph.NEIGHBOR_MODES that are compared (default: all but brute_force, as sph
+compare; standard, the reference, is always run); output: the report's directory (report.md, CSVs, images and, with
 run_frames, each mode's frames), or None for no files; frames, perturbation (of h: the chaos
 floor) and audit as the flags. progress: True, or a callable progress(label, index, count,
-steps_done, steps). Returns {"scene", "steps", "threads", "audited", "runs": [{"label", "mode",
+steps_done, steps). "speedup": the mean seconds of the standard runs (the reference and the
+perturbed one) divided by this run's. Returns {"scene", "steps", "threads", "audited", "runs": [{"label", "mode",
 "perturbed", "seconds", "speedup", "steps", "missed_pairs", "boundary_missed_pairs" (fluid-boundary
 pairs, 0 without boundary particles), "final_rms_divergence", "failure"}], "output", "report"}.)doc");
   m.def("read_frame", &read_frame_dict, py::arg("path"),

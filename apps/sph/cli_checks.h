@@ -15,6 +15,7 @@
 #include <CLI/CLI.hpp>
 
 #include <sph/core/error.h>
+#include <sph/io/run_directory.h>
 
 namespace sph::app {
 
@@ -29,18 +30,6 @@ inline CLI::Validator positive_number(const std::string& what) {
         return "expected a positive number (" + what + "), got " + text;
       },
       "POSITIVE");
-}
-
-/// Refuses an output directory given as "" (which would mean the current directory) or as the
-/// root of the file system (whose files a run or a render would replace), naming `flag`.
-inline void check_output_path(const std::string& path, const std::string& flag) {
-  if (path.empty())
-    throw Error("an empty directory name; expected the directory to write to, e.g. -o out/my_run", flag);
-  std::error_code ec;
-  const std::filesystem::path p = std::filesystem::absolute(path, ec).lexically_normal();
-  if (!ec && p.relative_path().empty())
-    throw Error("\"" + path + "\" is the root of the file system; expected a directory of its own, e.g. -o out/my_run",
-                flag);
 }
 
 /// The frame indices a command works on (sph render, sph surface): "all", "first", "last", or a comma list of indices

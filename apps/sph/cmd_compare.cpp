@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@
 #include <sph/core/timer.h>
 #include <sph/io/atomic_file.h>
 #include <sph/io/frames.h>
+#include <sph/io/run_directory.h>
 #include <sph/neighbors/neighbor_mode.h>
 #include <sph/run/memory.h>
 #include <sph/scene/scene_reader.h>
@@ -29,7 +31,7 @@ namespace fs = std::filesystem;
 
 struct CompareCliOptions {
   std::string scene;
-  std::string output;
+  std::optional<std::string> output;
   std::string modes = join_neighbor_mode_names(NeighborModeSet::Compared, ",", ",");
   std::int64_t steps = 0;
   int threads = 0;
@@ -75,11 +77,12 @@ int compare(const CompareCliOptions& opt) {
 
   std::vector<std::string> sets = opt.sets;
   if (opt.steps > 0) sets.push_back("Configuration.numberOfSteps=" + std::to_string(opt.steps));
+  if (opt.output) check_output_path(*opt.output, "-o/--output");
   const SceneDesc desc = read_scene_file(opt.scene, sets);
   check_fits_in_memory(desc);  // each mode's run holds one simulation at a time
   check_comparable(desc);
   for (const auto& w : desc.warnings) fmt::print(stderr, "sph: warning: {}\n", w);
-  const fs::path dir = opt.output.empty() ? fs::path("out") / (desc.name + "_compare") : fs::path(opt.output);
+  const fs::path dir = opt.output ? fs::path(*opt.output) : fs::path("out") / (desc.name + "_compare");
   prepare_comparison_directory(dir);
   if (!opt.no_run_frames) co.runs_dir = dir;
 

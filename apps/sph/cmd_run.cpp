@@ -327,12 +327,8 @@ int run(const RunOptions& opt) {
   for (const auto& w : desc.warnings) fmt::print(stderr, "sph: warning: {}\n", w);
   const std::filesystem::path dir =
       opt.output ? std::filesystem::path(*opt.output) : std::filesystem::path("out") / desc.name;
-  if (!opt.overwrite)
-    if (const std::optional<std::string> unfinished = unfinished_run(dir))
-      throw Error(fmt::format("holds {}; continue it with sph run --resume {}, or give --overwrite to delete it "
-                              "(with the run's frames, stats and summary) and start this run there",
-                              *unfinished, shell_word(dir.string())),
-                  dir.string());
+  check_new_run_directory(dir, opt.overwrite, "-o/--output", "--overwrite",
+                          "continue it with sph run --resume " + shell_word(dir.string()));
   return dispatch(desc, [&]<int D, class R>() { return run_scene<D, R>(desc, opt, dir, nullptr); });
 }
 

@@ -226,6 +226,35 @@ TEST_F(RunDirectory, AnEmptyOrRootOutputDirectoryIsRefused) {
   EXPECT_FALSE(fs::exists(at("d") / "render"));
 }
 
+// A directory that no run made (no run.json) but that holds files a run writes: the user's own
+// scene.json beside which they ran `sph run scene.json -o .`, or a stats.csv of theirs. A run used
+// to replace them without a word (the scene by the effective one, its "auto" and stopAt gone).
+TEST_F(RunDirectory, AUsersOwnFilesThatARunWouldReplaceAreRefusedUnlessOverwrite) {
+  fs::create_directories(at("mine"));
+  fs::copy_file(kDamBreak, at("mine") / "scene.json");
+  spit(at("mine") / "stats.csv", "my own table\n");
+  fs::create_directories(at("mine") / "frames");
+  spit(at("mine") / "frames" / "frame_000000.vtu", "my own frame");
+  spit(at("mine") / "notes.txt", "mine");
+  const auto before = files(at("mine"));
+  CommandResult r = sph({"run", "mine/scene.json", "--steps", "2", "--no-progress", "-o", "mine"});
+  expect_refused(r, {"mine: is not the directory of an earlier run (no run.json)",
+                     "holds files a run writes (stats.csv, scene.json, frames/frame_000000.vtu)", "--overwrite"});
+  EXPECT_EQ(files(at("mine")), before) << "nothing touched";
+  // sph compare does not write among a run's files either.
+  run("d", 5);
+  const auto run_files = files(at("d"));
+  expect_refused(sph({"compare", kDamBreak, "--steps", "2", "--no-progress", "-o", "d"}),
+                 {"d: holds a run (run.json: sph run's output)"});
+  EXPECT_EQ(files(at("d")), run_files);
+  expect_refused(sph({"compare", kDamBreak, "--steps", "2", "-o", ""}), {"-o/--output: an empty directory name"});
+  // An earlier run's directory is replaced as before; --overwrite allows the user's.
+  run("d", 5);
+  run("mine", 2, {"--overwrite"});
+  EXPECT_EQ(slurp(at("mine") / "notes.txt"), "mine") << "a file no run writes is kept";
+  EXPECT_TRUE(fs::exists(at("mine") / "run.json"));
+}
+
 TEST_F(RunDirectory, SceneFilesThatAreNotScenesAreRefused) {
   expect_refused(sph({"run", "/dev/zero", "-o", "o"}), {"/dev/zero: is not a regular file"});
   ASSERT_EQ(::mkfifo(at("fifo.json").c_str(), 0600), 0);

@@ -45,6 +45,18 @@ def test_run_errors(small_2d, tmp_path):
     blocker.write_text("")
     with pytest.raises(sph.Error):
         sph.run(small_2d, output=str(blocker / "sub"))
+    # The checks sph run makes of -o: not "" or the root, not a directory of the user's own files.
+    for out in ("", "/", "//.."):
+        with pytest.raises(sph.Error, match="empty directory name|root of the file system"):
+            sph.run(small_2d, output=out)
+        with pytest.raises(sph.Error, match="empty directory name|root of the file system"):
+            sph.compare(small_2d, output=out, steps=2)
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "scene.json").write_text("my scene")
+    with pytest.raises(sph.Error, match="not the directory of an earlier run .* overwrite=True"):
+        sph.run(small_2d, output=str(mine), steps=2)
+    assert (mine / "scene.json").read_text() == "my scene"
 
 
 def test_compare(small_2d, tmp_path):

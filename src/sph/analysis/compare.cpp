@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <sph/analysis/labels.h>
@@ -11,6 +12,7 @@
 #include <sph/core/parallel.h>
 #include <sph/io/atomic_file.h>
 #include <sph/io/frames.h>
+#include <sph/io/run_directory.h>
 #include <sph/render/frame_image.h>
 #include <sph/run/driver.h>
 #include <sph/scene/dispatch.h>
@@ -264,8 +266,16 @@ CompareResult run_comparison(const SceneDesc& desc, const CompareOptions& option
 }
 
 void prepare_comparison_directory(const std::filesystem::path& dir) {
-  make_writable_directory(dir, "the comparison's output");
   std::error_code ec;
+  // A run's own directory: the comparison's files would sit among the run's, and sph render would
+  // go on showing the run.
+  for (const char* file : {kRunIdentityFile, "scene.json"})
+    if (std::filesystem::exists(dir / file, ec))
+      throw Error(fmt::format("holds a run ({}: sph run's output); expected a directory of the comparison's own, e.g. "
+                              "out/my_compare",
+                              file),
+                  dir.string());
+  make_writable_directory(dir, "the comparison's output");
   for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
     const std::string f = entry.path().filename().string();
     // Files whose set depends on the options: images of other steps, the audit's plot.

@@ -129,7 +129,8 @@ CompareResult run_comparison(const SceneDesc& desc, const CompareOptions& option
 
 /// Creates `dir` (the comparison's output), checks that files can be created in it and removes
 /// what an earlier comparison left there whose set depends on the options (images of other
-/// steps, the audit's plot, runs.txt). Throws sph::Error naming the path.
+/// steps, the audit's plot, runs.txt). Throws sph::Error naming the path, also if it is a run's
+/// directory (holds run.json or scene.json).
 void prepare_comparison_directory(const std::filesystem::path& dir);
 
 /// Files written by write_comparison (relative to the output directory).

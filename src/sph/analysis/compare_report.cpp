@@ -203,7 +203,7 @@ std::string report_speed(const CompareResult& res) {
       "rebuilt per step | pairs stored per particle |\n";
   md += "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
   for (const RunRecord& r : res.runs) {
-    const bool is_ref = &r == &ref;  // its ratio to itself is 1 by definition: say what it is instead
+    const bool is_ref = &r == &ref;  // the table's reference: say what it is instead of a ratio
     const double total = r.totals.total();
     const double n = static_cast<double>(std::max<std::size_t>(1, r.steps.size()));
     double per_particle = 0;
@@ -220,10 +220,10 @@ std::string report_speed(const CompareResult& res) {
         100.0 * rebuilt_frac / n, per_particle / n);
   }
   md +=
-      "\nPhase columns are seconds over the whole run. \"speed vs standard\" is the standard run's total\n"
-      "time divided by this run's; the standard run is the reference the others are measured against.\n"
-      "The perturbed standard run repeats the standard algorithm: its ratio shows how much timings\n"
-      "vary between two runs of the same work.\n\n";
+      "\nPhase columns are seconds over the whole run. \"speed vs standard\" is the mean total time of\n"
+      "the standard runs (the reference and the perturbed one, which repeats the standard algorithm)\n"
+      "divided by this run's, so that the order of the runs biases no ratio. The perturbed run's own\n"
+      "ratio shows how much timings vary between two runs of the same work.\n\n";
   return md;
 }
 

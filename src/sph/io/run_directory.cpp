@@ -46,6 +46,15 @@ std::optional<std::uint64_t> frame_number(const std::string& name, const std::st
 
 }  // namespace
 
+void check_output_path(const std::string& path, const std::string& option) {
+  if (path.empty()) throw Error("an empty directory name; expected the directory to write to, e.g. out/my_run", option);
+  std::error_code ec;
+  const fs::path p = fs::absolute(path, ec).lexically_normal();
+  if (!ec && p.relative_path().empty())
+    throw Error("\"" + path + "\" is the root of the file system; expected a directory of its own, e.g. out/my_run",
+                option);
+}
+
 bool is_render_output(const std::string& file_name) {
   return file_name == "movie.mp4" || frame_number(file_name, "png").has_value();
 }

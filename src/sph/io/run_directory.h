@@ -87,6 +87,11 @@ void write_run_list(const std::filesystem::path& dir, const std::vector<std::str
 /// neither, or naming runs.txt if it is malformed or lists a directory that is not a run.
 std::vector<std::filesystem::path> run_directories(const std::filesystem::path& dir);
 
+/// Refuses an output directory given as "" (which would mean the current directory) or as the
+/// root of the file system (whose files a run or a render would replace): throws sph::Error
+/// naming `option` (e.g. "-o/--output", "output") and what is expected.
+void check_output_path(const std::string& path, const std::string& option);
+
 /// True for the names of the files `sph render` makes in its output directory:
 /// frame_NNNNNN.png (6 to 12 digits) and movie.mp4. A render removes only these (and a new run
 /// removes only these from DIR/render), never a user's other files.

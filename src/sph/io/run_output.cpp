@@ -1,9 +1,11 @@
 #include <sph/io/run_output.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include <sph/core/error.h>
@@ -12,6 +14,7 @@
 #include <sph/core/timer.h>
 #include <sph/core/version.h>
 #include <sph/io/atomic_file.h>
+#include <sph/io/checkpoint.h>
 #include <sph/io/vtk.h>
 #include <sph/scene/scene_writer.h>
 
@@ -42,20 +45,6 @@ void remove_stale_temporaries(const fs::path& dir) {
     if (dash != std::string::npos && digits(tail.substr(0, dash)) && digits(tail.substr(dash + 1)))
       fs::remove(entry.path(), ec);
   }
-}
-
-/// Removes the pictures `sph render` and `sph view` made of an earlier run in `dir`
-/// (render/frame_NNNNNN.png, render/movie.mp4, render/ itself once empty, view.html), so that
-/// they never sit beside a new run's frames. Other files are left alone.
-void remove_pictures(const fs::path& dir) {
-  std::error_code ec;
-  fs::remove(dir / "view.html", ec);
-  for (const auto& entry : fs::directory_iterator(dir / "render", ec))
-    if (is_render_output(entry.path().filename().string())) fs::remove(entry.path(), ec);
-  if (fs::is_empty(dir / "render", ec)) fs::remove(dir / "render", ec);
-  for (const auto& entry : fs::directory_iterator(dir / "surface", ec))
-    if (is_surface_output(entry.path().filename().string())) fs::remove(entry.path(), ec);
-  if (fs::is_empty(dir / "surface", ec)) fs::remove(dir / "surface", ec);
 }
 
 }  // namespace
@@ -97,6 +86,52 @@ void prepare_resume_directory(const fs::path& dir) {
   remove_stale_temporaries(dir / "frames");
 }
 
+std::vector<fs::path> files_a_run_replaces(const fs::path& dir) {
+  std::vector<fs::path> out;
+  std::error_code ec;
+  for (const char* name : {"frames.pvd", "solids.pvd", "stats.csv", "summary.json", "scene.json", kCheckpointFile,
+                           kRunIdentityFile, "boundary.vtu", "bodies.csv", "view.html"})
+    if (fs::exists(dir / name, ec)) out.push_back(dir / name);
+  // Directory listings in name order, so that messages and removals do not depend on the file system.
+  const auto sorted = [&](const fs::path& sub, const auto& wanted) {
+    std::vector<fs::path> found;
+    for (const auto& entry : fs::directory_iterator(sub, ec))
+      if (wanted(entry.path().filename().string(), entry.path().extension().string())) found.push_back(entry.path());
+    std::sort(found.begin(), found.end());
+    out.insert(out.end(), found.begin(), found.end());
+  };
+  sorted(dir / "render", [](const std::string& f, const std::string&) { return is_render_output(f); });
+  sorted(dir / "surface", [](const std::string& f, const std::string&) { return is_surface_output(f); });
+  sorted(dir / "frames", [](const std::string& f, const std::string& ext) {
+    return (f.rfind("frame_", 0) == 0 && (ext == ".vtu" || ext == ".vtk" || ext == ".ply")) ||
+           (f.rfind("solids_", 0) == 0 && (ext == ".vtp" || ext == ".ply"));
+  });
+  return out;
+}
+
+void check_new_run_directory(const fs::path& dir, bool overwrite, const std::string& output_option,
+                             const std::string& overwrite_option, const std::string& resume_hint) {
+  check_output_path(dir.string(), output_option);
+  if (overwrite) return;
+  if (const std::optional<std::string> unfinished = unfinished_run(dir))
+    throw Error(fmt::format("holds {}; {}give {} to delete it (with the run's frames, stats and summary) and start "
+                            "this run there",
+                            *unfinished, resume_hint.empty() ? "" : resume_hint + ", or ", overwrite_option),
+                dir.string());
+  std::error_code ec;
+  if (fs::exists(dir / kRunIdentityFile, ec)) return;  // an earlier run's directory: its files are replaced
+  const std::vector<fs::path> files = files_a_run_replaces(dir);
+  if (files.empty()) return;
+  std::vector<std::string> names;
+  for (std::size_t k = 0; k < files.size() && k < 3; ++k) names.push_back(files[k].lexically_relative(dir).string());
+  if (files.size() > 3) names.push_back(fmt::format("{} more", files.size() - 3));
+  throw Error(fmt::format("is not the directory of an earlier run (no {}) but holds files a run writes ({}), which "
+                          "would be replaced; expected a new or empty directory, or an earlier run's (or give {} to "
+                          "replace them)",
+                          kRunIdentityFile, fmt::join(names, ", "), overwrite_option),
+              dir.string());
+}
+
 void prepare_output_directory(const fs::path& dir) {
   std::error_code ec;
   // Check that files can be created here before anything else is touched.
@@ -104,16 +139,9 @@ void prepare_output_directory(const fs::path& dir) {
   remove_stale_temporaries(dir);
   remove_stale_temporaries(dir / "frames");
   // Remove what a previous run left, so that frames of two runs are never mixed.
-  for (const char* name : {"frames.pvd", "solids.pvd", "stats.csv", "summary.json", "scene.json", "checkpoint.sphc",
-                           "run.json", "boundary.vtu", "bodies.csv"})
-    fs::remove(dir / name, ec);
-  remove_pictures(dir);
-  for (const auto& entry : fs::directory_iterator(dir / "frames", ec)) {
-    const std::string f = entry.path().filename().string();
-    const std::string ext = entry.path().extension().string();
-    if (f.rfind("frame_", 0) == 0 && (ext == ".vtu" || ext == ".vtk" || ext == ".ply")) fs::remove(entry.path(), ec);
-    if (f.rfind("solids_", 0) == 0 && (ext == ".vtp" || ext == ".ply")) fs::remove(entry.path(), ec);
-  }
+  for (const fs::path& f : files_a_run_replaces(dir)) fs::remove(f, ec);
+  for (const char* sub : {"render", "surface"})
+    if (fs::is_empty(dir / sub, ec)) fs::remove(dir / sub, ec);
 }
 
 template <int D, std::floating_point R>

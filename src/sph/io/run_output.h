@@ -157,6 +157,23 @@ struct RunInfo {
   int threads = 1;
 };
 
+/// The files in `dir` that a new run replaces (prepare_output_directory removes them), in a fixed
+/// order: frames.pvd, solids.pvd, stats.csv, summary.json, scene.json, checkpoint.sphc, run.json,
+/// boundary.vtu, bodies.csv, view.html, render/frame_NNNNNN.png and movie.mp4,
+/// surface/surface_NNNNNN.ply, .obj and .vdb, frames/frame_NNNNNN.vtu, .vtk and .ply,
+/// frames/solids_NNNNNN.vtp and .ply; those that exist. Empty if `dir` does not exist.
+std::vector<std::filesystem::path> files_a_run_replaces(const std::filesystem::path& dir);
+
+/// Checks, before anything is written, that a new run may start in `dir` (sph run -o DIR,
+/// sph.run(output=DIR)). Throws sph::Error if it is "" or the root of the file system
+/// (check_output_path, naming `output_option`), or, naming `dir`, unless `overwrite`: if it holds the checkpoint of a
+/// run that did not finish (unfinished_run; `resume_hint`, e.g. "continue it with sph run --resume DIR", is said first
+/// if not empty), or if it is not a run's directory (no run.json) and yet holds files a run replaces
+/// (files_a_run_replaces: a scene.json or stats.csv of the user's own, which the run would overwrite without a word).
+/// `overwrite_option` names what allows it in the message ("--overwrite", "overwrite=True").
+void check_new_run_directory(const std::filesystem::path& dir, bool overwrite, const std::string& output_option,
+                             const std::string& overwrite_option, const std::string& resume_hint);
+
 /// Creates `dir` if needed and checks that files can be created in it; removes the files a
 /// previous run left there (frames, stats, summary, run.json, and the pictures of `sph render`
 /// and `sph view`: render/frame_NNNNNN.png, render/movie.mp4, view.html; the surfaces of `sph surface`

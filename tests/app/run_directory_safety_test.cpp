@@ -145,7 +145,8 @@ TEST_F(RunDirectory, ACheckpointOfAnotherRunIsRefusedNamingBothIds) {
   for (const char* f : {sph::kCheckpointFile, "run.json"})
     fs::copy_file(at("c") / f, at("a") / f, fs::copy_options::overwrite_existing);
   fs::remove(at("a") / "summary.json");
-  expect_refused(sph({"run", "--resume", "a", "--steps", "20"}), {"scene.json: holds another scene (fingerprint"});
+  expect_refused(sph({"run", "--resume", "a", "--steps", "20"}),
+                 {"scene.json: holds another scene, or a mesh file it names"});
   EXPECT_FALSE(fs::exists(at("a") / "summary.json"));
 }
 

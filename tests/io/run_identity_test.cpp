@@ -62,6 +62,24 @@ TEST(RunIdentity, TheFingerprintIgnoresTheNumberOfStepsAndKeyOrderButNothingElse
             fp);
 }
 
+// A resumed run reads its obstacles' meshes again: a mesh file changed since the run started would
+// give it another obstacle, so the fingerprint covers the files' bytes.
+TEST(RunIdentity, TheFingerprintCoversTheBytesOfTheMeshFilesTheSceneNames) {
+  TempDir d;
+  const fs::path mesh = d / "cube.obj";
+  spit(mesh, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const std::string scene = R"({"Configuration": {"numberOfSteps": 100}, "Obstacles": [{"geometryFile": ")" +
+                            mesh.string() + R"("}, {"start": [0, 0, 0], "end": [1, 1, 1]}]})";
+  const std::string fp = sph::scene_fingerprint(scene);
+  EXPECT_EQ(sph::scene_fingerprint(scene), fp);
+  spit(mesh, "v 0 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\n");
+  const std::string changed = sph::scene_fingerprint(scene);
+  EXPECT_NE(changed, fp) << "a vertex moved";
+  fs::remove(mesh);
+  EXPECT_NE(sph::scene_fingerprint(scene), changed) << "the file is gone";
+  EXPECT_NE(sph::scene_fingerprint(scene), fp);
+}
+
 TEST(RunIdentity, RenderOutputsAreOnlyNumberedPngFramesAndTheMovie) {
   for (const char* yes : {"frame_000000.png", "frame_123456789012.png", "movie.mp4"})
     EXPECT_TRUE(sph::is_render_output(yes)) << yes;
@@ -89,8 +107,11 @@ TEST(RunIdentity, CheckRunIdentityAcceptsItsOwnDirectoryAndNamesBothIdsOtherwise
   fs::remove(d / "summary.json");
   const sph::RunIdentity other_scene{other.run_id, "0123456789abcdef"};
   sph::write_run_identity(d.path(), other_scene);
-  EXPECT_CONTAINS(error_of([&] { sph::check_run_identity(d.path(), other_scene); }),
-                  "scene.json: holds another scene (fingerprint " + mine.scene_fingerprint);
+  EXPECT_CONTAINS(
+      error_of([&] { sph::check_run_identity(d.path(), other_scene); }),
+      "scene.json: holds another scene, or a mesh file it names (geometryFile) changed since the run started "
+      "(fingerprint " +
+          mine.scene_fingerprint);
 }
 
 TEST(RunIdentity, AnUnfinishedRunIsACheckpointWithoutACompletedSummary) {

@@ -259,7 +259,20 @@ std::string scene_fingerprint(const std::string& scene_json) {
   if (doc.is_object() && doc.contains("Configuration") && doc["Configuration"].is_object())
     doc["Configuration"].erase("numberOfSteps");
   std::uint64_t h = 14695981039346656037ull;  // FNV-1a 64
-  for (const char c : doc.dump()) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  const auto add = [&h](const std::string& bytes) {
+    for (const char c : bytes) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  };
+  add(doc.dump());
+  // The mesh files the scene names (the effective scene names them by absolute path): a run
+  // resumed after one changed would go on with another obstacle.
+  if (doc.is_object() && doc.contains("Obstacles") && doc["Obstacles"].is_array())
+    for (const nlohmann::json& o : doc["Obstacles"]) {
+      if (!o.is_object() || !o.contains("geometryFile") || !o["geometryFile"].is_string()) continue;
+      std::ifstream in(o["geometryFile"].get<std::string>(), std::ios::binary);
+      std::stringstream bytes;
+      bytes << in.rdbuf();
+      add(in ? "\n" + bytes.str() : std::string("\nunreadable"));
+    }
   return fmt::format("{:016x}", h);
 }
 
@@ -322,8 +335,11 @@ void check_run_identity(const fs::path& dir, const RunIdentity& checkpoint) {
       refuse(scene_file, "is not a scene this sph wrote");
     }
     if (fingerprint != checkpoint.scene_fingerprint)
-      refuse(scene_file, fmt::format("holds another scene (fingerprint {}, the checkpoint's is {})", fingerprint,
-                                     checkpoint.scene_fingerprint));
+      throw Error(fmt::format("holds another scene, or a mesh file it names (geometryFile) changed since the run "
+                              "started (fingerprint {}, the checkpoint's is {}); resume with the scene and meshes the "
+                              "run started with, or start a new run with sph run SCENE -o DIR",
+                              fingerprint, checkpoint.scene_fingerprint),
+                  scene_file.string());
   }
 }
 

@@ -122,7 +122,8 @@ std::string new_run_id();
 
 /// The fingerprint of an effective scene (scene_text(desc)): 16 hex digits of the FNV-1a 64-bit
 /// hash of its JSON, keys sorted, without Configuration.numberOfSteps (which `--resume --steps`
-/// changes within one run). Two scenes that would run the same way give the same fingerprint.
+/// changes within one run), then of the bytes of each mesh file its obstacles name
+/// (geometryFile). Two scenes that would run the same way give the same fingerprint.
 std::string scene_fingerprint(const std::string& scene_json);
 
 /// Writes DIR/run.json (atomically). Throws sph::Error naming the path.

@@ -197,6 +197,19 @@ TEST_F(Render, MistakesAreRefusedBeforeAnythingIsWritten) {
   expect_refused({"render", "db", "--colormap", "jet"}, "--colormap", out);
   expect_refused({"render", "db", "--no-png"}, "--mp4", out);
   expect_refused({"render", "db", "--format", "ply"}, "ply", out);
+  // A floating body's run without its bodies.csv, or with a table that lost the last frame's rows:
+  // the boxes would be drawn where they started, or where an earlier frame had them.
+  const std::string floating = SPH_SOURCE_DIR "/scenes/examples/floating_boxes_2d.json";
+  run(floating, "fb", {"--set", "Configuration.outputFps=0"});
+  fs::rename(tmp_.path() / "fb" / "bodies.csv", tmp_.path() / "bodies.csv");
+  expect_refused({"render", "fb"}, "fb/bodies.csv: is missing", tmp_.path() / "fb" / "render");
+  expect_refused({"view", "fb"}, "fb/bodies.csv: is missing", tmp_.path() / "fb" / "render");
+  const std::string table = sph::test::slurp(tmp_.path() / "bodies.csv");
+  std::size_t cut = table.size() - 1;
+  for (int rows = 0; rows < 3; ++rows) cut = table.rfind('\n', cut - 1);  // the last frame's 3 boxes
+  sph::test::spit(tmp_.path() / "fb" / "bodies.csv", table.substr(0, cut + 1));
+  expect_refused({"render", "fb", "--frames", "last"}, "bodies.csv: has no row of obstacle",
+                 tmp_.path() / "fb" / "render");
   sph::test::spit(tmp_.path() / "afile", "x");
   const CommandResult r = sph({"render", "db", "-o", "afile/sub", "--no-progress"});
   EXPECT_EQ(r.code, 2) << r.err;

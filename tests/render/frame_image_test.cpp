@@ -2,12 +2,15 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include <sph/core/error.h>
 #include <sph/render/frame_image.h>
+
+#include "support/expect.h"
 
 namespace {
 
@@ -181,16 +184,23 @@ TEST(FrameImage, FloatingBodiesAreDrawnWhereTheRunsTableHasThem) {
   run.scene.set_body(body);
   const double h = std::sqrt(0.5);
   run.bodies = {BodyPoseRow{0.0, 0, {0.3, 0.1, 0}, {1, 0, 0, 0}}, BodyPoseRow{1.0, 0, {1.0, 0.5, 0}, {h, 0, 0, h}}};
-  // The frame nearest each time: 0.4 s takes t = 0's row, 0.9 s t = 1's.
-  EXPECT_TRUE(run_obstacles(run, 0.4)[0].axis_aligned());
-  EXPECT_NEAR(run_obstacles(run, 0.4)[0].translation[0], 0.0, 1e-12);
-  const SolidBox s = run_obstacles(run, 0.9)[0];
+  // Each frame's row: t = 0 at rest, t = 1 moved and turned.
+  EXPECT_TRUE(run_obstacles(run, 0.0)[0].axis_aligned());
+  EXPECT_NEAR(run_obstacles(run, 0.0)[0].translation[0], 0.0, 1e-12);
+  const SolidBox s = run_obstacles(run, 1.0)[0];
   const auto centre = s.place({0.3, 0.1, 0}, 2);
   EXPECT_NEAR(centre[0], 1.0, 1e-12);
   EXPECT_NEAR(centre[1], 0.5, 1e-12);
   const auto corner = s.place({0.4, 0.0, 0}, 2);  // (0.1, -0.1) from the centre, turned a quarter
   EXPECT_NEAR(corner[0], 1.1, 1e-12);
   EXPECT_NEAR(corner[1], 0.6, 1e-12);
+  // A time the table has no row at (it lost rows): refused, not drawn at the nearest row's pose.
+  try {
+    (void)run_obstacles(run, 0.9);
+    ADD_FAILURE() << "no row at t = 0.9 s";
+  } catch (const sph::Error& e) {
+    EXPECT_CONTAINS(std::string(e.what()), "has no row of obstacle 0 (a floating body) at t = 0.9 s");
+  }
   // Without a table, where it started.
   run.bodies.clear();
   EXPECT_EQ(run_obstacles(run, 0.9)[0].translation, (std::array<double, 3>{0, 0, 0}));

@@ -119,6 +119,7 @@ std::vector<BodyPoseRow> read_body_rows(const fs::path& file) {
                               v[8], v[9]),
                   file.string());
     BodyPoseRow r;
+    r.frame = static_cast<std::size_t>(v[0]);
     r.time = v[1];
     r.obstacle = static_cast<std::size_t>(v[2]);
     r.position = {v[3], v[4], v[5]};
@@ -142,6 +143,12 @@ RunDirectory open_run_directory(const fs::path& dir, std::optional<FrameFormat> 
   run.dimension = run.scene.dimension;
   // (a scene with floating bodies only: a stray table beside any other run is not read)
   const bool floating = run.scene.visit_body([](const auto& body) { return any_dynamic_body(body.sim); });
+  if (floating && !fs::is_regular_file(dir / "bodies.csv", ec) && fs::exists(dir / "frames.pvd", ec))
+    throw Error(
+        "is missing: it holds where the scene's floating bodies were at each frame, and without it their "
+        "pictures would show them where they started; expected the file sph run wrote with the frames (the "
+        "run directory is incomplete)",
+        (dir / "bodies.csv").string());
   if (floating && fs::is_regular_file(dir / "bodies.csv", ec)) {
     run.bodies = read_body_rows(dir / "bodies.csv");
     const std::size_t obstacles = run.scene.visit_body([](const auto& body) { return body.sim.obstacles.size(); });
@@ -173,17 +180,35 @@ RunDirectory open_run_directory(const fs::path& dir, std::optional<FrameFormat> 
       throw Error(std::string("holds no .") + frame_format_name(*format) + " frames (frames/frame_000000." +
                       frame_format_name(*format) + " ...)",
                   dir.string());
-    return run;
-  }
-  for (const FrameFormatDesc& f : kFrameFormats) {
-    run.frames = list_frames(dir, f.format);
-    if (!run.frames.empty()) {
-      run.format = f.format;
-      return run;
+  } else {
+    for (const FrameFormatDesc& f : kFrameFormats) {
+      run.frames = list_frames(dir, f.format);
+      if (!run.frames.empty()) {
+        run.format = f.format;
+        break;
+      }
     }
+    if (run.frames.empty())
+      throw Error("holds no frames (frames/frame_000000.vtu, .vtk or .ply); was it run with outputEveryNSteps = 0?",
+                  dir.string());
   }
-  throw Error("holds no frames (frames/frame_000000.vtu, .vtk or .ply); was it run with outputEveryNSteps = 0?",
-              dir.string());
+  // Each floating body at every frame: a table that lost rows would draw it where it was not.
+  if (floating)
+    run.scene.visit_body([&]<int D>(const SceneBody<D>& body) {
+      for (std::size_t k = 0; k < body.sim.obstacles.size(); ++k) {
+        if (!obstacle_body(body.sim, k).dynamic) continue;
+        std::vector<bool> seen(run.frames.size(), false);
+        for (const BodyPoseRow& r : run.bodies)
+          if (r.obstacle == k && r.frame < seen.size()) seen[r.frame] = true;
+        const auto missing = std::find(seen.begin(), seen.end(), false);
+        if (missing != seen.end())
+          throw Error(fmt::format("has no row of obstacle {} (a floating body) at frame {} of the {}; expected the "
+                                  "table sph run wrote with the frames (the run directory is incomplete)",
+                                  k, missing - seen.begin(), run.frames.size()),
+                      (dir / "bodies.csv").string());
+      }
+    });
+  return run;
 }
 
 namespace {

@@ -29,6 +29,7 @@ struct BodyPoseRow {
   std::size_t obstacle = 0;
   std::array<double, 3> position{};               ///< centre of mass, m (z = 0 in 2D)
   std::array<double, 4> orientation{1, 0, 0, 0};  ///< unit quaternion w, x, y, z
+  std::size_t frame = 0;                          ///< the frame's number
 };
 
 /// A run directory as `sph run -o DIR` leaves it.
@@ -48,6 +49,7 @@ struct RunDirectory {
   std::vector<std::filesystem::path> frames;
   FrameFormat format = FrameFormat::Vtu;
   /// DIR/bodies.csv's rows (a scene with floating bodies), in the file's order; empty without one.
+  /// open_run_directory checks that each floating body has a row at every frame.
   std::vector<BodyPoseRow> bodies;
 };
 

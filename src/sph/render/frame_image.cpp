@@ -65,7 +65,7 @@ SolidBox placed_box(const SimulationParams<D>& sim, std::size_t k, const RigidPo
 }
 
 /// Obstacle k of `sim` placed at `time` (obstacle_solid): a floating body where `bodies` (a run's
-/// bodies.csv) has it at the frame nearest `time`.
+/// bodies.csv) has it at `time` (a frame's), where it started if `bodies` is empty.
 template <int D>
 SolidBox placed_obstacle(const SimulationParams<D>& sim, std::size_t k, double time,
                          std::span<const BodyPoseRow> bodies) {
@@ -74,7 +74,15 @@ SolidBox placed_obstacle(const SimulationParams<D>& sim, std::size_t k, double t
   const BodyPoseRow* nearest = nullptr;
   for (const BodyPoseRow& r : bodies)
     if (r.obstacle == k && (!nearest || std::abs(r.time - time) < std::abs(nearest->time - time))) nearest = &r;
-  if (!nearest) return placed_box(sim, k, RigidPose<D>{});  // (no table: where it started)
+  if (bodies.empty()) return placed_box(sim, k, RigidPose<D>{});  // (no table: where it started)
+  // bodies.csv has a row for each body at each frame's time: none there means the table lost rows
+  // (open_run_directory refuses a floating run's directory without one), and a neighbouring
+  // frame's pose would put the body where it was not.
+  if (!nearest || std::abs(nearest->time - time) > 1e-9 * std::max(1.0, std::abs(time)))
+    throw Error(fmt::format("has no row of obstacle {} (a floating body) at t = {} s, the time of a frame; expected "
+                            "the table sph run wrote with the frames (the run directory is incomplete)",
+                            k, time),
+                "bodies.csv");
   RigidBodyState<D> state;
   for (int a = 0; a < D; ++a) state.position[a] = nearest->position[static_cast<std::size_t>(a)];
   state.orientation = nearest->orientation;

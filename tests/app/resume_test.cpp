@@ -245,6 +245,17 @@ TEST_F(Resume, MistakesAreRefusedWithOneMessageAndExitCode2) {
   EXPECT_EQ(slurp(at("done") / "summary.json"), before) << "a refused resume leaves the run untouched";
   EXPECT_FALSE(fs::exists(at("elsewhere")));
 
+  // A frame of the run removed: a resumed run would list it in frames.pvd (and sph render refuse
+  // the run), so the resume is refused before anything is written.
+  fs::copy(at("done"), at("lost"), fs::copy_options::recursive);
+  fs::remove(at("lost") / "frames" / "frame_000000.vtu");
+  const std::string pvd = slurp(at("lost") / "frames.pvd");
+  const CommandResult lost = sph({"run", "--resume", "lost", "--steps", "40"});
+  EXPECT_EQ(lost.code, 2) << lost.err;
+  EXPECT_CONTAINS(lost.err, "lost/frames/frame_000000.vtu: is missing: the run wrote frames 0 to");
+  EXPECT_EQ(slurp(at("lost") / "summary.json"), before);
+  EXPECT_EQ(slurp(at("lost") / "frames.pvd"), pvd);
+
   // A corrupt checkpoint: refused, run untouched.
   std::string ck = slurp(at("done") / "checkpoint.sphc");
   ck[ck.size() / 2] = static_cast<char>(ck[ck.size() / 2] ^ 1);

@@ -156,6 +156,17 @@ void FrameWriter<D, R>::load_state(StateReader& in) {
   // step does not have it (an uninterrupted run of more steps writes no frame there), so it goes.
   if (off) times_.pop_back();
   last_off_schedule_ = false;
+  // The frames the run wrote before the checkpoint (checked before anything is written: a resumed
+  // run would list in frames.pvd files that are not there, and sph render would refuse the run).
+  std::error_code ec;
+  for (std::size_t k = 0; k < times_.size(); ++k)
+    for (FrameFormat f : output_.formats)
+      if (!fs::is_regular_file(dir_ / frame_name(k, f), ec))
+        throw Error(fmt::format("is missing: the run wrote frames 0 to {} before its checkpoint, and a resumed run "
+                                "would list a file that is not there; put the run's frames back, or start a new run "
+                                "(sph run SCENE -o DIR)",
+                                times_.size() - 1),
+                    (dir_ / frame_name(k, f)).string());
   in.get(body_rows_);
   const std::size_t columns = std::size(kBodyColumns);
   in.expect(body_rows_.size() % columns == 0, "a bad floating body table");
@@ -164,7 +175,6 @@ void FrameWriter<D, R>::load_state(StateReader& in) {
   body_rows_.resize(keep);
   if (!body_rows_.empty()) write_bodies();
   // Frames the interrupted run wrote after the checkpoint, in any format.
-  std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dir_ / "frames", ec)) {
     const std::string f = entry.path().filename().string();
     unsigned index = 0;

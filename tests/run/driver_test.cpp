@@ -274,7 +274,7 @@ TEST(RunDriver, AFailedStepIsReturnedWithItsMessage) {
   ASSERT_EQ(r.status, RunStatus::Failed) << r.message;
   EXPECT_FALSE(r.error.empty());
   EXPECT_EQ(r.message, "failed: " + r.error);
-  EXPECT_NE(r.error.find("went supersonic at step 0"), std::string::npos) << r.error;
+  EXPECT_NE(r.error.find("went supersonic at step 1"), std::string::npos) << r.error;
   EXPECT_EQ(r.steps_done, 1) << "the step that failed, step 0, is counted";
   EXPECT_EQ(nlohmann::json::parse(slurp(tmp / "o" / "summary.json")).at("status"), r.message);
 }

@@ -3,6 +3,7 @@
 // the step that raised it; a resumed run remembers the warnings given before its checkpoint;
 // stepping with RunDriver::step gives the same warnings through new_warnings.
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -69,6 +70,35 @@ TEST(HealthRun, StepByStepGivesTheWarningsOfRunOnceAtTheirStep) {
     for (const std::string& w : stepped.new_warnings(stepped.step())) given.emplace_back(k + 1, w);
   EXPECT_EQ(given, heard);
   EXPECT_EQ(stepped.simulation().health().warnings(), ran.simulation().health().warnings());
+}
+
+// A message's "at step N (t = T s)" is stats.csv's row N, whose time is T: the steps counted
+// from 1, as stats.csv, summary.json and steps_done() count them (messages counted from 0 until
+// 2026-12-07, one below the row of their own time).
+TEST(HealthRun, AWarningsStepAndTimeAreThoseOfItsStatsRow) {
+  TempDir tmp;
+  std::string warning;
+  RunCallbacks callbacks;
+  callbacks.warning = [&](const std::string& w) { warning = w; };
+  RunDriver<2, double> run(thrown_dam_break(), RunSettings{tmp / "o", 0});
+  ASSERT_EQ(run.run(callbacks).status, RunStatus::Completed);
+  const std::size_t at = warning.find("at step ");
+  ASSERT_NE(at, std::string::npos) << warning;
+  long long step = 0;
+  double time = 0;
+  ASSERT_EQ(std::sscanf(warning.c_str() + at, "at step %lld (t = %lf s)", &step, &time), 2) << warning;
+  std::ifstream stats(tmp / "o" / "stats.csv");
+  std::string line;
+  std::getline(stats, line);
+  ASSERT_EQ(line.rfind("step,time,", 0), 0u) << line;
+  bool found = false;
+  while (std::getline(stats, line))
+    if (std::stoll(line.substr(0, line.find(','))) == step) {
+      found = true;
+      const double row_time = std::stod(line.substr(line.find(',') + 1));
+      EXPECT_NEAR(row_time, time, 1e-6 * time) << line << "\n" << warning;
+    }
+  EXPECT_TRUE(found) << "no stats.csv row of step " << step;
 }
 
 TEST(HealthRun, StrictMakesTheFirstWarningAFailureInItsStep) {

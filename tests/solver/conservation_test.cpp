@@ -337,7 +337,7 @@ TEST(Simulation, BlowUpIsReportedWithStepAndParticle) {
     FAIL() << "expected a blow-up error";
   } catch (const Error& e) {
     const std::string m = e.what();
-    EXPECT_NE(m.find("step 0"), std::string::npos) << m;
+    EXPECT_NE(m.find("step 1 "), std::string::npos) << m;  // (the first step, stats.csv's row 1)
     EXPECT_NE(m.find("particle id 0"), std::string::npos) << m;
     EXPECT_NE(m.find("speed"), std::string::npos) << m;
   }
@@ -352,7 +352,7 @@ TEST(Simulation, NonFiniteValuesAreReportedInTheStepTheyAppear) {
   ps.add({{0.5, 0.5}}, {});
   ps.add({{0.2, 0.2}}, {});
   Simulation<2, double> sim(p, std::move(ps));
-  for (int s = 0; s < 3; ++s) sim.step();
+  for (int s = 0; s < 3; ++s) sim.step();  // steps 1 to 3
   // A NaN appearing in particle id 1's velocity (as an overflow would leave it). Its index is
   // looked up: the Morton reorder of step 0 may have moved it.
   auto& ps1 = const_cast<ParticleSet<2, double>&>(sim.particles());
@@ -363,7 +363,7 @@ TEST(Simulation, NonFiniteValuesAreReportedInTheStepTheyAppear) {
     FAIL() << "expected a blow-up error";
   } catch (const Error& e) {
     const std::string m = e.what();
-    EXPECT_NE(m.find("step 3"), std::string::npos) << m;
+    EXPECT_NE(m.find("step 4 "), std::string::npos) << m;  // the fourth step, stats.csv's row 4
     EXPECT_NE(m.find("particle id 1"), std::string::npos) << m;
     EXPECT_NE(m.find("position is not finite"), std::string::npos) << m;
   }

@@ -366,7 +366,7 @@ void Simulation<D, R>::advance_bodies(double dt) {
           "simulation blew up at step {} (t = {:.6g} s): the floating body Obstacles[{}] has a position or velocity "
           "that is not finite (the fluid's force on it: {:.6g} N). Lower Configuration.timeStepSize (or "
           "cflMaxTimeStepSize), or make the body denser",
-          steps_, time(), k, std::sqrt(norm2(body_force_[s].impulse))));
+          steps_ + 1, time() + dt, k, std::sqrt(norm2(body_force_[s].impulse))));  // (the step under way)
   }
 }
 
@@ -676,7 +676,7 @@ const StepInfo& Simulation<D, R>::step() {
     last_cfl_dt_ = st.cfl_dt;
   }
   info.health = integrate_and_check<true>(dt);
-  monitor_.check(info.health, steps_ - 1, time(), particles_.size());
+  monitor_.check(info.health, steps_, time(), particles_.size());  // (step k: stats.csv's row k)
   info.seconds.integrate = watch.lap();
 
   info.time = time();
@@ -728,7 +728,7 @@ HealthStats Simulation<D, R>::integrate_and_check(R dt) {
       throw Error(
           fmt::format("simulation blew up at step {} (t = {:.6g} s): particle id {}: {} is not finite; density "
                       "{:.6g}, pressure {:.6g}. Lower Configuration.timeStepSize or raise Fluid.viscosity",
-                      steps_ - 1, time(), particles_.id[i], all_finite(x) ? "velocity" : "position",
+                      steps_, time(), particles_.id[i], all_finite(x) ? "velocity" : "position",
                       static_cast<double>(particles_.density[i]), static_cast<double>(particles_.pressure[i])));
     }
   }

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <fmt/format.h>
@@ -30,6 +31,28 @@ inline CLI::Validator positive_number(const std::string& what) {
         return "expected a positive number (" + what + "), got " + text;
       },
       "POSITIVE");
+}
+
+/// A CLI11 check that the value is a number from `lo` to `hi` (a whole number if T is integral),
+/// with a message that says so: CLI11's CLI::Range says "Value abc not in range ..." for a value
+/// that is not a number at all.
+template <class T>
+CLI::Validator in_range(T lo, T hi) {
+  std::string expected;
+  if constexpr (std::is_integral_v<T>)
+    expected = fmt::format("a whole number from {} to {}", lo, hi);
+  else
+    expected = fmt::format("a number from {} to {}", lo, hi);
+  return CLI::Validator(
+      [lo, hi, expected](std::string& text) -> std::string {
+        T x{};
+        if (!CLI::detail::lexical_cast(text, x)) return "expected " + expected + ", got \"" + text + "\"";
+        if constexpr (!std::is_integral_v<T>)
+          if (!std::isfinite(x)) return "expected " + expected + ", got " + text;
+        if (x < lo || x > hi) return "expected " + expected + ", got " + text;
+        return {};
+      },
+      "IN [" + fmt::format("{} - {}", lo, hi) + "]");
 }
 
 /// The frame indices a command works on (sph render, sph surface): "all", "first", "last", or a comma list of indices

@@ -15,6 +15,7 @@
 #include <sph/core/timer.h>
 #include <sph/neighbors/neighbor_mode.h>
 
+#include "cli_checks.h"
 #include "commands.h"
 
 namespace sph::app {
@@ -104,29 +105,29 @@ std::function<int()> add_bench_command(CLI::App& app) {
                   "float, double or float,double (default: both; float only from 1M particles on; the tank runs "
                   "the scene's own precision)");
   cmd->add_option("--repeats", opt->repeats, "Timings per neighbors case and runs per tank mode (medians reported)")
-      ->check(CLI::Range(1, 1000))
+      ->check(in_range(1, 1000))
       ->default_str("5");
   cmd->add_option("--step-runs", opt->step_runs,
                   "Steps suite: runs per workload; the run of median wall time is reported, with the fastest and "
                   "slowest")
-      ->check(CLI::Range(1, 100))
+      ->check(in_range(1, 100))
       ->default_str("3");
   cmd->add_option("-o,--output", opt->output, "Output directory for bench.json and the CSVs")->default_str("out/bench");
   cmd->add_option("--particles", opt->particles,
                   "Steps suite: run one dam break of about this many particles (rounded to a cube) instead of the "
                   "size's, e.g. 10000000")
-      ->check(CLI::Range(std::int64_t{1}, std::int64_t{2'000'000'000}));
+      ->check(in_range(std::int64_t{1}, std::int64_t{2'000'000'000}));
   cmd->add_option("--modes", opt->modes, "Neighbor modes of the steps and tank suites")
       ->default_str(join_neighbor_mode_names(NeighborModeSet::Compared, ",", ","));
   cmd->add_option("--warmup-steps", opt->warmup_steps,
                   "Steps suite: untimed steps before timing (default: 10 at size small, else 20 to 3 by size)")
-      ->check(CLI::Range(std::int64_t{0}, std::int64_t{1'000'000}));
+      ->check(in_range(std::int64_t{0}, std::int64_t{1'000'000}));
   cmd->add_option("--timed-steps", opt->timed_steps,
                   "Steps suite: timed steps (default: 40 at size small, else 50 to 5 by size)")
-      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1'000'000}));
+      ->check(in_range(std::int64_t{1}, std::int64_t{1'000'000}));
   cmd->add_option("--steps", opt->tank_steps,
                   "Tank suite: steps per run (default: the whole scene, 1000 at size small)")
-      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1'000'000'000}));
+      ->check(in_range(std::int64_t{1}, std::int64_t{1'000'000'000}));
   cmd->add_option("--scene-dir", opt->scene_dir,
                   "Directory holding tank_fill_3d.json (default: the paper scenes installed with sph)");
   cmd->add_flag("--no-progress", opt->no_progress, "No progress lines on stderr (the tables still go to stdout)");

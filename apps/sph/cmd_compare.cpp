@@ -21,6 +21,7 @@
 #include <sph/run/memory.h>
 #include <sph/scene/scene_reader.h>
 
+#include "cli_checks.h"
 #include "commands.h"
 
 namespace sph::app {
@@ -139,14 +140,14 @@ std::function<int()> add_compare_command(CLI::App& app) {
   cmd->add_option("--modes", opt->modes, "Comma-separated modes to run (standard is always run: it is the reference)")
       ->default_str(join_neighbor_mode_names(NeighborModeSet::Compared, ",", ","));
   cmd->add_option("--steps", opt->steps, "Number of steps, overriding Configuration.numberOfSteps")
-      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1'000'000'000}));
-  cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
+      ->check(in_range(std::int64_t{1}, std::int64_t{1'000'000'000}));
+  cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(in_range(1, 4096));
   cmd->add_option("--frames", opt->frames, "Side-by-side images at this many evenly spaced steps")
-      ->check(CLI::Range(1, 100))
+      ->check(in_range(1, 100))
       ->default_str("3");
   cmd->add_option("--perturbation", opt->perturbation,
                   "Chaos floor: a second standard run with particles displaced by this fraction of h (0: none)")
-      ->check(CLI::Range(0.0, 0.1))
+      ->check(in_range(0.0, 0.1))
       ->default_str("1e-9");
   cmd->add_option("--set", opt->sets, "Override a scene value by its key path (repeatable), as in sph run")
       ->type_name("KEY=VALUE");

@@ -209,13 +209,15 @@ std::function<int()> add_render_command(CLI::App& app) {
   cmd->add_option("--frames", opt->frames,
                   "Frames to render: all, first, last, or numbers separated by commas (-1 is the last)")
       ->default_str("all");
-  cmd->add_option("--size", opt->size, "Image size of each panel (default: 1280x720, 640x480 side by side)")
+  cmd->add_option("--size", opt->size,
+                  "Size of each panel, WIDTHxHEIGHT pixels (default: 1280x720, 640x480 side by side); the image adds a "
+                  "caption row above and the color bar to the right")
       ->type_name("WxH");
   cmd->add_option("--azimuth", opt->azimuth, "3D camera: turn about the vertical axis, degrees")
-      ->check(CLI::Range(-360.0, 360.0))
+      ->check(in_range(-360.0, 360.0))
       ->default_str("30");
   cmd->add_option("--elevation", opt->elevation, "3D camera: look down from this angle, degrees")
-      ->check(CLI::Range(-90.0, 90.0))
+      ->check(in_range(-90.0, 90.0))
       ->default_str("20");
   cmd->add_flag("--flat", opt->flat, "Flat discs instead of shaded spheres");
   cmd->add_flag("--surface", opt->surface,
@@ -225,10 +227,10 @@ std::function<int()> add_render_command(CLI::App& app) {
                   "Which frames to read when the run wrote several formats: " + frame_format_list());
   cmd->add_flag("--mp4", opt->mp4, "Also encode the images as movie.mp4 in the output directory (needs ffmpeg)");
   cmd->add_option("--video-fps", opt->video_fps, "Frames per second of the movie")
-      ->check(CLI::Range(1.0, 240.0))
+      ->check(in_range(1.0, 240.0))
       ->default_str("30");
   cmd->add_flag("--no-png", opt->no_png, "Write only the movie, no PNG images");
-  cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
+  cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(in_range(1, 4096));
   cmd->add_flag("--no-progress", opt->no_progress, "No progress output");
   return [opt, cmd]() -> int {
     if (!cmd->parsed()) return kBadInput;

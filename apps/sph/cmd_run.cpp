@@ -299,7 +299,7 @@ int resume(RunOptions opt) {
   if (conflict)
     throw Error(
         fmt::format("--resume continues a run with the scene and settings it started with; {} cannot be "
-                    "given with it (allowed: --steps, --threads, --checkpoint-every, --no-progress)",
+                    "given with it (allowed: --steps, --threads, --checkpoint-every, --strict, --no-progress)",
                     conflict));
   if (opt.threads > 0) set_num_threads(opt.threads);
   RunToResume resumed = open_run_to_resume(opt.resume, opt.steps);
@@ -342,8 +342,8 @@ std::function<int()> add_run_command(CLI::App& app) {
   cmd->add_option("--neighbors", opt->neighbors, "Neighbor strategy, overriding the scene's Configuration.neighbors")
       ->check(CLI::IsMember(neighbor_mode_names()));
   cmd->add_option("--steps", opt->steps, "Number of steps, overriding Configuration.numberOfSteps")
-      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1'000'000'000'000}));
-  cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
+      ->check(in_range(std::int64_t{1}, std::int64_t{1'000'000'000'000}));
+  cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(in_range(1, 4096));
   cmd->add_option("--set", opt->sets,
                   "Override a scene value by its key path, e.g. --set Fluid.stiffness=2000 "
                   "--set FluidBlocks[0].end=[0.5,1.0] (repeatable; VALUE is JSON or a plain string)")
@@ -358,7 +358,7 @@ std::function<int()> add_run_command(CLI::App& app) {
       ->type_name("LIST");
   cmd->add_option("--every", opt->every,
                   "A frame every N steps (0: no frames), overriding Configuration.outputEveryNSteps and outputFps")
-      ->check(CLI::Range(std::int64_t{0}, std::int64_t{1'000'000'000'000}))
+      ->check(in_range(std::int64_t{0}, std::int64_t{1'000'000'000'000}))
       ->type_name("N");
   cmd->add_option("--fps", opt->fps,
                   "F frames per simulated second (frame k at the first step whose time reaches k / F), overriding "
@@ -387,7 +387,7 @@ std::function<int()> add_run_command(CLI::App& app) {
                   "Write DIR/checkpoint.sphc every N steps and at the last step (the latest replaces the "
                   "previous, atomically). Ctrl-C or SIGTERM always writes one: the run finishes its step, "
                   "writes the checkpoint and stops")
-      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1'000'000'000'000}))
+      ->check(in_range(std::int64_t{1}, std::int64_t{1'000'000'000'000}))
       ->type_name("N");
   cmd->add_option("--resume", opt->resume,
                   "Continue the run in DIR from its checkpoint, bitwise identically to a run never interrupted; "

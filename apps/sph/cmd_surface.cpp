@@ -129,7 +129,7 @@ std::function<int()> add_surface_command(CLI::App& app) {
       ->default_str("0.5");
   cmd->add_option("--frame-format", opt->frame_format,
                   "Which frames to read when the run wrote several formats: " + frame_format_list());
-  cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
+  cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(in_range(1, 4096));
   cmd->add_flag("--no-progress", opt->no_progress, "No progress output");
   return [opt, cmd]() -> int {
     if (!cmd->parsed()) return kBadInput;

@@ -15,6 +15,7 @@
 #include <sph/core/parallel.h>
 #include <sph/core/timer.h>
 
+#include "cli_checks.h"
 #include "commands.h"
 
 namespace sph::app {
@@ -108,7 +109,7 @@ std::function<int()> add_validate_command(CLI::App& app) {
       ->default_str("out/validation");
   cmd->add_option("--scenes", opt->scenes, "Directory of the validation scenes")
       ->default_str("the validation scenes of sph's data: <prefix>/share/sph/scenes/validation");
-  cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
+  cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(in_range(1, 4096));
   cmd->add_flag("--no-progress", opt->no_progress, "No progress lines");
   return [opt, cmd]() -> int {
     if (!cmd->parsed()) return kBadInput;

@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -14,6 +15,7 @@
 #include <sph/io/atomic_file.h>
 #include <sph/render/viewer.h>
 
+#include "cli_checks.h"
 #include "commands.h"
 
 namespace sph::app {
@@ -24,8 +26,9 @@ namespace fs = std::filesystem;
 
 struct ViewCliOptions {
   std::string dir;
-  std::string output;
+  std::optional<std::string> output;
   std::vector<std::string> color_by;
+  bool no_progress = false;  // (accepted as by the other commands; the page is written at once)
   std::size_t max_frames = 300;
   double max_size_mb = 200;
 };
@@ -56,14 +59,15 @@ void check_output(const fs::path& out) {
     throw Error("expected a file name ending in .html", out.string());
   if (fs::is_directory(out, ec)) throw Error("is a directory; expected the path of an .html file", out.string());
   const fs::path parent = out.has_parent_path() ? out.parent_path() : fs::path(".");
-  if (!fs::is_directory(parent, ec))
-    throw Error("no such directory; expected an existing directory for the page", parent.string());
+  require_directory(parent, "an existing directory for the page");
   AtomicFile probe(out);  // throws naming the directory if it is not writable; removed unused
 }
 
 int view(const ViewCliOptions& opt) {
   const fs::path dir(opt.dir);
-  const fs::path out = opt.output.empty() ? dir / "view.html" : fs::path(opt.output);
+  if (opt.output && opt.output->empty())
+    throw Error("an empty file name; expected the page to write, e.g. -o out/my_run/view.html", "-o/--output");
+  const fs::path out = opt.output ? fs::path(*opt.output) : dir / "view.html";
   ViewOptions vo;
   vo.max_frames = opt.max_frames;
   vo.color_by = parse_color_by(opt.color_by);
@@ -101,10 +105,11 @@ std::function<int()> add_view_command(CLI::App& app) {
   cmd->add_option("--max-frames", opt->max_frames,
                   "Frames kept per run; a run with more is subsampled evenly, first and last kept")
       ->default_str("300")
-      ->check(CLI::Range(std::size_t{2}, std::size_t{1000000}));
+      ->check(in_range(std::size_t{2}, std::size_t{1000000}));
   cmd->add_option("--max-size", opt->max_size_mb, "Refuse a page larger than this, in MB")
       ->default_str("200")
-      ->check(CLI::Range(1.0, 1e6));
+      ->check(in_range(1.0, 1e6));
+  cmd->add_flag("--no-progress", opt->no_progress, "Accepted as by the other commands (view prints no progress)");
   return [opt, cmd]() -> int {
     if (!cmd->parsed()) return kBadInput;
     return view(*opt);

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <CLI/CLI.hpp>
 
 #include <sph/core/error.h>
@@ -110,12 +112,17 @@ int main(int argc, char** argv) {
     std::string message = e.what();
     const std::string unknown = first_unknown_option(app, argc, argv);
     if (!unknown.empty()) message = "unknown option " + unknown;
+    std::vector<std::string> commands;
+    for (const CLI::App* c : app.get_subcommands([](CLI::App*) { return true; })) commands.push_back(c->get_name());
+    // A mistyped command (sph rnu scene.json): CLI11 says only that a subcommand is required.
+    if (argc > 1 && argv[1][0] != '-' &&
+        std::find(commands.begin(), commands.end(), std::string(argv[1])) == commands.end())
+      message = fmt::format("unknown command \"{}\"; expected one of: {}", argv[1], fmt::join(commands, ", "));
     // Point at the help of the subcommand the user typed, if any.
     std::string sub = "run";
     for (int i = 1; i < argc; ++i)
-      if (const std::string a = argv[i]; a == "run" || a == "compare" || a == "bench" || a == "validate" ||
-                                         a == "render" || a == "view" || a == "surface") {
-        sub = a;
+      if (std::find(commands.begin(), commands.end(), std::string(argv[i])) != commands.end()) {
+        sub = argv[i];
         break;
       }
     fmt::print(stderr, "sph: error: {}\nRun 'sph --help' or 'sph {} --help' for usage.\n", message, sub);

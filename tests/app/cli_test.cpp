@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <unistd.h>
@@ -138,6 +140,33 @@ TEST_F(Cli, UnknownFlagAloneIsNamed) {
     EXPECT_EQ(r.code, 2);
     EXPECT_CONTAINS(r.err, "--bogus");
   }
+}
+
+// A mistyped command, a value that is not a number, a file where a directory is expected: each
+// named as what it is (CLI11 said "A subcommand is required", "Value abc not in range 0 to
+// 1000000000000", and sph "no such directory" for an existing file).
+TEST_F(Cli, MistypedCommandsAndValuesAreNamedAsWhatTheyAre) {
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
+      {{"rnu", kDamBreak},
+       "unknown command \"rnu\"; expected one of: run, compare, bench, validate, render, view, surface"},
+      {{"run", kDamBreak, "--every", "abc"}, "--every: expected a whole number from 0 to"},
+      {{"run", kDamBreak, "--threads", "two"}, "--threads: expected a whole number from 1 to 4096, got \"two\""},
+      {{"run", kDamBreak, "--steps", "5.5"}, "--steps: expected a whole number from 1 to"},
+      {{"run", kDamBreak, "--threads", "0"}, "--threads: expected a whole number from 1 to 4096, got 0"},
+      {{"render", "afile"}, "afile: is a file, not a directory; expected a run directory"},
+      {{"view", "afile"}, "afile: is a file, not a directory; expected a run directory"},
+      {{"run", "--resume", "afile"},
+       "afile: is a file, not a directory; expected the output directory of an earlier run"},
+      {{"view", "nowhere", "-o", ""}, "-o/--output: an empty file name"},
+  };
+  std::ofstream(work_ / "afile") << "x";
+  for (const auto& [args, message] : cases) {
+    const Result r = sph(args);
+    EXPECT_EQ(r.code, 2) << args[0] << " " << args[1];
+    EXPECT_EQ(count(r.err, "sph: error:"), 1u) << r.err;
+    EXPECT_CONTAINS(r.err, message);
+  }
+  EXPECT_FALSE(fs::exists(work_ / "out"));
 }
 
 TEST_F(Cli, UnknownNeighborModeFlag) {

@@ -55,6 +55,14 @@ void AtomicFile::commit(bool sync) {
     throw Error("cannot flush the directory to disk", parent.string());
 }
 
+void require_directory(const std::filesystem::path& dir, std::string_view expected) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(dir, ec)) return;
+  throw Error(std::string(std::filesystem::exists(dir, ec) ? "is a file, not a directory" : "no such directory") +
+                  "; expected " + std::string(expected),
+              dir.string());
+}
+
 void make_writable_directory(const std::filesystem::path& dir, std::string_view purpose) {
   std::error_code ec;
   if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))

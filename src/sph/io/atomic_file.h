@@ -35,6 +35,10 @@ class AtomicFile {
 /// before they are renamed into place; prepare_output_directory removes such names left behind.
 std::filesystem::path temporary_path(const std::filesystem::path& path);
 
+/// Checks that `dir` is an existing directory; throws sph::Error naming it, "no such directory"
+/// or "is a file, not a directory" (whichever it is), then "; expected " and `expected`.
+void require_directory(const std::filesystem::path& dir, std::string_view expected);
+
 /// Creates `dir` (and its parents) if needed and checks that files can be created in it (a
 /// temporary file is made and removed). Throws sph::Error naming `dir` if it exists and is not
 /// a directory ("expected a directory for `purpose`") or cannot be created or written.

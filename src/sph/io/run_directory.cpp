@@ -131,8 +131,7 @@ std::vector<BodyPoseRow> read_body_rows(const fs::path& file) {
 
 RunDirectory open_run_directory(const fs::path& dir, std::optional<FrameFormat> format) {
   std::error_code ec;
-  if (!fs::is_directory(dir, ec))
-    throw Error("no such directory; expected a run directory (sph run -o DIR)", dir.string());
+  require_directory(dir, "a run directory (sph run -o DIR)");
   const fs::path scene_file = dir / "scene.json";
   if (!fs::is_regular_file(scene_file, ec))
     throw Error("is not a run directory: it has no scene.json (expected the output directory of sph run)",
@@ -247,10 +246,7 @@ void write_run_list(const fs::path& dir, const std::vector<std::string>& names) 
 
 std::vector<fs::path> run_directories(const fs::path& dir) {
   std::error_code ec;
-  if (!fs::is_directory(dir, ec))
-    throw Error(
-        "no such directory; expected a run directory (sph run -o DIR) or a compare directory (sph compare -o DIR)",
-        dir.string());
+  require_directory(dir, "a run directory (sph run -o DIR) or a compare directory (sph compare -o DIR)");
   if (fs::is_regular_file(dir / "scene.json", ec)) return {dir};
   if (!fs::is_regular_file(dir / kRunListFile, ec))
     throw Error(

@@ -79,8 +79,7 @@ std::string stats_row(const StepStats& stats) {
 
 void prepare_resume_directory(const fs::path& dir) {
   std::error_code ec;
-  if (!fs::is_directory(dir, ec))
-    throw Error("no such directory; expected the output directory of an earlier run (sph run -o DIR)", dir.string());
+  require_directory(dir, "the output directory of an earlier run (sph run -o DIR)");
   check_writable(dir);
   remove_stale_temporaries(dir);
   remove_stale_temporaries(dir / "frames");

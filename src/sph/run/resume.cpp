@@ -4,6 +4,7 @@
 
 #include <sph/core/error.h>
 #include <sph/core/version.h>
+#include <sph/io/atomic_file.h>
 #include <sph/io/run_directory.h>
 #include <sph/scene/scene_reader.h>
 
@@ -39,9 +40,7 @@ void check_finished_run(const std::filesystem::path& dir, std::int64_t checkpoin
 }  // namespace
 
 RunToResume open_run_to_resume(const std::filesystem::path& dir, std::int64_t steps) {
-  std::error_code ec;
-  if (!std::filesystem::is_directory(dir, ec))
-    throw Error("no such directory; expected the output directory of an earlier run (sph run -o DIR)", dir.string());
+  require_directory(dir, "the output directory of an earlier run (sph run -o DIR)");
   RunToResume run;
   run.dir = dir;
   run.checkpoint = std::make_unique<CheckpointReader>(dir / kCheckpointFile);

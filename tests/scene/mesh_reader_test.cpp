@@ -10,6 +10,8 @@
 #include <sph/scene/mesh_reader.h>
 #include <sph/solver/shape.h>
 
+#include "support/temp_dir.h"
+
 namespace sph {
 namespace {
 
@@ -42,8 +44,17 @@ TEST(MeshReader, FilesItCannotUseAreRefusedWithWhy) {
   EXPECT_NE(refusal(kData + "missing.obj").find("not found"), std::string::npos);
   EXPECT_NE(refusal(kData + "cube.3ds").find("expected a .obj, .stl or .ply file"), std::string::npos);
   EXPECT_NE(refusal(kData).find("expected a .obj"), std::string::npos);  // a directory, no extension
-  EXPECT_NE(refusal(kBad + "not_a_mesh.stl").find("cannot read mesh file"), std::string::npos);
+  EXPECT_NE(refusal(kBad + "not_a_mesh.stl").find("cannot be read as an STL file (the reader says: "),
+            std::string::npos);
   EXPECT_NE(refusal(kBad + "empty.obj").find("empty.obj"), std::string::npos);
+  // OBJ faults the importer reports without a line ("vertex index out of range"): named with it.
+  sph::test::TempDir tmp;
+  sph::test::spit(tmp / "flat.obj", "v 0 0 0\nv 1 0\nv 0 1 0\nf 1 2 3\n");
+  EXPECT_NE(refusal((tmp / "flat.obj").string()).find("line 2: a vertex (\"v\") needs three coordinates"),
+            std::string::npos);
+  sph::test::spit(tmp / "far.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 -4\n");
+  EXPECT_NE(refusal((tmp / "far.obj").string()).find("line 5: the face names vertex -4, but 3 vertices"),
+            std::string::npos);
   EXPECT_EQ(refusal(kData + "CUBE.OBJ").find("expected"), std::string::npos);  // (extensions in any case)
 }
 

@@ -2,8 +2,12 @@
 
 #include <algorithm>
 #include <cctype>
+#include <exception>
 #include <filesystem>
+#include <fstream>
 #include <map>
+#include <sstream>
+#include <string>
 #include <system_error>
 
 #include <assimp/postprocess.h>
@@ -14,6 +18,50 @@
 #include <sph/core/error.h>
 
 namespace sph {
+
+namespace {
+
+/// The first fault of an OBJ file that the importer would report without a line (its "vertex
+/// index out of range" for a vertex line with two coordinates): a "v" line that does not hold
+/// at least three numbers, or an "f" line with an index (1-based, or negative from the end) of a
+/// vertex not defined above it. Throws sph::Error naming the file and the line.
+void check_obj_lines(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::size_t vertices = 0;
+  for (std::size_t number = 1; std::getline(in, line); ++number) {
+    std::istringstream ss(line);
+    std::string tag;
+    ss >> tag;
+    if (tag == "v") {
+      int coordinates = 0;
+      for (double x = 0; coordinates < 3 && ss >> x; ++coordinates) {
+      }
+      if (coordinates < 3)
+        throw Error(fmt::format("mesh file '{}', line {}: a vertex (\"v\") needs three coordinates x y z, got \"{}\"",
+                                path, number, line));
+      ++vertices;
+    } else if (tag == "f") {
+      for (std::string corner; ss >> corner;) {
+        long long k = 0;
+        try {
+          k = std::stoll(corner.substr(0, corner.find('/')));
+        } catch (const std::exception&) {
+          throw Error(
+              fmt::format("mesh file '{}', line {}: \"{}\" is not a face's vertex number", path, number, corner));
+        }
+        const long long n = static_cast<long long>(vertices);
+        if (k == 0 || k > n || k < -n)
+          throw Error(
+              fmt::format("mesh file '{}', line {}: the face names vertex {}, but {} vertices are defined "
+                          "above it (numbered from 1, or from -1 backwards)",
+                          path, number, k, n));
+      }
+    }
+  }
+}
+
+}  // namespace
 
 TriangleMesh read_mesh_file(const std::string& path) {
   namespace fs = std::filesystem;
@@ -32,12 +80,20 @@ TriangleMesh read_mesh_file(const std::string& path) {
   if (size > (std::uintmax_t{1} << 31))
     throw Error(fmt::format("mesh file '{}' is {:.3g} GB; at most 2 GB is read (simplify the mesh first)", path,
                             static_cast<double>(size) / 1e9));
+  if (ext == ".obj") check_obj_lines(path);
   Assimp::Importer importer;
   // Only the triangles are wanted: points and lines are dropped, polygons split.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   const aiScene* scene =
       importer.ReadFile(path, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_PreTransformVertices);
-  if (scene == nullptr) throw Error(fmt::format("cannot read mesh file '{}': {}", path, importer.GetErrorString()));
+  std::string format = ext.substr(1);
+  std::transform(format.begin(), format.end(), format.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  if (scene == nullptr)
+    throw Error(
+        fmt::format("mesh file '{}' cannot be read as an {} file (the reader says: {}); expected a triangle "
+                    "mesh written by a modeller",
+                    path, format, importer.GetErrorString()));
   TriangleMesh mesh;
   // Vertices merged by exact position, numbered in order of first use.
   std::map<std::array<double, 3>, std::uint32_t> index;

@@ -74,10 +74,10 @@ std::vector<std::string> check_time_step(const SimulationParams<D>& p) {
   std::vector<std::string> warnings;
   for (const auto& l : time_step_limits(p)) {
     if (p.time_step > l.dt_refuse)
-      throw Error(fmt::format("time step {:.4g} s is unstable by the {} criterion: it must be at most {:.4g} s "
-                              "(and at most {:.4g} s to run without a warning); lower timeStepSize or the "
-                              "parameter named",
-                              p.time_step, l.name, l.dt_refuse, l.dt_warn),
+      throw Error(fmt::format("time step {:.4g} s is unstable by the {} criterion, which gives {:.4g} s here; a "
+                              "step above {:.4g} s is refused (and one above {:.4g} s warned of). Lower "
+                              "timeStepSize (or give \"auto\"), or change the parameter in the criterion",
+                              p.time_step, l.name, l.dt_warn, l.dt_refuse, l.dt_warn),
                   "Configuration.timeStepSize");
     if (p.time_step > l.dt_warn)
       warnings.push_back(fmt::format("time step {:.4g} s exceeds the {} limit of {:.4g} s; the run may be unstable",

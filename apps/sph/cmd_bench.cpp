@@ -41,6 +41,7 @@ struct BenchCliOptions {
 
 int bench(const BenchCliOptions& cli) {
   // Everything that can be refused is checked before the output directory is touched.
+  check_output_path(cli.output, "-o/--output");
   BenchOptions opt;
   opt.suites = parse_bench_suites(cli.suites, "--suite");
   opt.size = parse_bench_size(cli.size, "--size");

@@ -62,6 +62,7 @@ int validate(const ValidateCliOptions& opt) {
   if (!fs::is_directory(vo.scene_dir))
     throw Error("not a directory; expected the directory of the validation scenes (scenes/validation)", opt.scenes);
   if (opt.threads > 0) set_num_threads(opt.threads);
+  check_output_path(opt.output, "-o/--output");
   const fs::path dir(opt.output);
   check_validation_scenes(vo);  // a bad scene is refused before the output directory is touched
   prepare_validation_directory(dir);

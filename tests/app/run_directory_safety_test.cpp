@@ -225,6 +225,14 @@ TEST_F(RunDirectory, AnEmptyOrRootOutputDirectoryIsRefused) {
   expect_refused(sph({"render", "d", "-o", ""}), {"-o/--output: an empty directory name"});
   expect_refused(sph({"render", "d", "-o", "/"}), {"is the root of the file system"});
   EXPECT_FALSE(fs::exists(at("d") / "render"));
+  for (const char* command : {"bench", "validate", "compare"}) {
+    std::vector<std::string> args{command};
+    if (std::string(command) == "compare") args.push_back(kDamBreak);
+    args.insert(args.end(), {"-o", ""});
+    expect_refused(sph(args), {"-o/--output: an empty directory name"});
+    args.back() = "/";
+    expect_refused(sph(args), {"is the root of the file system"});
+  }
 }
 
 // A directory that no run made (no run.json) but that holds files a run writes: the user's own

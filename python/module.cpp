@@ -24,6 +24,43 @@ ErrorTypes& error_types() {
 
 void use_threads(int threads) { set_num_threads(threads); }
 
+std::int64_t whole_number_arg(const py::handle& value, const char* name, std::int64_t lo, std::int64_t hi) {
+  const std::string expected =
+      std::string(name) + " must be a whole number from " + std::to_string(lo) + " to " + std::to_string(hi) + ", got ";
+  if (!py::isinstance<py::int_>(value) || py::isinstance<py::bool_>(value))
+    throw py::type_error(expected + py::cast<std::string>(py::repr(value)));
+  // (a Python int of any size: compared as a Python object before any conversion)
+  if (value < py::int_(lo) || value > py::int_(hi))
+    throw py::value_error(expected + py::cast<std::string>(py::repr(value)));
+  return py::cast<std::int64_t>(value);
+}
+
+int thread_count_arg(const py::handle& threads) {
+  if (threads.is_none()) return num_threads();
+  return static_cast<int>(whole_number_arg(threads, "threads", 1, 4096));
+}
+
+std::vector<std::string> names_arg(const py::handle& value, const char* name) {
+  const std::string expected = std::string(name) + " must be a list of names (str)";
+  if (!py::isinstance<py::list>(value) && !py::isinstance<py::tuple>(value))
+    throw py::type_error(expected + ", got " + py::cast<std::string>(py::repr(value)));
+  std::vector<std::string> out;
+  for (const py::handle item : value) {
+    if (!py::isinstance<py::str>(item))
+      throw py::type_error(expected + ", got an item " + py::cast<std::string>(py::repr(item)));
+    out.push_back(py::cast<std::string>(item));
+  }
+  return out;
+}
+
+std::string path_arg(const py::handle& value, const char* name) {
+  if (py::isinstance<py::str>(value)) return py::cast<std::string>(value);
+  const py::object os = py::module_::import("os");
+  if (py::isinstance(value, os.attr("PathLike"))) return py::cast<std::string>(os.attr("fspath")(value));
+  throw py::type_error(std::string(name) + " must be a path (str or os.PathLike), got " +
+                       py::cast<std::string>(py::repr(value)));
+}
+
 namespace {
 
 /// A new exception type sph.NAME with `bases` (a type or a tuple of types), added to the module.

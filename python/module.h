@@ -3,6 +3,7 @@
 /// and the conversions every part uses. The module (module.cpp) is an edge of the house: every
 /// function it offers calls the library's public API.
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,23 @@ std::vector<std::string> override_strings(const py::handle& overrides);
 /// `desc` read again with `overrides` applied (the way sph run applies --set and its flags), so
 /// that every value goes through the reader's checks. Throws SceneError.
 SceneDesc with_overrides(const SceneDesc& desc, const std::vector<std::string>& overrides);
+
+/// A keyword argument's whole number (a Python int, not a bool), from `lo` to `hi`: TypeError or
+/// ValueError naming `name` and what is expected otherwise (pybind11's own cast says only "Unable
+/// to cast Python instance to C++ type").
+std::int64_t whole_number_arg(const py::handle& value, const char* name, std::int64_t lo, std::int64_t hi);
+
+/// The threads a call asks for: its `threads` argument (a whole number from 1 to 4096), or all
+/// the parallel loops' threads for None.
+int thread_count_arg(const py::handle& threads);
+
+/// A keyword argument's list of names (a list or tuple of str; a single str is refused, as
+/// iterating it would give its letters): TypeError naming `name` otherwise.
+std::vector<std::string> names_arg(const py::handle& value, const char* name);
+
+/// A keyword argument's path: a str or an os.PathLike (pathlib.Path): TypeError naming `name`
+/// otherwise.
+std::string path_arg(const py::handle& value, const char* name);
 
 /// Sets the worker threads of the calling thread's parallel loops; `threads` must be positive.
 void use_threads(int threads);

@@ -36,21 +36,16 @@ namespace fs = std::filesystem;
 /// stand for --set values.
 std::vector<std::string> run_overrides(const py::object& neighbors, const py::object& steps) {
   std::vector<std::string> sets;
-  if (!neighbors.is_none())
-    sets.push_back("Configuration.neighbors=\"" + py::cast<std::string>(py::str(neighbors)) + "\"");
-  if (!steps.is_none()) {
-    const auto n = py::cast<std::int64_t>(steps);
-    if (n < 1) throw py::value_error("steps must be at least 1, got " + std::to_string(n));
-    sets.push_back("Configuration.numberOfSteps=" + std::to_string(n));
+  if (!neighbors.is_none()) {
+    if (!py::isinstance<py::str>(neighbors))
+      throw py::type_error("neighbors must be a mode name: " +
+                           join_neighbor_mode_names(NeighborModeSet::All, ", ", " or "));
+    sets.push_back("Configuration.neighbors=\"" + py::cast<std::string>(neighbors) + "\"");
   }
+  if (!steps.is_none())
+    sets.push_back("Configuration.numberOfSteps=" +
+                   std::to_string(whole_number_arg(steps, "steps", 1, std::int64_t{1'000'000'000'000})));
   return sets;
-}
-
-int thread_count(const py::object& threads) {
-  if (threads.is_none()) return num_threads();
-  const int n = py::cast<int>(threads);
-  if (n < 1) throw py::value_error("threads must be at least 1, got " + std::to_string(n));
-  return n;
 }
 
 /// A progress callback: None or False (none), True (a line on stderr every 10 %), or a callable.
@@ -78,14 +73,14 @@ bool python_signal(std::optional<py::error_already_set>& pending) {
   return true;
 }
 
-py::dict run_scene(const Scene& scene, const std::string& output, const py::object& neighbors, const py::object& steps,
-                   const py::object& threads, std::int64_t checkpoint_every, bool strict, bool overwrite,
-                   const py::object& progress_arg) {
+py::dict run_scene(const Scene& scene, const py::object& output_arg, const py::object& neighbors,
+                   const py::object& steps, const py::object& threads, std::int64_t checkpoint_every, bool strict,
+                   bool overwrite, const py::object& progress_arg) {
   if (checkpoint_every < 0) throw py::value_error("checkpoint_every must be 0 or more steps");
   const SceneDesc desc = with_overrides(scene.desc, run_overrides(neighbors, steps));
-  const int n_threads = thread_count(threads);
+  const int n_threads = thread_count_arg(threads);
   const Progress progress(progress_arg);
-  const fs::path dir(output);
+  const fs::path dir(path_arg(output_arg, "output"));
   check_new_run_directory(dir, overwrite, "output", "overwrite=True", "");
   std::optional<py::error_already_set> interrupt;
   std::optional<py::error_already_set> callback_error;
@@ -148,7 +143,7 @@ py::dict compare_scene(const Scene& scene, const py::object& output, const py::o
   CompareOptions co;
   if (!modes.is_none()) {
     co.modes.clear();
-    for (const std::string& name : py::cast<std::vector<std::string>>(modes)) {
+    for (const std::string& name : names_arg(modes, "modes")) {
       const NeighborMode m = parse_neighbor_mode(name, "modes");
       if (!neighbor_mode_info(m).compared)
         throw Error(name + " is not compared (too slow to time); expected some of " +
@@ -167,11 +162,11 @@ py::dict compare_scene(const Scene& scene, const py::object& output, const py::o
   co.audit = audit;
   const SceneDesc desc = with_overrides(scene.desc, run_overrides(py::none(), steps));
   co.steps = desc.steps;
-  const int n_threads = thread_count(threads);
+  const int n_threads = thread_count_arg(threads);
   const Progress progress(progress_arg);
   std::optional<fs::path> dir;
   if (!output.is_none()) {
-    dir = fs::path(py::cast<std::string>(py::str(output)));
+    dir = fs::path(path_arg(output, "output"));
     check_output_path(dir->string(), "output");
   }
   std::optional<py::error_already_set> callback_error;
@@ -232,7 +227,8 @@ py::dict compare_scene(const Scene& scene, const py::object& output, const py::o
   return out;
 }
 
-py::dict read_frame_dict(const std::string& path) {
+py::dict read_frame_dict(const py::object& path_obj) {
+  const std::string path = path_arg(path_obj, "path");
   FrameData frame;
   {
     py::gil_scoped_release release;

@@ -109,7 +109,16 @@ Raises sph.SceneError (key path in `where`) for anything the reader refuses.)doc
       .def_property_readonly(
           "warnings", [](const Scene& s) { return s.desc.warnings; },
           "The reader's warnings (e.g. a time step close to its limit), as sph run prints them.")
-      .def("__eq__", [](const Scene& a, const Scene& b) { return a.desc == b.desc; })
+      .def(
+          "__eq__",
+          [](const Scene& a, const py::object& other) -> py::object {
+            if (!py::isinstance<Scene>(other)) return py::reinterpret_borrow<py::object>(py::handle(Py_NotImplemented));
+            // Where each was read from aside (Scene.from_dict(s.to_dict()) == s): the same run.
+            SceneDesc x = a.desc, y = other.cast<const Scene&>().desc;
+            x.source.clear(), y.source.clear();
+            return py::bool_(x == y);
+          },
+          "Equal when the two scenes run the same way, wherever each was read from; False for other objects.")
       .def("__repr__", [](const Scene& s) {
         return "<sph.Scene " + s.desc.name + " (" + std::to_string(s.desc.dimension) + "D, " +
                std::to_string(s.desc.steps) + " steps) from " + s.desc.source + ">";
@@ -117,7 +126,8 @@ Raises sph.SceneError (key path in `where`) for anything the reader refuses.)doc
 
   m.def(
       "load_scene",
-      [](const std::string& path, const py::object& overrides) {
+      [](const py::object& path_obj, const py::object& overrides) {
+        const std::string path = path_arg(path_obj, "path");
         const std::vector<std::string> sets = override_strings(overrides);
         return Scene{reading_scene([&] { return read_scene_file(path, sets); })};
       },

@@ -72,11 +72,7 @@ class PySimulation {
       sets.push_back("Configuration.neighbors=\"" + py::cast<std::string>(neighbors) + "\"");
     }
     SceneDesc desc = with_overrides(scene.desc, sets);
-    threads_ = num_threads();
-    if (!threads.is_none()) {
-      threads_ = py::cast<int>(threads);
-      if (threads_ < 1) throw py::value_error("threads must be at least 1, got " + std::to_string(threads_));
-    }
+    threads_ = thread_count_arg(threads);
     py::gil_scoped_release release;
     use_threads(threads_);
     dispatch(desc, [&]<int D, class R>() {
@@ -274,7 +270,7 @@ class PySimulation {
                   path);
     FrameFields selected;
     if (!fields.is_none()) {
-      const auto names = py::cast<std::vector<std::string>>(fields);
+      const auto names = names_arg(fields, "fields");
       const std::vector<std::string> known = field_names();
       for (const std::string& f : names) {
         const FieldDesc* desc = find_particle_field(f);

@@ -1,5 +1,6 @@
 # Type stub of the compiled module sph (python/*.cpp), for editors and type checkers.
 # tests/python/test_stub.py checks that it declares exactly what the module defines.
+import os
 from typing import Any, Callable, Literal, Mapping, Sequence
 
 import numpy as np
@@ -45,7 +46,7 @@ class Scene:
     def warnings(self) -> list[str]: ...
     def __eq__(self, other: object) -> bool: ...
 
-def load_scene(path: str, overrides: Mapping[str, Any] | None = None) -> Scene: ...
+def load_scene(path: str | os.PathLike[str], overrides: Mapping[str, Any] | None = None) -> Scene: ...
 
 class Simulation:
     def __init__(self, scene: Scene, neighbors: str | None = None, threads: int | None = None) -> None: ...
@@ -110,7 +111,7 @@ class Simulation:
 def run(
     scene: Scene,
     *,
-    output: str,
+    output: str | os.PathLike[str],
     neighbors: str | None = None,
     steps: int | None = None,
     threads: int | None = None,
@@ -122,7 +123,7 @@ def run(
 def compare(
     scene: Scene,
     *,
-    output: str | None = None,
+    output: str | os.PathLike[str] | None = None,
     modes: Sequence[str] | None = None,
     steps: int | None = None,
     threads: int | None = None,
@@ -132,7 +133,7 @@ def compare(
     run_frames: bool = True,
     progress: bool | Callable[[str, int, int, int, int], object] | None = None,
 ) -> dict[str, Any]: ...
-def read_frame(path: str) -> dict[str, Any]: ...
+def read_frame(path: str | os.PathLike[str]) -> dict[str, Any]: ...
 def surge_front(
     x: npt.ArrayLike, y: npt.ArrayLike, floor: float, spacing: float, h: float, min_neighbors: int = 3
 ) -> float: ...

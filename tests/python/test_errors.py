@@ -76,7 +76,9 @@ def test_syntax_errors_and_files():
 def test_scene_round_trip(small_2d):
     again = sph.Scene.from_dict(small_2d.to_dict())
     assert again.to_dict() == small_2d.to_dict() and again.source == "<dict>"
-    assert again != small_2d  # (the source differs)
+    assert again == small_2d  # (equal though read from elsewhere: they run the same way)
+    assert small_2d != sph.Scene.from_dict({**small_2d.to_dict(), "name": "other"})
+    assert (small_2d == None) is False and small_2d not in [None, 1, "scene"]  # noqa: E711
     assert sph.Scene.from_json(small_2d.to_json(), source=small_2d.source) == small_2d
     assert small_2d.dimension == 2 and small_2d.precision == "double" and small_2d.steps == 20
     assert small_2d.name == "dam_break_2d" and small_2d.source == DAM_BREAK
@@ -122,6 +124,19 @@ def test_argument_errors(small_2d):
         sim.step("two")
     with pytest.raises(ValueError, match="threads"):
         sim.threads = 0
+    # Named, not pybind11's "Unable to cast Python instance to C++ type".
+    for threads, error in ((2.5, TypeError), (True, TypeError), (10**12, ValueError)):
+        with pytest.raises(error, match="threads must be a whole number from 1 to 4096"):
+            sph.Simulation(small_2d, threads=threads)
+    sim.step(1)
+    with pytest.raises(TypeError, match="fields must be a list of names"):
+        sim.write_frame("x.vtu", fields="velocity")
+    with pytest.raises(TypeError, match="modes must be a list of names"):
+        sph.compare(small_2d, modes="adaptive")
+    with pytest.raises(TypeError, match="output must be a path"):
+        sph.compare(small_2d, output=5)
+    with pytest.raises(TypeError, match="steps must be a whole number"):
+        sph.run(small_2d, output="x", steps=2.0)
 
 
 def test_frame_errors(tmp_path):

@@ -57,6 +57,13 @@ def test_run_errors(small_2d, tmp_path):
     with pytest.raises(sph.Error, match="not the directory of an earlier run .* overwrite=True"):
         sph.run(small_2d, output=str(mine), steps=2)
     assert (mine / "scene.json").read_text() == "my scene"
+    # Paths as pathlib.Path, as str.
+    write_scene(small_2d, tmp_path / "from_path.json")
+    from_path = sph.load_scene(tmp_path / "from_path.json")  # a pathlib.Path
+    assert from_path == small_2d
+    r = sph.run(from_path, output=tmp_path / "as_path", steps=2)
+    assert r["status"] == "completed" and r["output"] == str(tmp_path / "as_path")
+    assert sph.read_frame(tmp_path / "as_path" / "frames" / "frame_000000.vtu")["position"].shape[0] > 0
 
 
 def test_compare(small_2d, tmp_path):

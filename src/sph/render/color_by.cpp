@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <sph/core/error.h>
 
@@ -47,11 +50,20 @@ double percentile(const std::vector<double>& sorted, double p) {
 const FrameField& require(const FrameData& frame, ColorBy by, const RunDirectory& run) {
   const std::string_view name = color_by_field(by);
   const FrameField* f = frame.field(name);
-  if (!f)
-    throw Error(fmt::format("the run's frames hold no '{}' field, which coloring by {} needs (the run left it out "
-                            "with --fields); color by a field the frames hold, or run again with it",
-                            name, color_by_name(by)),
-                run.dir.string());
+  if (!f) {
+    std::vector<std::string> held, colorable;
+    for (const FrameField& g : frame.fields) held.push_back(g.name);
+    for (const ColorBy other : kColorByAll)
+      if (frame.field(color_by_field(other))) colorable.push_back(std::string(color_by_name(other)));
+    throw Error(
+        fmt::format("the run's frames hold no '{}' field, which coloring by {} needs (the run left it out "
+                    "with --fields; they hold {}); {}, or run again with the field (sph view shows the "
+                    "particles without one)",
+                    name, color_by_name(by), held.empty() ? "positions only" : fmt::format("{}", fmt::join(held, ", ")),
+                    colorable.empty() ? std::string("no quantity can color them")
+                                      : fmt::format("color by {}", fmt::join(colorable, " or "))),
+        run.dir.string());
+  }
   const std::size_t want = frame.size * static_cast<std::size_t>(f->components);
   const FieldDesc* desc = find_particle_field(name);
   SPH_CHECK(desc, "color-by needs a field of the table");

@@ -1,6 +1,7 @@
 // sph.run, sph.compare and sph.read_frame: what `sph run`, `sph compare` and the frame readers do.
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -268,6 +269,16 @@ double front_of(const py::array_t<double, py::array::c_style | py::array::forcec
                 const py::array_t<double, py::array::c_style | py::array::forcecast>& y, double floor, double spacing,
                 double h, int min_neighbors) {
   if (x.ndim() != 1 || y.ndim() != 1) throw py::value_error("x and y must be 1-D arrays");
+  if (x.size() != y.size())
+    throw py::value_error("x and y must have one value per particle each, got " + std::to_string(x.size()) + " and " +
+                          std::to_string(y.size()));
+  if (!(spacing > 0) || !std::isfinite(spacing))
+    throw py::value_error("spacing must be a positive length (m), got " +
+                          py::cast<std::string>(py::repr(py::float_(spacing))));
+  if (!(h > 0) || !std::isfinite(h))
+    throw py::value_error("h must be a positive length (m), got " + py::cast<std::string>(py::repr(py::float_(h))));
+  if (!std::isfinite(floor)) throw py::value_error("floor must be a finite height (m)");
+  if (min_neighbors < 0) throw py::value_error("min_neighbors must be 0 or more, got " + std::to_string(min_neighbors));
   return surge_front({x.data(), static_cast<std::size_t>(x.size())}, {y.data(), static_cast<std::size_t>(y.size())},
                      floor, spacing, h, min_neighbors);
 }
@@ -283,8 +294,19 @@ plus half a spacing. NaN when no particle qualifies.)doc");
   m.def("martin_moyce_1952", &martin_moyce_points,
         "Martin & Moyce's (1952) measured front, an array of (T, Z) rows: Z = x / a at T = t sqrt(2 g / a) "
         "(the first row the initial state T = 0, Z = 1).");
-  m.def("martin_moyce_time", &martin_moyce_time, py::arg("t"), py::arg("g"), py::arg("a") = kMartinMoyceA,
-        "The experiment's scaled time T = t sqrt(2 g / a) of t in s (a: the column's base width, m).");
+  m.def(
+      "martin_moyce_time",
+      [](double t, double g, double a) {
+        if (!(g > 0) || !std::isfinite(g))
+          throw py::value_error("g must be the positive magnitude of gravity (m/s^2), got " +
+                                py::cast<std::string>(py::repr(py::float_(g))));
+        if (!(a > 0) || !std::isfinite(a))
+          throw py::value_error("a must be the column's positive base width (m), got " +
+                                py::cast<std::string>(py::repr(py::float_(a))));
+        return martin_moyce_time(t, g, a);
+      },
+      py::arg("t"), py::arg("g"), py::arg("a") = kMartinMoyceA,
+      "The experiment's scaled time T = t sqrt(2 g / a) of t in s (a: the column's base width, m).");
   m.attr("MARTIN_MOYCE_A") = kMartinMoyceA;
   m.def("run", &run_scene, py::arg("scene"), py::kw_only(), py::arg("output"), py::arg("neighbors") = py::none(),
         py::arg("steps") = py::none(), py::arg("threads") = py::none(), py::arg("checkpoint_every") = 0,

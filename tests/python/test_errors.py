@@ -147,3 +147,22 @@ def test_frame_errors(tmp_path):
     bad.write_text("<VTKFile>not a frame</VTKFile>")
     with pytest.raises(sph.Error):
         sph.read_frame(str(bad))
+
+
+def test_analysis_helpers_refuse_what_they_cannot_measure():
+    x = np.linspace(0.0, 0.1, 11)
+    y = np.zeros(11)
+    assert sph.surge_front(x, y, floor=0.0, spacing=0.01, h=0.02) == pytest.approx(0.095)  # 0.09 has 3 within h
+    for kwargs, text in ((dict(y=y[:5]), "one value per particle each, got 11 and 5"),
+                         (dict(h=0.0), "h must be a positive length"),
+                         (dict(spacing=-1.0), "spacing must be a positive length"),
+                         (dict(min_neighbors=-1), "min_neighbors must be 0 or more")):
+        args = dict(x=x, y=y, floor=0.0, spacing=0.01, h=0.02)
+        args.update(kwargs)
+        with pytest.raises(ValueError, match=text):
+            sph.surge_front(**args)
+    assert sph.martin_moyce_time(0.1, 9.81) == pytest.approx(0.1 * np.sqrt(2 * 9.81 / sph.MARTIN_MOYCE_A))
+    with pytest.raises(ValueError, match="g must be the positive magnitude"):
+        sph.martin_moyce_time(0.1, -9.81)
+    with pytest.raises(ValueError, match="a must be the column's positive base width"):
+        sph.martin_moyce_time(0.1, 9.81, 0.0)

@@ -243,6 +243,26 @@ std::array<int, 2> pixel_of(const ParticleCamera& cam, const A3& p) {
   return {static_cast<int>(std::floor(s[0])), static_cast<int>(std::floor(s[1]))};
 }
 
+// A polygon that reaches past the container: the simulation drops the part past the walls, and
+// the picture draws it cut at the wall (it was drawn over the outline and into the margin).
+TEST(ParticlesSolids, A2DPolygonPastTheContainerIsCutAtTheWall) {
+  const A3 lo{0, 0, 0}, hi{1, 1, 0};
+  SolidBox tri;
+  tri.lo = A3{0.6, 0, 0}, tri.hi = A3{1.4, 0.5, 0};
+  tri.vertices = {A3{0.6, 0, 0}, A3{1.4, 0, 0}, A3{1.4, 0.5, 0}};
+  const std::vector<SolidBox> solids = {tri};
+  const ParticleView view = flat_view();
+  const Image img = render_particles({}, 2, {}, 0.03, lo, hi, view, solids);
+  const ParticleCamera cam(2, lo, hi, 0.03, view);
+  const auto inside = pixel_of(cam, A3{0.9, 0.1, 0});
+  EXPECT_EQ(img.at(inside[0], inside[1]), kSolidColor);
+  const int wall = static_cast<int>(std::floor(cam.project(A3{1.0, 0.1, 0})[0]));
+  const Box solid = bbox(img, [](Rgb c) { return c == kSolidColor; });
+  EXPECT_LE(solid.x1, wall) << "no fill past the right wall";
+  const auto past = pixel_of(cam, A3{1.2, 0.1, 0});
+  if (past[0] < img.width()) EXPECT_NE(img.at(past[0], past[1]), kSolidColor);
+}
+
 TEST(ParticlesSolids, A2DObstacleIsAFilledRectangleWithADarkerOutlineOverTheParticles) {
   const A3 lo{0, 0, 0}, hi{1, 1, 0};
   const std::vector<SolidBox> solids = {{A3{0.4, 0, 0}, A3{0.6, 0.3, 0}}};

@@ -258,15 +258,44 @@ std::vector<Face> solid_faces(const SolidBox& box, int dim, const ParticleCamera
   return faces;
 }
 
-/// A 2D polygon solid: filled with kSolidColor (pixels whose centers it holds, by the even-odd
-/// rule), unless it is inverted, and outlined in kSolidEdgeColor.
-void draw_polygon(Image& img, const SolidBox& s, const ParticleCamera& cam) {
+/// The placed polygon `s` (2D) cut to the container [lo, hi] (Sutherland-Hodgman against its four
+/// sides): the simulation drops the part past the walls, and so does the picture.
+std::vector<Vec3> polygon_in_box(const SolidBox& s, const Vec3& lo, const Vec3& hi) {
+  std::vector<Vec3> poly;
+  for (const auto& v : s.vertices) poly.push_back(s.place(v, 2));
+  for (int side = 0; side < 4 && !poly.empty(); ++side) {
+    const int a = side / 2;
+    const bool upper = side % 2 == 1;
+    const double bound = upper ? hi[a] : lo[a];
+    const auto inside = [&](const Vec3& p) { return upper ? p[a] <= bound : p[a] >= bound; };
+    std::vector<Vec3> out;
+    for (std::size_t k = 0; k < poly.size(); ++k) {
+      const Vec3& p = poly[k];
+      const Vec3& q = poly[(k + 1) % poly.size()];
+      if (inside(p)) out.push_back(p);
+      if (inside(p) != inside(q)) {
+        const double t = (bound - p[a]) / (q[a] - p[a]);
+        Vec3 x{};
+        for (int b = 0; b < 3; ++b) x[b] = p[b] + t * (q[b] - p[b]);
+        x[a] = bound;
+        out.push_back(x);
+      }
+    }
+    poly = std::move(out);
+  }
+  return poly;
+}
+
+/// A 2D polygon solid, cut to the container [lo, hi]: filled with kSolidColor (pixels whose
+/// centers it holds, by the even-odd rule), unless it is inverted, and outlined in kSolidEdgeColor.
+void draw_polygon(Image& img, const SolidBox& s, const ParticleCamera& cam, const Vec3& lo, const Vec3& hi) {
   std::vector<std::array<double, 2>> q;
-  for (const auto& v : s.vertices) {
-    const Vec3 p = cam.project(s.place(v, 2));
+  for (const Vec3& x : polygon_in_box(s, lo, hi)) {
+    const Vec3 p = cam.project(x);
     q.push_back({p[0], p[1]});
   }
   const std::size_t n = q.size();
+  if (n < 3) return;  // wholly past the walls
   if (!s.inverted) {
     double lo_y = q[0][1], hi_y = lo_y;
     for (const auto& c : q) lo_y = std::min(lo_y, c[1]), hi_y = std::max(hi_y, c[1]);
@@ -524,7 +553,7 @@ Image render_particles(std::span<const double> xyz, int dim, std::span<const Rgb
     PixelBounds painted;
     for (const SolidBox& s : solids) {
       if (!s.vertices.empty()) {
-        draw_polygon(img, s, cam);
+        draw_polygon(img, s, cam, box_lo, box_hi);
         continue;
       }
       for (const Face& f : solid_faces(s, dim, cam)) fill_face(img, f, solid_edge_width(img), nullptr, painted);

@@ -124,7 +124,15 @@ py::dict run_scene(const Scene& scene, const py::object& output_arg, const py::o
       frames = driver.output()->frames_written();
     });
   }
-  if (interrupt) throw std::move(*interrupt);  // after the run's checkpoint and summary
+  if (interrupt) {  // after the run's checkpoint and summary: say where they are and how to go on
+    interrupt->restore();
+    PyErr_Clear();
+    PyErr_SetString(PyExc_KeyboardInterrupt,
+                    ("sph.run stopped after step " + std::to_string(result.steps_done) + "; its checkpoint is in " +
+                     dir.string() + ": continue it with sph run --resume " + dir.string())
+                        .c_str());
+    throw py::error_already_set();
+  }
   if (callback_error) throw std::move(*callback_error);
   py::dict out;
   out["status"] = std::string(to_string(result.status));

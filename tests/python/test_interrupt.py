@@ -44,7 +44,7 @@ def test_ctrl_c_interrupts_step_n_after_a_step_and_leaves_the_simulation_usable(
 def test_ctrl_c_stops_sph_run_with_a_checkpoint_that_resumes(small_2d, tmp_path):
     out = tmp_path / "run"
     timer = interrupt_after(1.0)
-    with pytest.raises(KeyboardInterrupt):
+    with pytest.raises(KeyboardInterrupt, match="continue it with sph run --resume " + str(out)):
         sph.run(small_2d, output=str(out), steps=1_000_000, threads=2)
     timer.join()
     s = summary(out)

@@ -120,7 +120,17 @@ std::pair<double, double> run_color_range(std::span<const RunDirectory> runs, Co
     const std::size_t take = std::min(n, max_frames);
     for (std::size_t k = 0; k < take; ++k) {
       const std::size_t index = take == 1 ? 0 : k * (n - 1) / (take - 1);
-      const std::vector<double> values = color_values(read_frame(run.frames[index]), by, run);
+      FrameData frame;
+      try {
+        frame = read_frame(run.frames[index]);
+      } catch (const Error& e) {
+        // (the frames asked for may be fine: say how to render them without this one)
+        throw Error(e.message() +
+                        " (the color range samples the run's frames, this one among them; give --range "
+                        "LO,HI to render other frames without it)",
+                    e.where());
+      }
+      const std::vector<double> values = color_values(frame, by, run);
       const std::size_t stride = std::max<std::size_t>(1, values.size() / max_values);
       std::vector<double>& out = sampled.emplace_back();
       for (std::size_t i = 0; i < values.size(); i += stride) out.push_back(values[i]);

@@ -330,8 +330,18 @@ void draw_legend(Image& img, const PlotSpec& spec, const PlotLayout& L) {
   for (std::size_t k = 0; k < names.size(); ++k) {
     const int ry = by + pad + static_cast<int>(k) * row_h;
     const double ly = ry + th * 7.0 / 18.0;
-    DashPen pen(img, spec.series[k].color, spec.series[k].dashed);
-    pen.segment(bx + pad, ly, bx + pad + sample_w, ly);
+    const Series& s = spec.series[k];
+    // A series drawn as dots only (no drawable point next to another: the experiment's points)
+    // shows a dot, as the plot draws it; the others a piece of their line.
+    bool dots = true;
+    for (std::size_t i = 0; dots && i + 1 < s.x.size(); ++i)
+      dots = !(drawable(s.x[i], s.y[i], L.log_y) && drawable(s.x[i + 1], s.y[i + 1], L.log_y));
+    if (dots) {
+      img.fill_disc(bx + pad + sample_w / 2.0, ly, kLineWidth + 0.5, s.color);
+    } else {
+      DashPen pen(img, s.color, s.dashed);
+      pen.segment(bx + pad, ly, bx + pad + sample_w, ly);
+    }
     draw_text(img, bx + pad + sample_w + pad, ry, names[k], kInk, ts);
   }
 }

@@ -329,6 +329,9 @@ int run(const RunOptions& opt) {
       opt.output ? std::filesystem::path(*opt.output) : std::filesystem::path("out") / desc.name;
   check_new_run_directory(dir, opt.overwrite, "-o/--output", "--overwrite",
                           "continue it with sph run --resume " + shell_word(dir.string()));
+  if (!files_a_run_replaces(dir).empty())
+    fmt::print(stderr, "sph: replacing the earlier run's files in {} (its frames, stats, summary and pictures)\n",
+               dir.string());
   return dispatch(desc, [&]<int D, class R>() { return run_scene<D, R>(desc, opt, dir, nullptr); });
 }
 

@@ -84,6 +84,9 @@ inline std::vector<std::size_t> parse_frames(const std::string& s, std::size_t c
           "--frames");
     out.push_back(static_cast<std::size_t>(k < 0 ? n + k : k));
   }
+  if (out.empty())  // "" (an empty list): nothing to do is a mistake, not a success
+    throw Error("an empty frame list; expected all, first, last or frame numbers separated by commas, e.g. 0,50,-1",
+                "--frames");
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;

@@ -193,6 +193,9 @@ TEST_F(Render, MistakesAreRefusedBeforeAnythingIsWritten) {
   expect_refused({"render", "db", "--size", "12x"}, "--size", out);
   expect_refused({"render", "db", "--frames", "5"}, "frame 5 does not exist", out);
   expect_refused({"render", "db", "--frames", "1,x"}, "--frames", out);
+  // An empty list rendered nothing, then crashed (it read the first of no frames).
+  expect_refused({"render", "db", "--frames", ""}, "--frames: an empty frame list", out);
+  expect_refused({"surface", "db", "--frames", ""}, "--frames: an empty frame list", tmp_.path() / "db" / "surface");
   expect_refused({"render", "db", "--range", "2,1"}, "--range", out);
   expect_refused({"render", "db", "--colormap", "jet"}, "--colormap", out);
   expect_refused({"render", "db", "--no-png"}, "--mp4", out);

@@ -295,6 +295,7 @@ int resume(RunOptions opt) {
                          : opt.fields             ? "--fields"
                          : opt.every              ? "--every"
                          : opt.fps                ? "--fps"
+                         : opt.surface            ? "--surface"
                                                   : nullptr;
   if (conflict)
     throw Error(
@@ -304,6 +305,16 @@ int resume(RunOptions opt) {
   if (opt.threads > 0) set_num_threads(opt.threads);
   RunToResume resumed = open_run_to_resume(opt.resume, opt.steps);
   for (const auto& w : resumed.warnings) fmt::print(stderr, "sph: warning: {}\n", w);
+  // The checkpoint does not hold the --surface settings: the frames go on, the surfaces do not.
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(resumed.dir / "surface", ec))
+    if (is_surface_output(e.path().filename().string())) {
+      fmt::print(stderr,
+                 "sph: warning: the run made surfaces of its frames (--surface); the resumed run writes frames only: "
+                 "make the rest with sph surface {} once it ends\n",
+                 shell_word(resumed.dir.string()));
+      break;
+    }
   if (opt.checkpoint_every == 0) opt.checkpoint_every = resumed.checkpoint_every;  // go on as the run did
   return dispatch(resumed.desc, [&]<int D, class R>() {
     return run_scene<D, R>(resumed.desc, opt, resumed.dir, resumed.checkpoint.get());
@@ -405,6 +416,9 @@ std::function<int()> add_run_command(CLI::App& app) {
                 "No progress output (default: a bar with ETA on a terminal, a line every 10 % otherwise)");
   return [opt, cmd]() -> int {
     if (!cmd->parsed()) return kBadInput;
+    if (!opt->surface)  // (they would be ignored without a word)
+      for (const char* o : {"--surface-format", "--surface-resolution", "--surface-smoothing"})
+        if (cmd->count(o) > 0) throw Error("applies to the surfaces of --surface; give --surface too", o);
     return run(*opt);
   };
 }

@@ -227,6 +227,8 @@ TEST_F(Resume, MistakesAreRefusedWithOneMessageAndExitCode2) {
       {{"run", "--resume", "done", "--fields", "id"}, "--fields cannot be given"},
       {{"run", "--resume", "done", "--every", "3"}, "--every cannot be given"},
       {{"run", "--resume", "done", "--fps", "30"}, "--fps cannot be given"},
+      {{"run", "--resume", "done", "--surface"}, "--surface cannot be given"},
+      {{"run", kDamBreak, "--surface-format", "ply"}, "--surface-format: applies to the surfaces of --surface"},
       {{"run", "--resume", "missing_dir"}, "missing_dir: no such directory"},
       {{"run", "--resume", "nock"}, "no checkpoint here"},
       {{"run", "--resume", "done"}, "already did all its 20 steps"},

@@ -7,9 +7,11 @@
 #include <cstddef>
 #include <exception>
 #include <filesystem>
+#include <initializer_list>
 #include <sstream>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -53,6 +55,17 @@ CLI::Validator in_range(T lo, T hi) {
         return {};
       },
       "IN [" + fmt::format("{} - {}", lo, hi) + "]");
+}
+
+/// Refuses a --set of a key that a flag also sets (--steps and --set Configuration.numberOfSteps):
+/// the later would hide the other, and a bad value in it. `flag_keys`: {key path, the flag that
+/// sets it or nullptr when that flag was not given}.
+inline void check_set_flag_conflicts(const std::vector<std::string>& sets,
+                                     std::initializer_list<std::pair<const char*, const char*>> flag_keys) {
+  for (const std::string& set : sets)
+    for (const auto& [key, flag] : flag_keys)
+      if (flag && set.substr(0, set.find('=')) == key)
+        throw Error(fmt::format("--set {} and {} both set it; give one of them", key, flag), "--set");
 }
 
 /// The frame indices a command works on (sph render, sph surface): "all", "first", "last", or a comma list of indices

@@ -76,6 +76,7 @@ int compare(const CompareCliOptions& opt) {
   co.audit = !opt.no_audit;
   if (opt.threads > 0) set_num_threads(opt.threads);
 
+  check_set_flag_conflicts(opt.sets, {{"Configuration.numberOfSteps", opt.steps > 0 ? "--steps" : nullptr}});
   std::vector<std::string> sets = opt.sets;
   if (opt.steps > 0) sets.push_back("Configuration.numberOfSteps=" + std::to_string(opt.steps));
   if (opt.output) check_output_path(*opt.output, "-o/--output");

@@ -327,6 +327,13 @@ int run(const RunOptions& opt) {
   if (opt.scene.empty())
     throw Error(
         "sph run needs a scene file: sph run SCENE.json (or --resume DIR to continue a run); see sph run --help");
+  check_set_flag_conflicts(opt.sets,
+                           {{"Configuration.numberOfSteps", opt.steps > 0 ? "--steps" : nullptr},
+                            {"Configuration.neighbors", opt.neighbors.empty() ? nullptr : "--neighbors"},
+                            {"Configuration.outputEveryNSteps", opt.every || opt.fps ? "--every/--fps" : nullptr},
+                            {"Configuration.outputFps", opt.every || opt.fps ? "--every/--fps" : nullptr},
+                            {"Configuration.outputFormats", opt.formats ? "--format" : nullptr},
+                            {"Configuration.outputFields", opt.fields ? "--fields" : nullptr}});
   std::vector<std::string> sets = opt.sets;
   for (std::string& o : output_overrides(opt)) sets.push_back(std::move(o));
   if (!opt.neighbors.empty()) sets.push_back("Configuration.neighbors=\"" + opt.neighbors + "\"");

@@ -229,6 +229,11 @@ TEST_F(Resume, MistakesAreRefusedWithOneMessageAndExitCode2) {
       {{"run", "--resume", "done", "--fps", "30"}, "--fps cannot be given"},
       {{"run", "--resume", "done", "--surface"}, "--surface cannot be given"},
       {{"run", kDamBreak, "--surface-format", "ply"}, "--surface-format: applies to the surfaces of --surface"},
+      // A --set of what a flag sets: the flag hid it, a bad value in it too.
+      {{"run", kDamBreak, "--steps", "2", "--set", "Configuration.numberOfSteps=abc"},
+       "--set Configuration.numberOfSteps and --steps both set it"},
+      {{"compare", kDamBreak, "--steps", "2", "--set", "Configuration.numberOfSteps=0"},
+       "--set Configuration.numberOfSteps and --steps both set it"},
       {{"run", "--resume", "missing_dir"}, "missing_dir: no such directory"},
       {{"run", "--resume", "nock"}, "no checkpoint here"},
       {{"run", "--resume", "done"}, "already did all its 20 steps"},

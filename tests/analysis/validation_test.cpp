@@ -3,11 +3,14 @@
 #include <sph/analysis/validation.h>
 
 #include <cmath>
+#include <filesystem>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include <sph/core/error.h>
+
+#include "support/temp_dir.h"
 
 namespace sph {
 namespace {
@@ -289,6 +292,27 @@ TEST(Hydrostatic, LatticeGradientConsistency) {
   const double p3 = lattice_gradient_consistency(3, 0.005, 0.01, true);
   EXPECT_GT(p3, 1.03);
   EXPECT_LT(p3, 1.08);
+}
+
+}  // namespace
+}  // namespace sph
+
+namespace sph {
+namespace {
+
+// An earlier validation's report stays until this one writes its own: a run stopped on the way
+// (Ctrl-C in the minutes of a full validation) used to leave the directory empty.
+TEST(ValidationFiles, AnEarlierReportStaysUntilTheNewOneIsWritten) {
+  test::TempDir dir;
+  test::spit(dir / "report.md", "earlier\n");
+  test::spit(dir / "front.png", "earlier\n");
+  prepare_validation_directory(dir.path());
+  EXPECT_EQ(test::slurp(dir / "report.md"), "earlier\n");
+  ValidationResult res;
+  res.cases = {"conservation"};
+  write_validation(dir.path(), res);
+  EXPECT_NE(test::slurp(dir / "report.md"), "earlier\n");
+  EXPECT_FALSE(std::filesystem::exists(dir / "front.png")) << "a case this run did not run";
 }
 
 }  // namespace

@@ -272,3 +272,32 @@ TEST(BenchSizes, GrowWithTheSize) {
 
 }  // namespace
 }  // namespace sph
+
+namespace sph {
+namespace {
+
+// A benchmark stopped (or read) before its last suite ends says so, and an earlier benchmark's
+// files stay until this one has results to put in their place.
+TEST(BenchFiles, AnUnfinishedRunIsIncompleteAndEarlierFilesStayUntilReplaced) {
+  test::TempDir dir;
+  test::spit(dir / "bench.json", "earlier\n");
+  test::spit(dir / "steps.csv", "earlier\n");
+  test::spit(dir / "tank.csv", "earlier\n");
+  prepare_bench_directory(dir.path());
+  EXPECT_EQ(test::slurp(dir / "bench.json"), "earlier\n") << "kept until this run writes";
+  BenchResult r;
+  r.options.suites = {"neighbors", "steps"};
+  r.suites_done = {"neighbors"};
+  EXPECT_EQ(json::parse(bench_json(r))["status"], "incomplete: 1 of 2 suites done (stopped, or still running)");
+  write_bench_files(dir.path(), r);
+  EXPECT_TRUE(std::filesystem::exists(dir / "neighbors.csv"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "steps.csv")) << "the earlier run's, not this one's";
+  EXPECT_FALSE(std::filesystem::exists(dir / "tank.csv"));
+  r.suites_done.push_back("steps");
+  EXPECT_EQ(json::parse(bench_json(r))["status"], "completed");
+  r.failure = "boom";
+  EXPECT_EQ(json::parse(bench_json(r))["status"], "failed: boom");
+}
+
+}  // namespace
+}  // namespace sph

@@ -291,12 +291,13 @@ void check_validation_scenes(const ValidationOptions& options);
 /// Files write_validation writes (relative to the output directory).
 std::vector<std::string> validation_files(const ValidationResult& result);
 
-/// Creates `dir` (the validation's output), checks that files can be created in it and removes
-/// every file an earlier validation may have written there (their set depends on the cases
-/// run), so that it holds only this run's results. Throws sph::Error naming the path.
+/// Creates `dir` (the validation's output) and checks that files can be created in it. Throws
+/// sph::Error naming the path. An earlier validation's files stay until write_validation.
 void prepare_validation_directory(const std::filesystem::path& dir);
 
-/// Writes report.md, the CSVs and the plots into `dir` (which must exist), each atomically.
+/// Removes every file an earlier validation may have written in `dir` (their set depends on the
+/// cases run), so that it holds only this run's results, then writes report.md, the CSVs and the
+/// plots (which must exist), each atomically.
 void write_validation(const std::filesystem::path& dir, const ValidationResult& result);
 
 }  // namespace sph

@@ -533,6 +533,11 @@ void write_conservation_files(const std::filesystem::path& dir, const Validation
 
 void prepare_validation_directory(const std::filesystem::path& dir) {
   make_writable_directory(dir, "the validation's output");
+}
+
+void write_validation(const std::filesystem::path& dir, const ValidationResult& res) {
+  // An earlier validation's files go now that this one has its own to write (not when it starts:
+  // a run stopped on the way leaves the earlier report whole), those of cases it did not run too.
   std::error_code ec;
   ValidationResult every;
   every.cases.assign(kValidationCases.begin(), kValidationCases.end());
@@ -540,9 +545,6 @@ void prepare_validation_directory(const std::filesystem::path& dir) {
   every.hydrostatic.resize(2);
   every.hydrostatic[1].dimension = 3;
   for (const std::string& f : validation_files(every)) std::filesystem::remove(dir / f, ec);
-}
-
-void write_validation(const std::filesystem::path& dir, const ValidationResult& res) {
   write_checks_csv(dir, res);
   if (!res.front_runs.empty()) write_front_csvs(dir, res);
   if (has(res, "martin_moyce"))

@@ -229,8 +229,9 @@ void prepare_bench_directory(const std::filesystem::path& dir) {
   fs::create_directories(dir, ec);
   if (ec) throw Error("cannot create the output directory: " + ec.message(), dir.string());
   { AtomicFile probe(dir / ".write-test"); }  // throws sph::Error naming the path if not writable
-  // An earlier run's files would sit next to this run's as if they belonged to it.
-  for (const char* name : {"bench.json", "neighbors.csv", "steps.csv", "tank.csv"}) fs::remove(dir / name, ec);
+  // An earlier run's files stay until this run has results to put in their place
+  // (write_bench_files removes those of suites it did not run): a run stopped before its first
+  // suite ends leaves them as they were.
 }
 
 BenchResult run_benchmarks(const BenchOptions& options, const std::filesystem::path& dir, const BenchOutput& out) {

@@ -180,16 +180,18 @@ void run_tank_suite(const BenchOptions& options, BenchResult& result, const Benc
 /// Checks options (suite names, thread counts, repeats...); throws sph::Error naming the option.
 void validate_bench_options(const BenchOptions& options);
 
-/// Creates `dir` if needed, checks that files can be written there (throws sph::Error naming
-/// the path otherwise) and removes the files an earlier benchmark left there.
+/// Creates `dir` if needed and checks that files can be written there (throws sph::Error naming
+/// the path otherwise). An earlier benchmark's files stay until write_bench_files replaces them.
 void prepare_bench_directory(const std::filesystem::path& dir);
 
 /// Runs every suite of options.suites in order, writing the files (write_bench_files) after each
 /// suite, so that a later failure keeps the earlier figures. `dir` must be prepared.
 BenchResult run_benchmarks(const BenchOptions& options, const std::filesystem::path& dir, const BenchOutput& out);
 
-/// Writes DIR/bench.json (everything) and one CSV per suite run (neighbors.csv, steps.csv,
-/// tank.csv), each atomically.
+/// Writes DIR/bench.json (everything; its "status" is "completed" only once every suite ran,
+/// "incomplete: ..." while they run or if the run was stopped) and one CSV per suite run
+/// (neighbors.csv, steps.csv, tank.csv), each atomically, and removes the CSVs of the suites it
+/// did not run (an earlier benchmark's).
 void write_bench_files(const std::filesystem::path& dir, const BenchResult& result);
 /// The JSON document of write_bench_files.
 std::string bench_json(const BenchResult& result);

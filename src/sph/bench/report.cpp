@@ -321,7 +321,11 @@ std::string bench_json(const BenchResult& r) {
               {"machine", machine_json(r.machine)},
               {"options", options_json(r)},
               {"suites_done", r.suites_done},
-              {"status", r.failure.empty() ? std::string("completed") : "failed: " + r.failure},
+              {"status", !r.failure.empty() ? "failed: " + r.failure
+                         : r.suites_done.size() == r.options.suites.size()
+                             ? std::string("completed")
+                             : fmt::format("incomplete: {} of {} suites done (stopped, or still running)",
+                                           r.suites_done.size(), r.options.suites.size())},
               {"notes", r.notes}};
   if (ran(r, "neighbors", r.neighbors)) doc["neighbors"] = neighbors_json(r);
   if (ran(r, "steps", r.steps)) {
@@ -333,9 +337,17 @@ std::string bench_json(const BenchResult& r) {
 }
 
 void write_bench_files(const std::filesystem::path& dir, const BenchResult& r) {
-  if (ran(r, "neighbors", r.neighbors)) write_file_atomic(dir / "neighbors.csv", neighbors_csv(r));
-  if (ran(r, "steps", r.steps)) write_file_atomic(dir / "steps.csv", steps_csv(r));
-  if (ran(r, "tank", r.tank)) write_file_atomic(dir / "tank.csv", tank_csv(r));
+  std::error_code ec;
+  // Each suite's table, or none: an earlier run's would sit next to this run's as if it belonged to it.
+  const auto table = [&](const char* suite, const auto& rows, const char* file, auto&& csv) {
+    if (ran(r, suite, rows))
+      write_file_atomic(dir / file, csv(r));
+    else
+      std::filesystem::remove(dir / file, ec);
+  };
+  table("neighbors", r.neighbors, "neighbors.csv", neighbors_csv);
+  table("steps", r.steps, "steps.csv", steps_csv);
+  table("tank", r.tank, "tank.csv", tank_csv);
   write_file_atomic(dir / "bench.json", bench_json(r));
 }
 

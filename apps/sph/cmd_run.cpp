@@ -205,8 +205,9 @@ int run_scene(const SceneDesc& desc, const RunOptions& opt, const std::filesyste
   if (opt.surface) {
     SurfaceOutput surface;
     surface.formats = parse_surface_formats(opt.surface_format, "--surface-format");
-    if (D == 2 && !surface.formats.ply && !surface.formats.obj)
-      throw Error("a 2D run's surfaces are polylines, which have no level set; choose ply or obj", "--surface-format");
+    if (D == 2 && surface.formats.vdb && opt.surface_format != "all")  // ("all": those that apply)
+      throw Error("a 2D run's surfaces are polylines, which have no level set: vdb is for 3D runs; choose ply or obj",
+                  "--surface-format");
     surface.settings.resolution = opt.surface_resolution;
     surface.settings.smoothing = opt.surface_smoothing;
     settings.surface = surface;
@@ -400,10 +401,12 @@ std::function<int()> add_run_command(CLI::App& app) {
       ->default_str("all");
   cmd->add_option("--surface-resolution", opt->surface_resolution,
                   "With --surface: voxels per particle spacing, 0.5 to 8")
-      ->default_str("2");
+      ->default_str("2")
+      ->check(in_range(0.5, 8.0));
   cmd->add_option("--surface-smoothing", opt->surface_smoothing,
                   "With --surface: kernel radius in particle spacings, 1 to 4")
-      ->default_str("2");
+      ->default_str("2")
+      ->check(in_range(1.0, 4.0));
   cmd->add_option("--checkpoint-every", opt->checkpoint_every,
                   "Write DIR/checkpoint.sphc every N steps and at the last step (the latest replaces the "
                   "previous, atomically). Ctrl-C or SIGTERM always writes one: the run finishes its step, "

@@ -58,8 +58,10 @@ int surface(SurfaceCliOptions opt) {
     const bool res = e.rfind("resolution", 0) == 0, smooth = e.rfind("smoothing", 0) == 0;
     throw Error(e, res ? "--resolution" : smooth ? "--smoothing" : e.rfind("iso", 0) == 0 ? "--iso" : opt.dir);
   }
-  if (run.dimension == 2 && formats.vdb && !formats.ply && !formats.obj)
-    throw Error("a 2D run's surfaces are polylines, which have no level set; choose ply or obj", "--format");
+  // ("all" means the formats that apply: a 2D run's are ply and obj)
+  if (run.dimension == 2 && formats.vdb && opt.format != "all")
+    throw Error("a 2D run's surfaces are polylines, which have no level set: vdb is for 3D runs; choose ply or obj",
+                "--format");
   const std::vector<std::size_t> frames = parse_frames(opt.frames, run.frames.size());
 
   const fs::path out = opt.output ? fs::path(*opt.output) : fs::path(opt.dir) / "surface";
@@ -119,14 +121,17 @@ std::function<int()> add_surface_command(CLI::App& app) {
       ->default_str("all");
   cmd->add_option("--resolution", opt->settings.resolution,
                   "Voxels per particle spacing, 0.5 to 8 (finer: smoother and slower)")
-      ->default_str("2");
+      ->default_str("2")
+      ->check(in_range(0.5, 8.0));
   cmd->add_option("--smoothing", opt->settings.smoothing,
                   "Kernel radius in particle spacings, 1 to 4 (larger: flatter surfaces, rounder edges)")
-      ->default_str("2");
+      ->default_str("2")
+      ->check(in_range(1.0, 4.0));
   cmd->add_option("--iso", opt->settings.iso,
                   "Iso-value of the color field, 0.05 to 0.95 (0.5 puts a flat surface half a spacing beyond the "
                   "outer particles)")
-      ->default_str("0.5");
+      ->default_str("0.5")
+      ->check(in_range(0.05, 0.95));
   cmd->add_option("--frame-format", opt->frame_format,
                   "Which frames to read when the run wrote several formats: " + frame_format_list());
   cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(in_range(1, 4096));

@@ -162,17 +162,19 @@ with tempfile.TemporaryDirectory() as tmp:
 
     # --- bad input: one message, exit 2, earlier surfaces kept ---
     before = sorted(os.listdir(a))
-    for args, words in ((["--resolution", "0"], "resolution must be 0.5 to 8"),
-                        (["--smoothing", "9"], "smoothing must be 1 to 4"),
+    for args, words in ((["--resolution", "0"], "--resolution: expected a number from 0.5 to 8"),
+                        (["--resolution", "abc"], "--resolution: expected a number from 0.5 to 8"),
+                        (["--smoothing", "9"], "--smoothing: expected a number from 1 to 4"),
                         (["--format", "stl"], 'unknown surface format "stl"'),
                         (["--format", "ply,ply"], "given twice"),
                         (["--frames", "7"], "frame 7 does not exist")):
         err = sph("surface", run3, "-o", a, *args, expect=2)
         if words not in err or err.count("error") != 1:
             fail(f"sph surface {' '.join(args)}: expected one error saying {words!r}, got:\n{err}")
-    err = sph("surface", run2, "--format", "vdb", expect=2)
-    if "no level set" not in err:
-        fail(f"2D --format vdb: {err}")
+    for formats in ("vdb", "ply,vdb"):  # (vdb listed with others was dropped without a word)
+        err = sph("surface", run2, "--format", formats, expect=2)
+        if "no level set" not in err:
+            fail(f"2D --format {formats}: {err}")
     err = sph("surface", os.path.join(tmp, "missing"), expect=2)
     if sorted(os.listdir(a)) != before:
         fail("a refused call changed the earlier surfaces")

@@ -77,6 +77,45 @@ TEST(SceneReader, PaperDamBreak2d) {
   EXPECT_TRUE(d.warnings.empty()) << d.warnings.front();
 }
 
+// DFSPH with the paper's kernels (poly6 density, spiky gradient) is what the docs say not to do:
+// the reader says so, and is quiet with the cubic spline.
+TEST(SceneReader, DfsphWithThePapersKernelsIsWarnedOf) {
+  json j = valid_scene();
+  j["Configuration"]["simulationMethod"] = "dfsph";
+  j["Configuration"]["boundaryHandling"] = "particles";
+  const sph::SceneDesc paper = sph::parse_scene(j.dump(), "dfsph.json");
+  ASSERT_EQ(paper.warnings.size(), 1u);
+  EXPECT_NE(paper.warnings[0].find("Configuration.kernel = \"paper\" with simulationMethod \"dfsph\""),
+            std::string::npos)
+      << paper.warnings[0];
+  j["Configuration"]["kernel"] = "cubic";
+  const sph::SceneDesc cubic = sph::parse_scene(j.dump(), "dfsph.json");
+  EXPECT_TRUE(cubic.warnings.empty()) << cubic.warnings.front();
+}
+
+// A vector with one element that is not a number names that element, and a null is "null".
+TEST(SceneReader, ABadVectorElementAndANullAreNamedAsTheyAre) {
+  json j = valid_scene();
+  j["FluidBlocks"][0]["end"] = json::parse(R"([0.2, "0.3"])");
+  try {
+    (void)sph::parse_scene(j.dump(), "v.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const sph::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("as an array of 2 numbers, got string \"0.3\" in [1]"), std::string::npos)
+        << e.what();
+  }
+  j = valid_scene();
+  j["Configuration"]["particleRadius"] = nullptr;
+  try {
+    (void)sph::parse_scene(j.dump(), "n.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const sph::Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find(", got null"), std::string::npos) << m;
+    EXPECT_EQ(m.find("null null"), std::string::npos) << m;
+  }
+}
+
 TEST(SceneReader, PaperBlock3d) {
   const sph::SceneDesc d = sph::read_scene_file(SPH_SOURCE_DIR "/scenes/paper/block_3d.json");
   EXPECT_EQ(d.dimension, 3);

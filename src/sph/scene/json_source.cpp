@@ -16,6 +16,7 @@ std::string describe(const json& j) {
   // Never dump containers whole: a deeply nested value would recurse without bound.
   if (j.is_array()) return fmt::format("an array of {} element{}", j.size(), j.size() == 1 ? "" : "s");
   if (j.is_object()) return fmt::format("an object with {} key{}", j.size(), j.size() == 1 ? "" : "s");
+  if (j.is_null()) return "null";
   std::string text = j.dump();
   if (text.size() > 40) text = text.substr(0, 37) + "...";
   return std::string(j.type_name()) + " " + text;

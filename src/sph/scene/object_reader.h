@@ -79,7 +79,7 @@ class ObjectReader {
     for (int d = 0; d < D; ++d) {
       const json& e = (*v)[static_cast<std::size_t>(d)];
       if (!e.is_number() || !std::isfinite(e.get<double>()))
-        ctx_.fail(child(key), "expected " + expect + ", got " + describe(*v));
+        ctx_.fail(child(key), fmt::format("expected {}, got {} in [{}]", expect, describe(e), d));
       out[d] = e.get<double>();
     }
     return out;

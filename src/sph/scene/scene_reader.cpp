@@ -766,6 +766,11 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
   });
   check_emitter_travel<D>(root.ctx(), sim, derived.time_step);
   warn_from_scales<D>(desc, sim, derived, scales);
+  if (sim.method == SimulationMethod::Dfsph && sim.fluid.kernel == KernelKind::Paper)
+    desc.warnings.push_back(
+        "Configuration.kernel = \"paper\" with simulationMethod \"dfsph\": the paper's kernels take the density by "
+        "poly6 and the gradient by spiky, which the divergence-free solve cannot reconcile (docs/physics.md, "
+        "\"DFSPH\", \"Kernels\"); give kernel \"cubic\", as the DFSPH scenes do");
   try {
     for (const std::string& w : check_time_step<D>(sim)) desc.warnings.push_back(w);
   } catch (const Error& e) {

@@ -113,7 +113,10 @@ std::function<int()> add_bench_command(CLI::App& app) {
                   "slowest")
       ->check(in_range(1, 100))
       ->default_str("3");
-  cmd->add_option("-o,--output", opt->output, "Output directory for bench.json and the CSVs")->default_str("out/bench");
+  cmd->add_option("-o,--output", opt->output,
+                  "Output directory for bench.json and the CSVs (an earlier benchmark's files there, those of other "
+                  "suites too, are replaced once this one has its first results)")
+      ->default_str("out/bench");
   cmd->add_option("--particles", opt->particles,
                   "Steps suite: run one dam break of about this many particles (rounded to a cube) instead of the "
                   "size's, e.g. 10000000")

@@ -260,7 +260,9 @@ TEST(ParticlesSolids, A2DPolygonPastTheContainerIsCutAtTheWall) {
   const Box solid = bbox(img, [](Rgb c) { return c == kSolidColor; });
   EXPECT_LE(solid.x1, wall) << "no fill past the right wall";
   const auto past = pixel_of(cam, A3{1.2, 0.1, 0});
-  if (past[0] < img.width()) EXPECT_NE(img.at(past[0], past[1]), kSolidColor);
+  if (past[0] < img.width()) {
+    EXPECT_NE(img.at(past[0], past[1]), kSolidColor);
+  }
 }
 
 TEST(ParticlesSolids, A2DObstacleIsAFilledRectangleWithADarkerOutlineOverTheParticles) {

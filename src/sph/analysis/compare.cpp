@@ -10,6 +10,7 @@
 #include <sph/analysis/labels.h>
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
+#include <sph/core/vec.h>
 #include <sph/io/atomic_file.h>
 #include <sph/io/frames.h>
 #include <sph/io/run_directory.h>
@@ -21,7 +22,6 @@ namespace sph {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr std::uint64_t kPerturbationSeed = 20240917;
 
 /// Steps (after the step, 1-based counts) at which images are taken: evenly spaced, the last

@@ -11,6 +11,7 @@
 #include <sph/analysis/compare.h>
 #include <sph/analysis/labels.h>
 #include <sph/core/error.h>
+#include <sph/core/vec.h>
 #include <sph/core/version.h>
 #include <sph/io/atomic_file.h>
 #include <sph/render/color_by.h>
@@ -23,8 +24,6 @@
 namespace sph {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double mean_of(const std::vector<StepRecord>& v, std::uint64_t StepRecord::*field) {
   if (v.empty()) return 0;

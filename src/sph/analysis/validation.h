@@ -11,10 +11,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
-#include <limits>
 #include <span>
 #include <string>
 #include <vector>
+
+#include <sph/core/vec.h>
 
 namespace sph {
 
@@ -52,14 +53,14 @@ double interpolate(std::span<const double> xs, std::span<const double> ys, doubl
 
 /// A simulated front Z(T) against the experiment.
 struct FrontError {
-  int points = 0;        ///< experimental points compared
-  bool complete = true;  ///< false if the simulation did not reach every point with T <= t_max
-  double max = std::numeric_limits<double>::quiet_NaN();      ///< max |Z_sim - Z_exp|
-  double rms = std::numeric_limits<double>::quiet_NaN();      ///< RMS of Z_sim - Z_exp
-  double mean = std::numeric_limits<double>::quiet_NaN();     ///< mean of Z_sim - Z_exp (> 0: ahead)
-  double worst_T = std::numeric_limits<double>::quiet_NaN();  ///< T of the largest |dZ|
-  std::vector<FrontPoint> experiment;                         ///< the points compared
-  std::vector<double> simulated;                              ///< Z_sim at each of them (NaN if not reached)
+  int points = 0;                      ///< experimental points compared
+  bool complete = true;                ///< false if the simulation did not reach every point with T <= t_max
+  double max = kNaN;                   ///< max |Z_sim - Z_exp|
+  double rms = kNaN;                   ///< RMS of Z_sim - Z_exp
+  double mean = kNaN;                  ///< mean of Z_sim - Z_exp (> 0: ahead)
+  double worst_T = kNaN;               ///< T of the largest |dZ|
+  std::vector<FrontPoint> experiment;  ///< the points compared
+  std::vector<double> simulated;       ///< Z_sim at each of them (NaN if not reached)
 };
 
 /// Compares the simulated front (T increasing, same sizes) with the experimental points of

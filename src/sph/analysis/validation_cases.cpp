@@ -13,6 +13,7 @@
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 #include <sph/core/timer.h>
+#include <sph/core/vec.h>
 #include <sph/io/frames.h>
 #include <sph/run/driver.h>
 #include <sph/scene/dispatch.h>
@@ -23,8 +24,6 @@
 namespace sph {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 template <int D, std::floating_point R>
 FluidState state_of(const Simulation<D, R>& sim) {

@@ -20,8 +20,6 @@ namespace sph {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
 // Martin & Moyce (1952), Table 2, n^2 = 2: (T, Z), the initial condition first.
 constexpr std::array<FrontPoint, 16> kMartinMoyce{{{0.00, 1.00},
                                                    {0.41, 1.11},

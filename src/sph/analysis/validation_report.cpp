@@ -9,6 +9,7 @@
 
 #include <sph/analysis/labels.h>
 #include <sph/analysis/validation.h>
+#include <sph/core/vec.h>
 #include <sph/core/version.h>
 #include <sph/io/atomic_file.h>
 #include <sph/render/colormap.h>
@@ -18,8 +19,6 @@
 namespace sph {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string g(double x, int digits = 3) {
   return std::isfinite(x) ? fmt::format("{:.{}g}", x, digits) : std::string("n/a");

@@ -5,10 +5,14 @@
 #include <cmath>
 #include <concepts>
 #include <cstddef>
+#include <limits>
 #include <span>
 #include <vector>
 
 namespace sph {
+
+/// A quiet NaN: what the analyses report for a quantity that was not measured.
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// A D-dimensional vector of floating-point type R. Plain value type (trivially copyable).
 template <int D, std::floating_point R>
@@ -59,6 +63,12 @@ constexpr R dot(const Vec<D, R>& a, const Vec<D, R>& b) {
 template <int D, std::floating_point R>
 constexpr R norm2(const Vec<D, R>& a) {
   return dot(a, a);
+}
+
+/// The cross product a x b of two 3D vectors.
+template <std::floating_point R>
+constexpr Vec<3, R> cross(const Vec<3, R>& a, const Vec<3, R>& b) {
+  return {{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}};
 }
 
 template <int D, std::floating_point R>

@@ -16,7 +16,6 @@ namespace sph {
 
 namespace {
 
-constexpr Rgb kInk{40, 40, 40};
 /// The 2D surface lines: dark blue, apart from every colormap's particles.
 constexpr Rgb kSurfaceLine{20, 40, 120};
 

@@ -16,6 +16,9 @@ struct Rgb {
   friend bool operator==(const Rgb&, const Rgb&) = default;
 };
 
+/// The dark grey of text, ticks and labels in every picture.
+inline constexpr Rgb kInk{40, 40, 40};
+
 /// Linear interpolation between two colors: `t = 0` gives `a`, `t = 1` gives `b` (t is clamped).
 Rgb mix(Rgb a, Rgb b, double t);
 /// The color scaled by `factor` (clamped to [0, 255] per channel).

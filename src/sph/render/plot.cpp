@@ -15,7 +15,6 @@ namespace sph {
 namespace {
 
 constexpr Rgb kWhite{255, 255, 255};
-constexpr Rgb kInk{40, 40, 40};
 constexpr Rgb kFrame{90, 90, 90};
 constexpr Rgb kGrid{222, 222, 222};
 constexpr Rgb kMinorGrid{240, 240, 240};

@@ -20,10 +20,6 @@ Vec<3, double> times_transposed(const std::array<double, 9>& r, const Vec<3, dou
            r[2] * v[0] + r[5] * v[1] + r[8] * v[2]}};
 }
 
-Vec<3, double> cross(const Vec<3, double>& a, const Vec<3, double>& b) {
-  return {{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}};
-}
-
 constexpr std::array<double, 9> kIdentity{1, 0, 0, 0, 1, 0, 0, 0, 1};
 
 /// A B for row-major 3 x 3 matrices.

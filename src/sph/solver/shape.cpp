@@ -20,9 +20,6 @@ namespace {
 using V2 = Vec<2, double>;
 using V3 = Vec<3, double>;
 
-V3 cross(const V3& a, const V3& b) {
-  return V3{{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}};
-}
 double cross2(const V2& a, const V2& b) { return a[0] * b[1] - a[1] * b[0]; }
 
 template <int D>

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The lint check: clang-tidy (.clang-tidy: the naming rules and a focused set of bug and
 # performance checks, warnings as errors) on every C++ source of src/, apps/ and python/, and through
-# its HeaderFilterRegex on the headers of src/sph and python/ they include, with the compile commands of a
-# configured build directory (default build/; scripts/build.sh makes it). Exits 1 on any finding.
+# its HeaderFilterRegex on the headers of src/sph, apps/sph and python/ they include, with the compile
+# commands of a configured build directory (default build/; scripts/build.sh makes it). Exits 1 on
+# any finding.
 #   bash scripts/check_tidy.sh [BUILD_DIR] [FILE...]      (no file: all of src/, apps/ and python/)
-# JOBS (default: nproc) files at a time. CLANG_TIDY names the program (default clang-tidy-14).
+# JOBS (default: nproc) units at a time. CLANG_TIDY names the program (default clang-tidy-14).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
@@ -60,14 +61,37 @@ if [ "$found" != "Bad_ FunctionBad WidthBad _reserved alias_bad lanes_bad lower_
   echo "check_tidy: self-check failed: the naming rules flagged [${found}], expected the nine names marked bad"
   exit 1
 fi
-export tidy build log
+# The sources are checked in units (scripts/tidy_units.py): each directory's sources of one
+# compile command as one generated file, so that the headers they share are parsed and walked
+# once, not once per source. A unit that does not compile as one file (two sources define the
+# same name in their anonymous namespaces, a macro is defined twice) has its sources checked
+# one by one instead, and the lint says so: the findings are the same either way.
+python3 scripts/tidy_units.py "$build" "$log" "${files[@]}" >"$log/units.txt" || exit 2
+export tidy log
+check_unit() {  # unit, then its sources
+  local unit=$1 out
+  shift
+  out=$log/$(basename "$unit").log
+  "$tidy" -p "$log" --config-file=.clang-tidy --quiet --extra-arg=-Wno-unknown-warning-option "$unit" >"$out" 2>&1 && return 0
+  if grep -q '\[clang-diagnostic-' "$out"; then
+    echo "check_tidy: $(grep -m1 '\[clang-diagnostic-' "$out" | sed 's/ \[clang-diagnostic-.*//')"
+    echo "check_tidy: so the $# sources of $(basename "$unit" .cpp) are checked one by one"
+    local s status=0
+    for s in "$@"; do
+      "$tidy" -p "$log" --config-file=.clang-tidy --quiet --extra-arg=-Wno-unknown-warning-option "$s" >"$out.$(basename "$s").log" 2>&1 || status=1
+    done
+    rm -f "$out"
+    [ $status -eq 0 ] && return 0
+  fi
+  echo "$unit" >>"$log/failed"
+}
+export -f check_unit
 # The compile commands are GCC's: clang does not know some of its warning options.
-printf '%s\n' "${files[@]}" | xargs -P "${JOBS:-$(nproc)}" -I{} sh -c \
-  '"$tidy" -p "$build" --quiet --extra-arg=-Wno-unknown-warning-option "$1" >"$log/$(echo "$1" | tr / _).log" 2>&1 || echo "$1" >>"$log/failed"' _ {}
+xargs -d '\n' -n1 -P "${JOBS:-$(nproc)}" bash -c 'IFS=$'"'\\t'"' read -ra unit <<<"$1"; check_unit "${unit[@]}"' _ <"$log/units.txt"
 if [ -s "$log/failed" ]; then
   # Each finding once (a header's shows up in every file that includes it).
   cat "$log"/*.log | grep -E '^[^ ].*: (warning|error): ' | sort -u
-  echo "check_tidy: findings in $(wc -l <"$log/failed") of ${#files[@]} files (and the headers they include); see .clang-tidy"
+  echo "check_tidy: findings in $(wc -l <"$log/failed") of $(wc -l <"$log/units.txt") units of ${#files[@]} sources (and the headers they include); see .clang-tidy"
   exit 1
 fi
-echo "check_tidy: ${#files[@]} sources of src/, apps/ and python/ and the headers they include pass .clang-tidy"
+echo "check_tidy: ${#files[@]} sources of src/, apps/ and python/ (in $(wc -l <"$log/units.txt") units) and the headers they include pass .clang-tidy"

@@ -9,9 +9,11 @@
 
 namespace sph::app {
 
-/// Exit codes: 0 success, 1 the run failed (blow-up, I/O error during the run),
-/// 2 bad input (scene, flags, paths), 70 internal error (a bug).
-enum ExitCode { kOk = 0, kRunFailed = 1, kBadInput = 2, kInternal = 70 };
+// Exit codes.
+inline constexpr int kOk = 0;         ///< success
+inline constexpr int kRunFailed = 1;  ///< the run failed (blow-up, I/O error during the run)
+inline constexpr int kBadInput = 2;   ///< bad input (scene, flags, paths)
+inline constexpr int kInternal = 70;  ///< internal error (a bug)
 
 /// Adds `sph run` to the app; the returned function runs it after parsing.
 std::function<int()> add_run_command(CLI::App& app);

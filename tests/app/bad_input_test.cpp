@@ -14,8 +14,11 @@
 
 #include "support/expect.h"
 #include "support/run_sph.h"
+#include "support/scenes.h"
 
 namespace {
+
+using sph::test::kDamBreak;
 
 namespace fs = std::filesystem;
 using sph::test::CommandResult;
@@ -23,7 +26,6 @@ using sph::test::slurp;
 using sph::test::TempDir;
 
 const fs::path kBadDir = fs::path(SPH_SOURCE_DIR) / "tests" / "scene" / "bad";
-const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
 
 std::vector<std::string> lines(const std::string& text) {
   std::vector<std::string> out;

@@ -17,12 +17,14 @@
 
 #include "support/expect.h"
 #include "support/run_sph.h"
+#include "support/scenes.h"
 
 namespace {
 
+using sph::test::kDamBreak;
+
 namespace fs = std::filesystem;
 
-const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
 const std::string kBadScene = SPH_SOURCE_DIR "/tests/scene/bad/typo_optional_key_viscosity.json";  // Fluid.viscosty
 
 std::string read_file(const fs::path& p) { return sph::test::slurp(p); }

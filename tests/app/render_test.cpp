@@ -14,14 +14,16 @@
 #include "support/expect.h"
 #include "support/png_decode.h"
 #include "support/run_sph.h"
+#include "support/scenes.h"
 
 namespace {
 
+using sph::test::kBlock;
+using sph::test::kDamBreak;
+
 namespace fs = std::filesystem;
 using sph::test::CommandResult;
-
-const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
-const std::string kBlock = SPH_SOURCE_DIR "/scenes/paper/block_3d.json";
+using sph::test::error_lines;
 
 sph::test::DecodedPng load_png(const fs::path& p) { return sph::test::decode_png(sph::test::slurp(p)); }
 
@@ -31,12 +33,6 @@ std::vector<std::string> pngs_in(const fs::path& dir) {
     if (e.path().extension() == ".png") names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
   return names;
-}
-
-int error_lines(const std::string& err) {
-  int n = 0;
-  for (std::size_t p = err.find("sph: error:"); p != std::string::npos; p = err.find("sph: error:", p + 1)) ++n;
-  return n;
 }
 
 class Render : public testing::Test {
@@ -56,7 +52,7 @@ class Render : public testing::Test {
   void expect_refused(const std::vector<std::string>& args, const std::string& what, const fs::path& render_dir) {
     const CommandResult r = sph(args);
     EXPECT_EQ(r.code, 2) << r.err;
-    EXPECT_EQ(error_lines(r.err), 1) << r.err;
+    EXPECT_EQ(error_lines(r.err).size(), 1u) << r.err;
     EXPECT_CONTAINS(r.err, what);
     EXPECT_FALSE(fs::exists(render_dir)) << r.err;
   }

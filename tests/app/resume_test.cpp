@@ -18,17 +18,18 @@
 
 #include "support/expect.h"
 #include "support/run_sph.h"
+#include "support/scenes.h"
 
 namespace {
+
+using sph::test::kDamBreak;
+using sph::test::kTank;
 
 namespace fs = std::filesystem;
 using sph::test::CommandResult;
 using sph::test::slurp;
 using sph::test::SphProcess;
 using sph::test::TempDir;
-
-const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
-const std::string kTank = SPH_SOURCE_DIR "/scenes/paper/tank_fill_3d.json";
 
 class Resume : public testing::Test {
  protected:

@@ -18,16 +18,17 @@
 
 #include "support/expect.h"
 #include "support/run_sph.h"
+#include "support/scenes.h"
 
 namespace {
+
+using sph::test::kDamBreak;
 
 namespace fs = std::filesystem;
 using sph::test::CommandResult;
 using sph::test::slurp;
 using sph::test::spit;
 using sph::test::TempDir;
-
-const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
 
 class RunDirectory : public testing::Test {
  protected:

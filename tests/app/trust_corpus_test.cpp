@@ -30,6 +30,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using sph::test::CommandResult;
+using sph::test::error_lines;
 using sph::test::slurp;
 using sph::test::TempDir;
 
@@ -71,14 +72,6 @@ Expectation read_expect(const fs::path& file) {
       ADD_FAILURE() << file << ": unknown key \"" << key << "\"";
   }
   return e;
-}
-
-std::vector<std::string> error_lines(const std::string& err) {
-  std::vector<std::string> out;
-  std::istringstream in(err);
-  for (std::string l; std::getline(in, l);)
-    if (l.rfind("sph: error:", 0) == 0) out.push_back(l);
-  return out;
 }
 
 /// What the frames of a run show, checked against the effective scene (scene.json).

@@ -16,17 +16,19 @@
 #include <sph/scene/builders.h>
 #include <sph/scene/scene_reader.h>
 
+#include "support/scenes.h"
 #include "support/temp_dir.h"
 #include "support/thread_count.h"
 
 namespace sph {
 namespace {
 
+using sph::test::kDamBreak;
+
 namespace fs = std::filesystem;
 using test::TempDir;
 
 const std::string kTank = SPH_SOURCE_DIR "/scenes/paper/tank_fill_3d.json";
-const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
 
 using test::ThreadCount;
 

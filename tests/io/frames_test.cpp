@@ -23,18 +23,20 @@
 #include <sph/scene/builders.h>
 #include <sph/scene/scene_reader.h>
 
+#include "support/scenes.h"
 #include "support/temp_dir.h"
 #include "support/test_particles.h"
 
 namespace sph {
 namespace {
 
+using sph::test::kDamBreak;
+
 namespace fs = std::filesystem;
 using test::slurp;
 using test::spit;
 using test::TempDir;
 
-const std::string kDamBreak = SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json";
 constexpr FrameFormat kFormats[] = {FrameFormat::Vtu, FrameFormat::Vtk, FrameFormat::Ply};
 
 /// Which of kFrameFieldNames a test frame holds: bit k for kFrameFieldNames[k].

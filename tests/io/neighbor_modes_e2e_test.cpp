@@ -10,16 +10,18 @@
 #include <sph/scene/builders.h>
 #include <sph/scene/scene_reader.h>
 
+#include "support/scenes.h"
+
 namespace sph {
 namespace {
 
-std::string scene_path(const std::string& name) { return SPH_SOURCE_DIR "/scenes/paper/" + name + ".json"; }
+using test::paper_scene;
 
 SceneDesc scene(const std::string& name, const std::string& mode, bool audit, int period = 200) {
   // The same reorder steps in every run (by default they follow fullRebuildPeriod).
-  SceneDesc d = read_scene_file(scene_path(name), {"Configuration.neighbors=\"" + mode + "\"",
-                                                   "Configuration.fullRebuildPeriod=" + std::to_string(period),
-                                                   "Configuration.reorderPeriod=50"});
+  SceneDesc d = read_scene_file(paper_scene(name), {"Configuration.neighbors=\"" + mode + "\"",
+                                                    "Configuration.fullRebuildPeriod=" + std::to_string(period),
+                                                    "Configuration.reorderPeriod=50"});
   d.set_audit(audit);
   return d;
 }

@@ -14,12 +14,13 @@
 #include <sph/scene/builders.h>
 #include <sph/scene/scene_reader.h>
 
+#include "support/scenes.h"
 #include "support/thread_count.h"
 
 namespace sph {
 namespace {
 
-std::string scene_path(const std::string& name) { return SPH_SOURCE_DIR "/scenes/paper/" + name + ".json"; }
+using test::paper_scene;
 
 struct Expect {
   double min_mean_neighbors, max_mean_neighbors;
@@ -105,7 +106,7 @@ void run_scene(const std::string& name, std::int64_t steps, const Expect& ex) {
   ThreadCount restore;
   set_num_threads(kSanityThreads);
   const auto t0 = std::chrono::steady_clock::now();
-  const SceneDesc desc = read_scene_file(scene_path(name));
+  const SceneDesc desc = read_scene_file(paper_scene(name));
   ASSERT_EQ(desc.dimension, D);
   Simulation<D, R> sim = make_simulation<D, R>(desc);
   const std::size_t initial = sim.particles().size();
@@ -130,7 +131,7 @@ void run_scene(const std::string& name, std::int64_t steps, const Expect& ex) {
 
 TEST(ScenesE2E, DamBreak2D) {
   run_scene<2, double>("dam_break_2d", 1500, {4, 20});
-  const SceneDesc desc = read_scene_file(scene_path("dam_break_2d"));
+  const SceneDesc desc = read_scene_file(paper_scene("dam_break_2d"));
   EXPECT_EQ(count_block_particles<2>(desc.body<2>()), 3200u);
 }
 
@@ -138,14 +139,14 @@ TEST(ScenesE2E, DamBreak2DFloat) { run_scene<2, float>("dam_break_2d", 1500, {4,
 
 TEST(ScenesE2E, Block3D) {
   run_scene<3, double>("block_3d", 600, {10, 60});
-  const SceneDesc desc = read_scene_file(scene_path("block_3d"));
+  const SceneDesc desc = read_scene_file(paper_scene("block_3d"));
   EXPECT_EQ(count_block_particles<3>(desc.body<3>()), 4000u);
 }
 
 TEST(ScenesE2E, TankFill3D) {
   ThreadCount restore;
   set_num_threads(kSanityThreads);
-  const SceneDesc desc = read_scene_file(scene_path("tank_fill_3d"));
+  const SceneDesc desc = read_scene_file(paper_scene("tank_fill_3d"));
   Simulation<3, double> sim = make_simulation<3, double>(desc);
   ASSERT_EQ(sim.particles().size(), 0u);
   ASSERT_EQ(sim.params().emitters.size(), 1u);
@@ -180,7 +181,7 @@ Simulation<D, R> run_with_threads(const SceneDesc& desc, int threads, std::int64
 
 TEST(ScenesE2E, Block3DIsBitwiseIdenticalFor1And2Threads) {
   ThreadCount restore;
-  const SceneDesc desc = read_scene_file(scene_path("block_3d"));
+  const SceneDesc desc = read_scene_file(paper_scene("block_3d"));
   const auto a = run_with_threads<3, double>(desc, 1, 100);
   const auto b = run_with_threads<3, double>(desc, 2, 100);
   const auto& pa = a.particles();
@@ -201,7 +202,7 @@ TEST(ScenesE2E, Block3DIsBitwiseIdenticalFor1And2Threads) {
 TEST(ScenesE2E, TankFill3DIsBitwiseIdenticalFor1And2Threads) {
   // With an emitter the particle count changes during the run (new chunks appear).
   ThreadCount restore;
-  const SceneDesc desc = read_scene_file(scene_path("tank_fill_3d"));
+  const SceneDesc desc = read_scene_file(paper_scene("tank_fill_3d"));
   const auto a = run_with_threads<3, double>(desc, 1, 300);
   const auto b = run_with_threads<3, double>(desc, 2, 300);
   ASSERT_EQ(a.particles().size(), b.particles().size());

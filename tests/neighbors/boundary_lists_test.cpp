@@ -17,17 +17,15 @@
 #include <sph/neighbors/tracked.h>
 #include <sph/neighbors/verlet.h>
 
+#include "support/lists.h"
+
 namespace sph {
 namespace {
 
 using V3 = Vec<3, double>;
-constexpr double kH = 0.1;
+constexpr double kSupport = 0.1;
 
-std::vector<std::uint32_t> sorted(std::span<const std::uint32_t> s) {
-  std::vector<std::uint32_t> v(s.begin(), s.end());
-  std::sort(v.begin(), v.end());
-  return v;
-}
+using test::sorted;
 
 /// Samples on the six faces of the unit cube, two layers, spacing 0.05.
 template <std::floating_point R>
@@ -72,14 +70,14 @@ void check_queries_match_brute_force() {
   // Particles inside the box, near the walls, and far outside it (clamped to the edge cells).
   const auto ps = random_particles<R>(4000, -0.6, 1.6, 7);
   UniformGrid<3, R> grid;
-  grid.build(samples, static_cast<R>(kH));
-  const NeighborLists bf = brute_force_query_lists<3, R>(ps.position, samples, static_cast<R>(kH));
+  grid.build(samples, static_cast<R>(kSupport));
+  const NeighborLists bf = brute_force_query_lists<3, R>(ps.position, samples, static_cast<R>(kSupport));
   EXPECT_GT(bf.entry_count(), 1000u);
   for (bool vector : {true, false}) {
     ListBuilder<3, R> builder;
     builder.use_vector_kernel(vector);
     NeighborLists lists;
-    builder.build_queries(grid, ps.position, static_cast<R>(kH), lists);
+    builder.build_queries(grid, ps.position, static_cast<R>(kSupport), lists);
     expect_equal_lists<R>(lists, bf);
   }
 }
@@ -94,7 +92,7 @@ TEST(BoundaryLists, SameForAnyThreadCount) {
   std::vector<NeighborLists> out;
   for (int t : {1, 2, 3}) {
     set_num_threads(t);
-    StandardNeighbors<3, double> s(kH);
+    StandardNeighbors<3, double> s(kSupport);
     s.set_boundary(samples);
     s.update(ps);
     out.push_back(s.boundary_lists());
@@ -106,7 +104,7 @@ TEST(BoundaryLists, SameForAnyThreadCount) {
 
 TEST(BoundaryLists, NoSamplesNoLists) {
   const auto ps = random_particles<double>(100, 0.0, 1.0, 3);
-  StandardNeighbors<3, double> s(kH);
+  StandardNeighbors<3, double> s(kSupport);
   s.update(ps);
   EXPECT_EQ(s.boundary_lists().particle_count(), 0u);
   EXPECT_EQ(s.counters().boundary_pairs_stored, 0u);
@@ -115,18 +113,18 @@ TEST(BoundaryLists, NoSamplesNoLists) {
 TEST(BoundaryLists, EveryStrategyListsThePairsWithinH) {
   const auto samples = wall_samples<double>();
   auto ps = random_particles<double>(3000, 0.0, 1.0, 11);
-  const NeighborLists exact = brute_force_query_lists<3, double>(ps.position, samples, kH);
+  const NeighborLists exact = brute_force_query_lists<3, double>(ps.position, samples, kSupport);
   for (NeighborMode mode : {NeighborMode::Standard, NeighborMode::Adaptive, NeighborMode::Verlet, NeighborMode::Tracked,
                             NeighborMode::AdaptiveExact, NeighborMode::VerletClusters, NeighborMode::BruteForce}) {
     NeighborOptions opt;
-    opt.radius = kH;
+    opt.radius = kSupport;
     auto s = make_neighbor_strategy<3, double>(mode, opt);
     s->set_boundary(samples);
     s->update(ps);
     ASSERT_EQ(s->boundary_lists().particle_count(), ps.size()) << to_string(mode);
     EXPECT_EQ(s->counters().boundary_pairs_stored, s->boundary_lists().entry_count()) << to_string(mode);
     ListAuditor<3, double> auditor;
-    const ListAudit a = auditor.audit_boundary(ps.position, samples, s->boundary_lists(), kH);
+    const ListAudit a = auditor.audit_boundary(ps.position, samples, s->boundary_lists(), kSupport);
     EXPECT_EQ(a.missed_pairs, 0u) << to_string(mode);
     if (mode == NeighborMode::Standard || mode == NeighborMode::Adaptive || mode == NeighborMode::BruteForce) {
       expect_equal_lists<double>(s->boundary_lists(), exact);
@@ -139,7 +137,7 @@ TEST(BoundaryLists, EveryStrategyListsThePairsWithinH) {
 TEST(BoundaryLists, VerletNeverMissesWhileParticlesMoveWithinTheSkin) {
   const auto samples = wall_samples<double>();
   auto ps = random_particles<double>(2000, 0.0, 1.0, 12);
-  VerletNeighbors<3, double> v(kH, 0.2 * kH);
+  VerletNeighbors<3, double> v(kSupport, 0.2 * kSupport);
   v.set_boundary(samples);
   ListAuditor<3, double> auditor;
   std::mt19937 rng(5);
@@ -147,7 +145,7 @@ TEST(BoundaryLists, VerletNeverMissesWhileParticlesMoveWithinTheSkin) {
   for (int step = 0; step < 30; ++step) {
     for (auto& x : ps.position) x += V3{{u(rng), u(rng), u(rng)}};
     v.update(ps);
-    ASSERT_EQ(auditor.audit_boundary(ps.position, samples, v.boundary_lists(), kH).missed_pairs, 0u) << step;
+    ASSERT_EQ(auditor.audit_boundary(ps.position, samples, v.boundary_lists(), kSupport).missed_pairs, 0u) << step;
   }
 }
 
@@ -156,7 +154,7 @@ TEST(BoundaryLists, VerletNeverMissesWhileParticlesMoveWithinTheSkin) {
 TEST(BoundaryLists, TrackedNeverMissesWhileParticlesMoveAndTheSkinChanges) {
   const auto samples = wall_samples<double>();
   auto ps = random_particles<double>(2000, 0.0, 1.0, 14);
-  TrackedNeighbors<3, double> t(kH, 0, 10, 0.1, false);  // automatic skin, full rebuild every 10
+  TrackedNeighbors<3, double> t(kSupport, 0, 10, 0.1, false);  // automatic skin, full rebuild every 10
   t.set_boundary(samples);
   ListAuditor<3, double> auditor;
   std::mt19937 rng(6);
@@ -170,7 +168,7 @@ TEST(BoundaryLists, TrackedNeverMissesWhileParticlesMoveAndTheSkinChanges) {
     }
     t.update(ps);
     skins.insert(t.skin());
-    ASSERT_EQ(auditor.audit_boundary(ps.position, samples, t.boundary_lists(), kH).missed_pairs, 0u) << step;
+    ASSERT_EQ(auditor.audit_boundary(ps.position, samples, t.boundary_lists(), kSupport).missed_pairs, 0u) << step;
     ASSERT_EQ(t.boundary_lists().particle_count(), ps.size());
   }
   EXPECT_GE(skins.size(), 3u) << "the skin was chosen again at the full rebuilds";
@@ -179,7 +177,7 @@ TEST(BoundaryLists, TrackedNeverMissesWhileParticlesMoveAndTheSkinChanges) {
 TEST(BoundaryLists, AdaptiveRebuildsAFlaggedParticlesBoundaryListAndTheAuditSeesTheRest) {
   const auto samples = wall_samples<double>();
   auto ps = random_particles<double>(2000, 0.0, 1.0, 13);
-  AdaptiveNeighbors<3, double> a(kH, 200);
+  AdaptiveNeighbors<3, double> a(kSupport, 200);
   a.set_boundary(samples);
   a.update(ps);
   const NeighborLists before = a.boundary_lists();
@@ -188,7 +186,7 @@ TEST(BoundaryLists, AdaptiveRebuildsAFlaggedParticlesBoundaryListAndTheAuditSees
   for (auto& x : ps.position) x[0] -= 0.03;
   a.update(ps);
   EXPECT_EQ(a.boundary_lists(), before);
-  const NeighborLists exact = brute_force_query_lists<3, double>(ps.position, samples, kH);
+  const NeighborLists exact = brute_force_query_lists<3, double>(ps.position, samples, kSupport);
   std::uint64_t missing = 0;
   for (std::size_t i = 0; i < ps.size(); ++i) {
     const auto have = sorted(before.of(i));
@@ -196,7 +194,7 @@ TEST(BoundaryLists, AdaptiveRebuildsAFlaggedParticlesBoundaryListAndTheAuditSees
   }
   EXPECT_GT(missing, 0u);
   ListAuditor<3, double> auditor;
-  EXPECT_EQ(auditor.audit_boundary(ps.position, samples, a.boundary_lists(), kH).missed_pairs, missing);
+  EXPECT_EQ(auditor.audit_boundary(ps.position, samples, a.boundary_lists(), kSupport).missed_pairs, missing);
   // Flag particle 5 and 1500: their boundary lists become exact, the others stay as they were.
   a.pair_exit_flags()[5] = 1;
   a.pair_exit_flags()[1500] = 1;

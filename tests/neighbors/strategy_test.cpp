@@ -15,6 +15,7 @@
 #include <sph/neighbors/strategy.h>
 #include <sph/neighbors/verlet.h>
 
+#include "support/lists.h"
 #include "support/thread_count.h"
 
 namespace sph {
@@ -22,11 +23,7 @@ namespace {
 
 using V3 = Vec<3, double>;
 
-std::vector<std::uint32_t> sorted(std::span<const std::uint32_t> s) {
-  std::vector<std::uint32_t> v(s.begin(), s.end());
-  std::sort(v.begin(), v.end());
-  return v;
-}
+using test::sorted;
 
 ParticleSet<3, double> random_particles(std::size_t n, double extent, unsigned seed) {
   std::mt19937 rng(seed);
@@ -45,7 +42,7 @@ void jitter(ParticleSet<3, double>& ps, double amount, unsigned seed) {
 
 using test::ThreadCount;
 
-constexpr double kH = 0.1;
+constexpr double kRadius = 0.1;
 
 // NeighborStrategy::scratch_until_update: memory the solver may overwrite between updates (the
 // force pass's copy of 1 / rho and p). Every strategy with a grid but verlet_clusters lends its grid's; the
@@ -55,7 +52,7 @@ TEST(NeighborStrategy, LentScratchIsNotReadByTheNextUpdates) {
   for (NeighborMode mode : neighbor_modes(NeighborModeSet::All)) {
     SCOPED_TRACE(to_string(mode));
     NeighborOptions opt;
-    opt.radius = kH;
+    opt.radius = kRadius;
     opt.full_rebuild_period = 3;
     opt.time_step = 1e-3;
     const auto lent = make_neighbor_strategy<3, double>(mode, opt);
@@ -80,16 +77,16 @@ TEST(NeighborStrategy, LentScratchIsNotReadByTheNextUpdates) {
         std::uint8_t* bytes = scratch->place<std::uint8_t>(0, scratch->capacity());
         std::fill_n(bytes, scratch->capacity(), std::uint8_t{0xff});
       }
-      jitter(ps, 0.03 * kH, 100 + static_cast<unsigned>(step));
+      jitter(ps, 0.03 * kRadius, 100 + static_cast<unsigned>(step));
     }
   }
 }
 
 TEST(Adaptive, FirstUpdateBuildsEveryListExactly) {
   auto ps = random_particles(3000, 1.0, 1);
-  AdaptiveNeighbors<3, double> a(kH, 200);
+  AdaptiveNeighbors<3, double> a(kRadius, 200);
   a.update(ps);
-  const NeighborLists bf = brute_force_lists<3, double>(ps.position, kH);
+  const NeighborLists bf = brute_force_lists<3, double>(ps.position, kRadius);
   EXPECT_EQ(a.counters().lists_rebuilt, ps.size());
   ASSERT_EQ(a.lists().entry_count(), bf.entry_count());
   for (std::size_t i = 0; i < ps.size(); ++i) ASSERT_EQ(sorted(a.lists().of(i)), sorted(bf.of(i)));
@@ -99,7 +96,7 @@ TEST(Adaptive, FirstUpdateBuildsEveryListExactly) {
 
 TEST(Adaptive, RebuildsOnlyFlaggedListsAndKeepsTheOthers) {
   auto ps = random_particles(3000, 1.0, 2);
-  AdaptiveNeighbors<3, double> a(kH, 200);
+  AdaptiveNeighbors<3, double> a(kRadius, 200);
   a.update(ps);
   const NeighborLists before = a.lists();
 
@@ -114,7 +111,7 @@ TEST(Adaptive, RebuildsOnlyFlaggedListsAndKeepsTheOthers) {
   for (std::size_t i : flagged) a.pair_exit_flags()[i] = 1;
   a.update(ps);
   EXPECT_EQ(a.counters().lists_rebuilt, flagged.size());
-  const NeighborLists now = brute_force_lists<3, double>(ps.position, kH);
+  const NeighborLists now = brute_force_lists<3, double>(ps.position, kRadius);
   std::size_t changed = 0;
   for (std::size_t i = 0; i < ps.size(); ++i) {
     const bool is_flagged = std::find(flagged.begin(), flagged.end(), i) != flagged.end();
@@ -132,20 +129,20 @@ TEST(Adaptive, RebuildsOnlyFlaggedListsAndKeepsTheOthers) {
 
 TEST(Adaptive, AppendedParticlesGetListsAndFullRebuildComesOnSchedule) {
   auto ps = random_particles(500, 0.5, 4);
-  AdaptiveNeighbors<3, double> a(kH, 3);
+  AdaptiveNeighbors<3, double> a(kRadius, 3);
   a.update(ps);  // update 0: full
   for (int k = 0; k < 20; ++k) ps.add(V3{0.25 + 0.001 * k, 0.25, 0.25}, V3{});
   a.update(ps);  // update 1: only the 20 new particles
   EXPECT_EQ(a.counters().lists_rebuilt, 20u);
   ASSERT_EQ(a.lists().particle_count(), ps.size());
-  const NeighborLists bf = brute_force_lists<3, double>(ps.position, kH);
+  const NeighborLists bf = brute_force_lists<3, double>(ps.position, kRadius);
   for (std::size_t i = 500; i < ps.size(); ++i) EXPECT_EQ(sorted(a.lists().of(i)), sorted(bf.of(i)));
   a.update(ps);  // update 2: nothing flagged
   EXPECT_EQ(a.counters().lists_rebuilt, 0u);
   jitter(ps, 0.01, 5);
   a.update(ps);  // update 3: the period's full rebuild
   EXPECT_EQ(a.counters().lists_rebuilt, ps.size());
-  const NeighborLists bf2 = brute_force_lists<3, double>(ps.position, kH);
+  const NeighborLists bf2 = brute_force_lists<3, double>(ps.position, kRadius);
   for (std::size_t i = 0; i < ps.size(); ++i) ASSERT_EQ(sorted(a.lists().of(i)), sorted(bf2.of(i)));
 }
 
@@ -155,7 +152,7 @@ TEST(Adaptive, PartialRebuildIsIdenticalForAnyThreadCount) {
   for (int t : {1, 2}) {
     set_num_threads(t);
     auto ps = random_particles(5000, 1.0, 6);
-    AdaptiveNeighbors<3, double> a(kH, 200);
+    AdaptiveNeighbors<3, double> a(kRadius, 200);
     a.update(ps);
     jitter(ps, 0.02, 7);
     for (std::size_t i = 0; i < ps.size(); i += 7) a.pair_exit_flags()[i] = 1;
@@ -168,12 +165,12 @@ TEST(Adaptive, PartialRebuildIsIdenticalForAnyThreadCount) {
 TEST(Verlet, NeverMissesAPairWithinHAndRebuildsAtHalfTheSkin) {
   auto ps = random_particles(2000, 1.0, 8);
   const double skin = 0.02;
-  VerletNeighbors<3, double> v(kH, skin);
+  VerletNeighbors<3, double> v(kRadius, skin);
   ListAuditor<3, double> auditor;
   v.update(ps);
   EXPECT_EQ(v.counters().lists_rebuilt, ps.size());
   // Lists hold exactly the pairs within h + skin.
-  const NeighborLists wide = brute_force_lists<3, double>(ps.position, kH + skin);
+  const NeighborLists wide = brute_force_lists<3, double>(ps.position, kRadius + skin);
   for (std::size_t i = 0; i < ps.size(); ++i) ASSERT_EQ(sorted(v.lists().of(i)), sorted(wide.of(i)));
 
   // Random small moves: rebuilds happen only after someone moved skin / 2, and nothing within
@@ -195,7 +192,7 @@ TEST(Verlet, NeverMissesAPairWithinHAndRebuildsAtHalfTheSkin) {
       ++reuses;
       EXPECT_LE(max_move, 0.5 * skin);
     }
-    const ListAudit audit = auditor.audit(ps.position, v.lists(), kH);
+    const ListAudit audit = auditor.audit(ps.position, v.lists(), kRadius);
     ASSERT_EQ(audit.missed_pairs, 0u) << "step " << step;
   }
   EXPECT_GT(rebuilds, 0);
@@ -204,7 +201,7 @@ TEST(Verlet, NeverMissesAPairWithinHAndRebuildsAtHalfTheSkin) {
 
 TEST(Verlet, RebuildsWhenParticlesAreAdded) {
   auto ps = random_particles(300, 0.5, 10);
-  VerletNeighbors<3, double> v(kH, 0.02);
+  VerletNeighbors<3, double> v(kRadius, 0.02);
   v.update(ps);
   v.update(ps);
   EXPECT_EQ(v.counters().lists_rebuilt, 0u);
@@ -222,12 +219,12 @@ TEST(Audit, CountsMissedPairsAndTheirPenetration) {
   ps.add(V3{0, 0.08, 0}, V3{});  // 0.8 h from particle 0
   ps.add(V3{1, 1, 1}, V3{});     // alone
   ListAuditor<3, double> auditor;
-  const NeighborLists exact = brute_force_lists<3, double>(ps.position, kH);
-  EXPECT_EQ(auditor.audit(ps.position, exact, kH).missed_pairs, 0u);
+  const NeighborLists exact = brute_force_lists<3, double>(ps.position, kRadius);
+  EXPECT_EQ(auditor.audit(ps.position, exact, kRadius).missed_pairs, 0u);
 
   // Particle 0 lists only particle 2; particle 1 lists nothing; particle 2 lists 0.
   const NeighborLists lists = NeighborLists::from({{2}, {}, {0}, {}});
-  const ListAudit a = auditor.audit(ps.position, lists, kH);
+  const ListAudit a = auditor.audit(ps.position, lists, kRadius);
   // Missed: 0->1 and 1->0 (r = 0.3 h, penetration 0.7), 2->1? |(0,0.08)-(0.03,0)| = 0.0854 < h: 2->1 and 1->2.
   EXPECT_EQ(a.missed_pairs, 4u);
   EXPECT_EQ(a.particles_missing, 3u);
@@ -241,13 +238,13 @@ TEST(Audit, FindsWhatAdaptiveListsMissWhenParticlesApproach) {
   ps.mass = 1.0;
   ps.add(V3{0, 0, 0}, V3{});
   ps.add(V3{0.15, 0, 0}, V3{});
-  AdaptiveNeighbors<3, double> a(kH, 200);
+  AdaptiveNeighbors<3, double> a(kRadius, 200);
   ListAuditor<3, double> auditor;
   a.update(ps);
   EXPECT_EQ(a.lists().entry_count(), 0u);
   ps.position[1][0] = 0.05;
   a.update(ps);
-  const ListAudit audit = auditor.audit(ps.position, a.lists(), kH);
+  const ListAudit audit = auditor.audit(ps.position, a.lists(), kRadius);
   EXPECT_EQ(audit.missed_pairs, 2u);
   EXPECT_NEAR(audit.max_penetration, 0.5, 1e-12);
 }

@@ -10,8 +10,12 @@
 #include <sph/core/parallel.h>
 #include <sph/neighbors/standard.h>
 
+#include "support/lists.h"
+
 namespace sph {
 namespace {
+
+using test::sorted;
 
 template <class T>
 struct Variant;
@@ -27,12 +31,6 @@ class GridLists : public ::testing::Test {
   static constexpr int D = Variant<P>::D;
   using R = typename Variant<P>::R;
   using V = Vec<D, R>;
-
-  static std::vector<std::uint32_t> sorted(std::span<const std::uint32_t> s) {
-    std::vector<std::uint32_t> v(s.begin(), s.end());
-    std::sort(v.begin(), v.end());
-    return v;
-  }
 
   void expect_equal_to_brute_force(const std::vector<V>& x, R radius) {
     ParticleSet<D, R> ps;

@@ -7,12 +7,14 @@
 
 #include <sph/render/compose.h>
 
+#include "support/colors.h"
+
 namespace sph {
 namespace {
 
-constexpr Rgb kWhite{255, 255, 255};
-constexpr Rgb kRed{255, 0, 0};
-constexpr Rgb kBlue{0, 0, 255};
+using test::kBlue;
+using test::kRed;
+using test::kWhite;
 
 TEST(Hstack, PlacesPanelsSideBySideUnderTheirCaptions) {
   const std::vector<Image> panels = {Image(40, 30, kRed), Image(50, 20, kBlue)};

@@ -7,12 +7,14 @@
 
 #include <sph/render/image.h>
 
+#include "support/colors.h"
+
 namespace sph {
 namespace {
 
-constexpr Rgb kWhite{255, 255, 255};
-constexpr Rgb kRed{255, 0, 0};
-constexpr Rgb kBlue{0, 0, 255};
+using test::kBlue;
+using test::kRed;
+using test::kWhite;
 
 int count_color(const Image& img, Rgb c) {
   int n = 0;

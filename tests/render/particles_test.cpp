@@ -15,12 +15,15 @@
 #include <sph/core/error.h>
 #include <sph/render/particles.h>
 
+#include "support/colors.h"
+
 namespace sph {
 namespace {
 
-constexpr Rgb kWhite{255, 255, 255};
-constexpr Rgb kRed{255, 0, 0};
-constexpr Rgb kBlue{0, 0, 255};
+using test::kBlue;
+using test::kRed;
+using test::kWhite;
+
 using A3 = std::array<double, 3>;
 
 ParticleView flat_view(int w = 400, int h = 300) {
@@ -33,14 +36,14 @@ ParticleView flat_view(int w = 400, int h = 300) {
 
 bool is_gray(Rgb c) { return c.r == c.g && c.g == c.b; }
 
-struct Box {
+struct PixelBox {
   int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;
 };
 
 /// Bounding box of the pixels for which pred(pixel) holds.
 template <typename Pred>
-Box bbox(const Image& img, Pred pred) {
-  Box b;
+PixelBox bbox(const Image& img, Pred pred) {
+  PixelBox b;
   for (int y = 0; y < img.height(); ++y)
     for (int x = 0; x < img.width(); ++x)
       if (pred(img.at(x, y))) {
@@ -59,7 +62,7 @@ TEST(Particles, ParticleAtTheBoxCenterColorsTheImageCenter2D) {
   EXPECT_EQ(img.at(200, 150), kRed);
   EXPECT_EQ(img.at(199, 149), kRed);
   // Red only around the center: radius 0.05 of a ~0.92 * 300 px tall box is ~14 px.
-  const Box b = bbox(img, [](Rgb c) { return c == kRed; });
+  const PixelBox b = bbox(img, [](Rgb c) { return c == kRed; });
   EXPECT_GE(b.x0, 200 - 16);
   EXPECT_LE(b.x1, 200 + 16);
   EXPECT_GE(b.y0, 150 - 16);
@@ -81,7 +84,7 @@ TEST(Particles, CornerParticleColorsThatCorner2D) {
   const std::vector<double> xyz = {0.05, 0.05};  // bottom left (y is up)
   const std::vector<Rgb> colors = {kRed};
   const Image img = render_particles(xyz, 2, colors, 0.05, A3{0, 0, 0}, A3{1, 1, 0}, flat_view());
-  const Box b = bbox(img, [](Rgb c) { return c == kRed; });
+  const PixelBox b = bbox(img, [](Rgb c) { return c == kRed; });
   ASSERT_GE(b.x1, 0);
   // The box spans ~276 px square centered at (200, 150): its bottom-left corner is near (62, 288).
   EXPECT_LT(b.x1, 200 - 100);
@@ -100,8 +103,8 @@ TEST(Particles, NearestCornerOfA3DBoxAppearsUpperRightFromTheDefaultCamera) {
     v.shaded = false;
     return v;
   }());
-  const Box red = bbox(img, [](Rgb c) { return c == kRed; });
-  const Box blue = bbox(img, [](Rgb c) { return c == kBlue; });
+  const PixelBox red = bbox(img, [](Rgb c) { return c == kRed; });
+  const PixelBox blue = bbox(img, [](Rgb c) { return c == kBlue; });
   ASSERT_GE(red.x1, 0);
   ASSERT_GE(blue.x1, 0);
   EXPECT_GT(red.x0, 200);
@@ -125,7 +128,7 @@ TEST(Particles, NothingIsDrawnOutsideTheBoxProjection) {
   const Image img = render_particles(xyz, 2, colors, r, A3{0, 0, 0}, A3{2, 1, 0}, view);
   const ParticleCamera cam(2, A3{0, 0, 0}, A3{2, 1, 0}, r, view);
   const A3 lo = cam.project(A3{0, 0, 0}), hi = cam.project(A3{2, 1, 0});
-  const Box ink = bbox(img, [](Rgb c) { return c != kWhite; });
+  const PixelBox ink = bbox(img, [](Rgb c) { return c != kWhite; });
   EXPECT_GE(ink.x0, std::floor(lo[0]) - 1);
   EXPECT_LE(ink.x1, std::ceil(hi[0]) + 1);
   EXPECT_GE(ink.y0, std::floor(hi[1]) - 1);  // y is up: the top of the box is hi
@@ -186,7 +189,7 @@ TEST(Particles, BoxEdgesIn3DIncludeTheSilhouette) {
     xmin = std::min(xmin, p[0]);
     xmax = std::max(xmax, p[0]);
   }
-  const Box ink = bbox(img, [](Rgb c) { return c != kWhite; });
+  const PixelBox ink = bbox(img, [](Rgb c) { return c != kWhite; });
   EXPECT_NEAR(ink.x0, xmin, 2.0);
   EXPECT_NEAR(ink.x1, xmax, 2.0);
   // The view is fitted: here the projected cube is taller than wide for the 4:3 image, so it fills
@@ -257,7 +260,7 @@ TEST(ParticlesSolids, A2DPolygonPastTheContainerIsCutAtTheWall) {
   const auto inside = pixel_of(cam, A3{0.9, 0.1, 0});
   EXPECT_EQ(img.at(inside[0], inside[1]), kSolidColor);
   const int wall = static_cast<int>(std::floor(cam.project(A3{1.0, 0.1, 0})[0]));
-  const Box solid = bbox(img, [](Rgb c) { return c == kSolidColor; });
+  const PixelBox solid = bbox(img, [](Rgb c) { return c == kSolidColor; });
   EXPECT_LE(solid.x1, wall) << "no fill past the right wall";
   const auto past = pixel_of(cam, A3{1.2, 0.1, 0});
   if (past[0] < img.width()) {
@@ -291,7 +294,7 @@ TEST(ParticlesSolids, A2DObstacleIsAFilledRectangleWithADarkerOutlineOverThePart
   EXPECT_EQ(img.at(right, center[1]), kSolidEdgeColor);
   EXPECT_EQ(img.at(right + 1, center[1]), kWhite);
   // Its pixels are exactly those whose centers lie in the projected rectangle (outline included).
-  const Box solid = bbox(img, [](Rgb c) { return c == kSolidColor || c == kSolidEdgeColor; });
+  const PixelBox solid = bbox(img, [](Rgb c) { return c == kSolidColor || c == kSolidEdgeColor; });
   EXPECT_EQ(solid.x0, left);
   EXPECT_EQ(solid.x1, right);
   EXPECT_EQ(solid.y0, static_cast<int>(std::ceil(cam.project(A3{0.5, 0.3, 0})[1] - 0.5)));
@@ -369,7 +372,7 @@ TEST(ParticlesSolids, A3DObstacleHidesTheParticlesBehindItAndNotThoseInFront) {
   const std::vector<double> peeking = {0.35, 0, -0.7};
   const std::vector<Rgb> red = {kRed};
   const Image img = render_particles(peeking, 3, red, 0.1, lo, hi, view, solids);
-  const Box seen = bbox(img, [](Rgb c) { return c == kRed; });
+  const PixelBox seen = bbox(img, [](Rgb c) { return c == kRed; });
   ASSERT_GE(seen.x1, 0);
   EXPECT_GE(seen.x0, cam.project(A3{0.3, 0, 0})[0] - 0.5);
   EXPECT_GT(seen.x1, cam.project(A3{0.4, 0, 0})[0]);

@@ -13,8 +13,8 @@
 namespace sph {
 namespace {
 
-constexpr Rgb kRed{230, 20, 20};
-constexpr Rgb kGreen{20, 170, 40};
+constexpr Rgb kLineRed{230, 20, 20};
+constexpr Rgb kLineGreen{20, 170, 40};
 constexpr Rgb kMuted{140, 140, 140};  // the "no data" text
 const double kNan = std::numeric_limits<double>::quiet_NaN();
 
@@ -86,20 +86,20 @@ TEST(Plot, RisingLineRisesAndTheLegendShowsItsColor) {
     x.push_back(i * 0.1);
     y.push_back(i * 0.1);
   }
-  spec.series.push_back(line(x, y, kRed));
+  spec.series.push_back(line(x, y, kLineRed));
   const Image img = render_plot(spec, 900, 560);
   EXPECT_EQ(img.width(), 900);
   EXPECT_EQ(img.height(), 560);
-  EXPECT_GT(count(img, kRed), 500);
+  EXPECT_GT(count(img, kLineRed), 500);
   // The legend sample is a horizontal run of the series color; the diagonal line has none so long.
-  const HRun legend = longest_run(img, kRed);
+  const HRun legend = longest_run(img, kLineRed);
   EXPECT_GE(legend.length, 20);
   // The line: lower on the left, higher on the right, and straight.
-  const std::vector<int> cols = columns_with(img, kRed, legend);
+  const std::vector<int> cols = columns_with(img, kLineRed, legend);
   ASSERT_GT(cols.size(), 600u);
   const int a = cols[cols.size() / 5], b = cols[cols.size() / 2], c = cols[cols.size() * 4 / 5];
-  const double ya = mean_row(img, kRed, a, legend), yb = mean_row(img, kRed, b, legend),
-               yc = mean_row(img, kRed, c, legend);
+  const double ya = mean_row(img, kLineRed, a, legend), yb = mean_row(img, kLineRed, b, legend),
+               yc = mean_row(img, kLineRed, c, legend);
   EXPECT_GT(ya, yb + 50);  // image rows grow downwards
   EXPECT_GT(yb, yc + 50);
   EXPECT_NEAR(yb, ya + (b - a) * (yc - ya) / (c - a), 3.0);
@@ -107,14 +107,14 @@ TEST(Plot, RisingLineRisesAndTheLegendShowsItsColor) {
 
 TEST(Plot, LegendHasOneSamplePerSeriesAndDashedSamplesHaveGaps) {
   PlotSpec spec;
-  spec.series.push_back(line({0, 1, 2}, {0, 1, 0}, kRed, "solid"));
-  Series dashed = line({0, 1, 2}, {1, 0, 1}, kGreen, "dashed");
+  spec.series.push_back(line({0, 1, 2}, {0, 1, 0}, kLineRed, "solid"));
+  Series dashed = line({0, 1, 2}, {1, 0, 1}, kLineGreen, "dashed");
   dashed.dashed = true;
   spec.series.push_back(dashed);
   const Image img = render_plot(spec);
-  EXPECT_GE(longest_run(img, kRed).length, 20);
-  EXPECT_GT(count(img, kGreen), 100);
-  EXPECT_LT(longest_run(img, kGreen).length, 15);  // dashes, not a solid sample
+  EXPECT_GE(longest_run(img, kLineRed).length, 20);
+  EXPECT_GT(count(img, kLineGreen), 100);
+  EXPECT_LT(longest_run(img, kLineGreen).length, 15);  // dashes, not a solid sample
 }
 
 TEST(Plot, NanBreaksTheLine) {
@@ -124,11 +124,11 @@ TEST(Plot, NanBreaksTheLine) {
     x.push_back(i);
     y.push_back(i >= 40 && i <= 60 ? kNan : 50.0 + 0.2 * i);  // a gap over the middle fifth
   }
-  spec.series.push_back(line(x, y, kRed, ""));
+  spec.series.push_back(line(x, y, kLineRed, ""));
   const Image img = render_plot(spec);
-  const HRun legend = longest_run(img, kRed);
+  const HRun legend = longest_run(img, kLineRed);
   ASSERT_GE(legend.length, 20);
-  const std::vector<int> cols = columns_with(img, kRed, legend);
+  const std::vector<int> cols = columns_with(img, kLineRed, legend);
   ASSERT_FALSE(cols.empty());
   // The data spans x = 0..100 and the axis too: the line covers the plot width but for the gap.
   const int first = cols.front(), last = cols.back(), span = last - first;
@@ -158,14 +158,14 @@ TEST(Plot, LogAxisStraightensAnExponential) {
   y.push_back(-1.0);
   PlotSpec spec;
   spec.log_y = true;
-  spec.series.push_back(line(x, y, kRed));
+  spec.series.push_back(line(x, y, kLineRed));
   // Deviation from a straight line through the pixels at 50% and 90% of the drawn columns, at 70%
   // (the legend sits top left, away from these columns).
   auto straightness = [&](const Image& img) {
-    const std::vector<int> cols = columns_with(img, kRed, longest_run(img, kRed));
+    const std::vector<int> cols = columns_with(img, kLineRed, longest_run(img, kLineRed));
     const int first = cols.front(), span = cols.back() - cols.front();
     const int a = first + span / 2, b = first + span * 7 / 10, c = first + span * 9 / 10;
-    const double ya = mean_row(img, kRed, a), yb = mean_row(img, kRed, b), yc = mean_row(img, kRed, c);
+    const double ya = mean_row(img, kLineRed, a), yb = mean_row(img, kLineRed, b), yc = mean_row(img, kLineRed, c);
     return std::abs(yb - (ya + (b - a) * (yc - ya) / (c - a)));
   };
   const Image log_img = render_plot(spec);
@@ -177,12 +177,12 @@ TEST(Plot, LogAxisStraightensAnExponential) {
 TEST(Plot, NoDataSaysSo) {
   PlotSpec empty_series;
   empty_series.title = "nothing";
-  empty_series.series.push_back(line({}, {}, kRed, "empty"));
+  empty_series.series.push_back(line({}, {}, kLineRed, "empty"));
   PlotSpec all_nan;
-  all_nan.series.push_back(line({kNan, 1, kNan}, {1, kNan, kNan}, kRed, "nan"));
+  all_nan.series.push_back(line({kNan, 1, kNan}, {1, kNan, kNan}, kLineRed, "nan"));
   PlotSpec log_nonpositive;
   log_nonpositive.log_y = true;
-  log_nonpositive.series.push_back(line({1, 2}, {0, -5}, kRed, "nonpositive"));
+  log_nonpositive.series.push_back(line({1, 2}, {0, -5}, kLineRed, "nonpositive"));
   PlotSpec no_series;
   for (const PlotSpec* spec : {&empty_series, &all_nan, &log_nonpositive, &no_series}) {
     const Image img = render_plot(*spec);
@@ -194,18 +194,18 @@ TEST(Plot, NoDataSaysSo) {
   }
   // With data, no "no data" text.
   PlotSpec some;
-  some.series.push_back(line({0, 1}, {0, 1}, kRed));
+  some.series.push_back(line({0, 1}, {0, 1}, kLineRed));
   EXPECT_EQ(count(render_plot(some), kMuted), 0);
 }
 
 TEST(Plot, SinglePointsAndConstantDataAreVisible) {
   PlotSpec spec;
-  spec.series.push_back(line({3.0}, {7.0}, kRed, "one point"));
-  spec.series.push_back(line({0, 1, 2, 3}, {7, 7, 7, 7}, kGreen, "flat"));
+  spec.series.push_back(line({3.0}, {7.0}, kLineRed, "one point"));
+  spec.series.push_back(line({0, 1, 2, 3}, {7, 7, 7, 7}, kLineGreen, "flat"));
   const Image img = render_plot(spec);
-  EXPECT_GT(count(img, kRed), 10);                  // the dot plus the legend's dot
-  EXPECT_LT(longest_run(img, kRed).length, 8);      // a dot in the legend too, as the plot draws it
-  EXPECT_GT(longest_run(img, kGreen).length, 100);  // the flat line
+  EXPECT_GT(count(img, kLineRed), 10);                  // the dot plus the legend's dot
+  EXPECT_LT(longest_run(img, kLineRed).length, 8);      // a dot in the legend too, as the plot draws it
+  EXPECT_GT(longest_run(img, kLineGreen).length, 100);  // the flat line
 }
 
 TEST(Plot, HugeAndTinyValuesAndManySeriesDoNotBreakTheLayout) {
@@ -223,15 +223,15 @@ TEST(Plot, HugeAndTinyValuesAndManySeriesDoNotBreakTheLayout) {
   EXPECT_NO_THROW(render_plot(spec, 160, 120));
   // Nearly constant data far from zero, and a range too wide for a double: no hang, no crash.
   PlotSpec odd;
-  odd.series.push_back(line({1e17, 1e17 + 16, 1e17 + 32}, {1, 2, 3}, kRed));
-  odd.series.push_back(line({0, 1}, {-1e308, 1e308}, kGreen));
+  odd.series.push_back(line({1e17, 1e17 + 16, 1e17 + 32}, {1, 2, 3}, kLineRed));
+  odd.series.push_back(line({0, 1}, {-1e308, 1e308}, kLineGreen));
   EXPECT_NO_THROW(render_plot(odd));
 }
 
 TEST(Plot, BadArgumentsThrow) {
   PlotSpec spec;
   EXPECT_THROW(render_plot(spec, 10, 10), Error);
-  spec.series.push_back(line({1, 2, 3}, {1, 2}, kRed, "mismatched"));
+  spec.series.push_back(line({1, 2, 3}, {1, 2}, kLineRed, "mismatched"));
   try {
     render_plot(spec);
     FAIL() << "expected sph::Error";

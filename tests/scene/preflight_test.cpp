@@ -21,8 +21,12 @@
 #include <sph/solver/wcsph.h>
 
 #include "support/expect.h"
+#include "support/scene_text.h"
 
 namespace {
+
+using sph::test::error_of;
+using sph::test::parse;
 
 using json = nlohmann::json;
 namespace fs = std::filesystem;
@@ -60,25 +64,6 @@ json emitter_scene_3d() {
     "Emitters": [ { "translation": [0.05, 0.4, 0.3], "direction": [1, 0, 0], "velocity": 4.5, "width": 6,
                     "height": 6, "maxParticles": 72 } ]
   })");
-}
-
-sph::SceneDesc parse(const json& j, const std::vector<std::string>& overrides = {}) {
-  return sph::parse_scene(j.dump(2), "test.json", overrides);
-}
-
-/// The what() of the sph::Error that reading `j` throws; a test failure if it throws nothing
-/// or another exception type.
-std::string error_of(const json& j) {
-  try {
-    parse(j);
-  } catch (const sph::Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "threw a " << typeid(e).name() << " instead of sph::Error: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "no error for scene:\n" << j.dump(2);
-  return {};
 }
 
 /// The scene's warnings, joined one per line ("" if none); a test failure if it is refused.

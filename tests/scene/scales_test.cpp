@@ -14,8 +14,12 @@
 #include <sph/solver/time_step.h>
 
 #include "support/expect.h"
+#include "support/scene_text.h"
 
 namespace {
+
+using sph::test::error_of;
+using sph::test::parse;
 
 using json = nlohmann::json;
 
@@ -25,20 +29,6 @@ json tank_2d() {
     "Configuration": { "numberOfSteps": 10, "particleRadius": 0.01 },
     "Container": { "start": [0, 0], "end": [1, 1] },
     "FluidBlocks": [ { "start": [0, 0], "end": [0.2, 0.2] } ] })");
-}
-
-sph::SceneDesc parse(const json& j, const std::vector<std::string>& overrides = {}) {
-  return sph::parse_scene(j.dump(), "scales.json", overrides);
-}
-
-std::string error_of(const json& j) {
-  try {
-    parse(j);
-  } catch (const sph::Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no error for " << j.dump();
-  return {};
 }
 
 TEST(SceneScales, TankAtRest2d) {
@@ -230,7 +220,7 @@ TEST(SceneDefaults, TheEffectiveSceneGivesTheComputedValuesAndReadsBackEqual) {
   EXPECT_EQ(w["Fluid"]["viscosity"], sim.fluid.viscosity);
   EXPECT_EQ(w["Container"]["wallStiffness"], sim.walls.stiffness);
   EXPECT_EQ(w["Container"]["wallDamping"], sim.walls.damping);
-  const sph::SceneDesc again = sph::parse_scene(w.dump(), "scales.json");
+  const sph::SceneDesc again = parse(w);
   EXPECT_TRUE(again == d);
   EXPECT_EQ(d.steps, static_cast<std::int64_t>(std::ceil(0.05 / sim.time_step)));
 }

@@ -16,8 +16,12 @@
 #include <sph/scene/scene_writer.h>
 
 #include "support/expect.h"
+#include "support/scene_text.h"
 
 namespace {
+
+using sph::test::error_of;
+using sph::test::parse;
 
 using json = nlohmann::json;
 
@@ -41,28 +45,6 @@ json valid_emitter_scene() {
   j["Emitters"] = json::parse(
       R"([ { "translation": [0.05, 0.5], "direction": [1, 0], "velocity": 20.0, "width": 4, "maxParticles": 100 } ])");
   return j;
-}
-
-sph::SceneDesc parse(const json& j, const std::vector<std::string>& overrides = {}) {
-  return sph::parse_scene(j.dump(2), "test.json", overrides);
-}
-
-/// The what() of the sph::Error that parsing `text` throws; a test failure if it throws
-/// nothing or another exception type.
-std::string error_of(const std::string& text, const std::vector<std::string>& overrides = {}) {
-  try {
-    sph::parse_scene(text, "test.json", overrides);
-  } catch (const sph::Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "threw a " << typeid(e).name() << " instead of sph::Error: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "no error for scene:\n" << text;
-  return {};
-}
-std::string error_of(const json& j, const std::vector<std::string>& overrides = {}) {
-  return error_of(j.dump(2), overrides);
 }
 
 // ---------------------------------------------------------------------------------------------

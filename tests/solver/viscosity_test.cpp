@@ -25,15 +25,15 @@ namespace {
 
 using test::ThreadCount;
 
-constexpr double kSpacing = 0.01;
-constexpr double kH = 0.02;
+constexpr double kDx = 0.01;
+constexpr double kSupport = 0.02;
 
 /// A jittered lattice block of side n particles, with a sheared, swirling velocity field and some
 /// other acceleration already in ps.acceleration (the step's gravity and pressure, say).
 template <int D>
 ParticleSet<D, double> sheared_block(int n, unsigned seed) {
   std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> jitter(-0.2 * kSpacing, 0.2 * kSpacing), noise(-0.3, 0.3);
+  std::uniform_real_distribution<double> jitter(-0.2 * kDx, 0.2 * kDx), noise(-0.3, 0.3);
   ParticleSet<D, double> ps;
   ps.mass = 0.1;
   const int total = D == 2 ? n * n : n * n * n;
@@ -41,7 +41,7 @@ ParticleSet<D, double> sheared_block(int n, unsigned seed) {
     Vec<D, double> x, v;
     int rest = k;
     for (int d = 0; d < D; ++d) {
-      x[d] = (rest % n + 0.5) * kSpacing + jitter(rng);
+      x[d] = (rest % n + 0.5) * kDx + jitter(rng);
       rest /= n;
     }
     v[0] = std::sin(x[1] * 40.0) + noise(rng);
@@ -58,8 +58,8 @@ ParticleSet<D, double> sheared_block(int n, unsigned seed) {
 
 /// Every pair closer than 1.2 h, both ways (lists hold some pairs beyond h, as verlet's do).
 template <int D>
-NeighborLists all_pairs(const ParticleSet<D, double>& ps) {
-  return brute_force_lists<D, double>(ps.position, 1.2 * kH);
+NeighborLists pairs_of(const ParticleSet<D, double>& ps) {
+  return brute_force_lists<D, double>(ps.position, 1.2 * kSupport);
 }
 
 /// `tolerance`: the solve's, as a fraction of its starting residual.
@@ -84,7 +84,7 @@ std::vector<Vec<D, double>> explicit_viscosity(ParticleSet<D, double> ps, const 
   Vec<D, double> lo, hi;
   for (int d = 0; d < D; ++d) lo[d] = -100, hi[d] = 100;
   const WallContact<D, double> no_walls({lo, hi}, no_obstacles, 0.0, WallParams{});
-  compute_accelerations<D, double>(ps, lists, kH, fluid, Vec<D, double>{}, no_walls, {}, 0.0, {}, 0.0, false);
+  compute_accelerations<D, double>(ps, lists, kSupport, fluid, Vec<D, double>{}, no_walls, {}, 0.0, {}, 0.0, false);
   return ps.acceleration;
 }
 
@@ -92,13 +92,13 @@ template <int D>
 void check_backward_euler(KernelKind kernel) {
   SCOPED_TRACE(::testing::Message() << D << "D, kernel " << static_cast<int>(kernel));
   ParticleSet<D, double> ps = sheared_block<D>(D == 2 ? 12 : 6, 7);
-  const NeighborLists lists = all_pairs(ps);
+  const NeighborLists lists = pairs_of(ps);
   const double dt = 2e-3, mu = 20.0;  // 13x the explicit limit 0.125 h^2 rho0 / mu = 2.5e-4 s
   const FluidParams fluid = viscous(kernel, mu, 1e-12);
   std::vector<Vec<D, double>> v_star(ps.size());
   for (std::size_t i = 0; i < ps.size(); ++i) v_star[i] = ps.velocity[i] + ps.acceleration[i] * dt;
   ImplicitViscosity<D, double> solver;
-  const SolveStats stats = solver.solve(ps, lists, kH, fluid, dt);
+  const SolveStats stats = solver.solve(ps, lists, kSupport, fluid, dt);
   EXPECT_TRUE(stats.converged);
   EXPECT_GT(stats.iterations, 0);
   std::vector<Vec<D, double>> v(ps.size());
@@ -141,7 +141,7 @@ double kinetic(const ParticleSet<D, double>& ps, const std::vector<Vec<D, double
 TEST(ImplicitViscosity, DampsAtStepsWhereTheExplicitTermBlowsUp) {
   ParticleSet<2, double> ps = sheared_block<2>(14, 3);
   for (auto& a : ps.acceleration) a = {};
-  const NeighborLists lists = all_pairs(ps);
+  const NeighborLists lists = pairs_of(ps);
   const FluidParams fluid = viscous(KernelKind::Cubic, 20.0, 1e-6);
   const double dt = 2.5e-2;  // 100x the explicit limit
   const double before = kinetic(ps, ps.velocity);
@@ -157,7 +157,7 @@ TEST(ImplicitViscosity, DampsAtStepsWhereTheExplicitTermBlowsUp) {
   double last = before;
   for (int k = 0; k < 5; ++k) {
     for (auto& a : ps.acceleration) a = {};
-    solver.solve(ps, lists, kH, fluid, dt);
+    solver.solve(ps, lists, kSupport, fluid, dt);
     for (std::size_t i = 0; i < ps.size(); ++i) ps.velocity[i] += ps.acceleration[i] * dt;
     const double now = kinetic(ps, ps.velocity);
     EXPECT_LT(now, last);
@@ -169,7 +169,7 @@ TEST(ImplicitViscosity, DampsAtStepsWhereTheExplicitTermBlowsUp) {
 TEST(ImplicitViscosity, SameBitsForAnyThreadCount) {
   ThreadCount restore;
   const ParticleSet<3, double> start = sheared_block<3>(11, 5);  // 1,331 particles: two chunks
-  const NeighborLists lists = all_pairs(start);
+  const NeighborLists lists = pairs_of(start);
   const FluidParams fluid = viscous(KernelKind::Wendland, 20.0, 1e-8);
   std::vector<std::vector<Vec<3, double>>> results;
   std::vector<int> iterations;
@@ -177,7 +177,7 @@ TEST(ImplicitViscosity, SameBitsForAnyThreadCount) {
     set_num_threads(threads);
     ParticleSet<3, double> ps = start;
     ImplicitViscosity<3, double> solver;
-    iterations.push_back(solver.solve(ps, lists, kH, fluid, 2e-3).iterations);
+    iterations.push_back(solver.solve(ps, lists, kSupport, fluid, 2e-3).iterations);
     results.push_back(ps.acceleration);
   }
   EXPECT_GT(iterations[0], 2);

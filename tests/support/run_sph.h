@@ -10,6 +10,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,15 @@ struct CommandResult {
   std::string out;  ///< stdout
   std::string err;  ///< stderr
 };
+
+/// The lines of a program's stderr that are an error message ("sph: error: ...").
+inline std::vector<std::string> error_lines(const std::string& err) {
+  std::vector<std::string> out;
+  std::istringstream in(err);
+  for (std::string l; std::getline(in, l);)
+    if (l.rfind("sph: error:", 0) == 0) out.push_back(l);
+  return out;
+}
 
 /// Runs `env_prefix SPH_BINARY args...` in `cwd` (env_prefix, e.g. "env -u VAR", may be empty);
 /// stderr goes through `err_file`.

@@ -302,6 +302,22 @@ TEST(ViewerPage, Errors) {
   ViewOptions one;
   one.max_frames = 1;
   EXPECT_NE(message([&] { build_view_page(dam_run(), one); }).find("--max-frames"), std::string::npos);
+  // The --max-frames N suggested is the most that the limit lets through: N passes the estimate,
+  // N + 1 does not.
+  const ViewPage whole = build_view_page(dam_run(), {});
+  ASSERT_GT(whole.frames_shown, 4u);
+  ViewOptions half;
+  half.max_bytes = whole.html.size() * 3 / 5;
+  const std::string refused = message([&] { build_view_page(dam_run(), half); });
+  const std::size_t at = refused.find("--max-frames ");
+  ASSERT_NE(at, std::string::npos) << refused;
+  const std::size_t n = std::stoul(refused.substr(at + 13));
+  ASSERT_GE(n, 2u) << refused;
+  ASSERT_LT(n, whole.frames_shown) << refused;
+  half.max_frames = n;
+  EXPECT_EQ(message([&] { build_view_page(dam_run(), half); }).find("would be about"), std::string::npos);
+  half.max_frames = n + 1;
+  EXPECT_NE(message([&] { build_view_page(dam_run(), half); }).find("would be about"), std::string::npos);
 }
 
 }  // namespace

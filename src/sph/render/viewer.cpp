@@ -200,12 +200,14 @@ void check_page_estimate(const fs::path& dir, const ViewOptions& options,
   std::size_t frames = 0;
   for (const auto& p : picks) frames += p.size();
   const std::size_t per_particle = 2 * static_cast<std::size_t>(dim) + q.scalars.size();
-  const std::size_t estimate = base64_size(per_particle * max_particles) * frames + (100 + pose_bytes) * frames +
-                               (q.rgb ? base64_size(3 * max_particles) * runs : 0) + detail::viewer_html().size() +
-                               detail::viewer_css().size() + detail::viewer_js().size();
+  // What each frame adds, and what the page holds whatever the frames.
+  const std::size_t per_frame = base64_size(per_particle * max_particles) + 100 + pose_bytes;
+  const std::size_t fixed = (q.rgb ? base64_size(3 * max_particles) * runs : 0) + detail::viewer_html().size() +
+                            detail::viewer_css().size() + detail::viewer_js().size();
+  const std::size_t estimate = per_frame * frames + fixed;
   if (estimate <= options.max_bytes) return;
-  const std::size_t per_frame = std::max<std::size_t>(1, estimate / std::max<std::size_t>(1, frames));
-  const std::size_t fit = options.max_bytes / per_frame / runs;
+  // --max-frames keeps up to N frames of each run.
+  const std::size_t fit = options.max_bytes > fixed ? (options.max_bytes - fixed) / (per_frame * runs) : 0;
   throw Error(fmt::format("the page would be about {:.0f} MB ({} frames of up to {} particles), more than the "
                           "limit of {:.0f} MB; use --max-frames {} (or fewer), fewer quantities with --color-by, "
                           "or raise the limit with --max-size",

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -75,9 +76,10 @@ bool python_signal(std::optional<py::error_already_set>& pending) {
 }
 
 py::dict run_scene(const Scene& scene, const py::object& output_arg, const py::object& neighbors,
-                   const py::object& steps, const py::object& threads, std::int64_t checkpoint_every, bool strict,
-                   bool overwrite, const py::object& progress_arg) {
-  if (checkpoint_every < 0) throw py::value_error("checkpoint_every must be 0 or more steps");
+                   const py::object& steps, const py::object& threads, const py::object& checkpoint_every_arg,
+                   bool strict, bool overwrite, const py::object& progress_arg) {
+  const std::int64_t checkpoint_every =
+      whole_number_arg(checkpoint_every_arg, "checkpoint_every", 0, std::numeric_limits<std::int64_t>::max());
   const SceneDesc desc = with_overrides(scene.desc, run_overrides(neighbors, steps));
   const int n_threads = thread_count_arg(threads);
   const Progress progress(progress_arg);
@@ -147,8 +149,8 @@ py::dict run_scene(const Scene& scene, const py::object& output_arg, const py::o
 }
 
 py::dict compare_scene(const Scene& scene, const py::object& output, const py::object& modes, const py::object& steps,
-                       const py::object& threads, int frames, double perturbation, bool audit, bool run_frames,
-                       const py::object& progress_arg) {
+                       const py::object& threads, const py::object& frames_arg, double perturbation, bool audit,
+                       bool run_frames, const py::object& progress_arg) {
   CompareOptions co;
   if (!modes.is_none()) {
     co.modes.clear();
@@ -164,7 +166,7 @@ py::dict compare_scene(const Scene& scene, const py::object& output, const py::o
     }
     if (co.modes.empty()) throw Error("no mode given", "modes");
   }
-  if (frames < 1 || frames > 100) throw py::value_error("frames must be 1 to 100");
+  const int frames = static_cast<int>(whole_number_arg(frames_arg, "frames", 1, 100));
   if (!(perturbation >= 0 && perturbation <= 0.1)) throw py::value_error("perturbation must be 0 to 0.1 (of h)");
   co.frames = frames;
   co.perturbation = perturbation;

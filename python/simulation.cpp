@@ -292,10 +292,7 @@ class PySimulation {
     return visit([](const auto& d) { return Scene{d.scene()}; });
   }
   int threads() const { return threads_; }
-  void set_threads(int n) {
-    if (n < 1) throw py::value_error("threads must be at least 1, got " + std::to_string(n));
-    threads_ = n;
-  }
+  void set_threads(const py::object& n) { threads_ = static_cast<int>(whole_number_arg(n, "threads", 1, 4096)); }
 
  private:
   /// Marks the simulation busy for its life (with the GIL held when it starts and ends).

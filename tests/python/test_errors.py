@@ -128,6 +128,17 @@ def test_argument_errors(small_2d):
     for threads, error in ((2.5, TypeError), (True, TypeError), (10**12, ValueError)):
         with pytest.raises(error, match="threads must be a whole number from 1 to 4096"):
             sph.Simulation(small_2d, threads=threads)
+        with pytest.raises(error, match="threads must be a whole number from 1 to 4096"):
+            sim.threads = threads
+    assert sim.threads >= 1
+    with pytest.raises(TypeError, match="checkpoint_every must be a whole number"):
+        sph.run(small_2d, output="x", steps=2, checkpoint_every=2.5)
+    with pytest.raises(ValueError, match="checkpoint_every must be a whole number"):
+        sph.run(small_2d, output="x", steps=2, checkpoint_every=-1)
+    with pytest.raises(TypeError, match="frames must be a whole number from 1 to 100"):
+        sph.compare(small_2d, frames="3")
+    with pytest.raises(ValueError, match="frames must be a whole number from 1 to 100"):
+        sph.compare(small_2d, frames=0)
     sim.step(1)
     with pytest.raises(TypeError, match="fields must be a list of names"):
         sim.write_frame("x.vtu", fields="velocity")

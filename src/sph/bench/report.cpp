@@ -19,7 +19,7 @@ namespace {
 std::string threads_cell(int threads, bool oversubscribed) {
   return fmt::format("{}{}", threads, oversubscribed ? "*" : "");
 }
-double mb(std::int64_t bytes) { return static_cast<double>(bytes) / (1024.0 * 1024.0); }
+double mib(std::int64_t bytes) { return static_cast<double>(bytes) / (1024.0 * 1024.0); }
 }  // namespace
 
 std::string neighbors_table_header() {
@@ -39,7 +39,7 @@ std::string steps_table_header() {
       "{:>8} {:<9} {:<6} {:>4} {:>6} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>17} {:>10} {:>9} {:>9} {:>8} {:>7} "
       "{:>8} {:>6} {:>10}",
       "N", "mode", "prec", "thr", "steps", "grid", "lists", "density", "forces", "integr", "total", "wall",
-      "[min .. max]", "Mpart-st/s", "ns/pt-st", "rebuilt/st", "peak MB", "B/part", "visits/p", "<h", "Mvisit/c-s");
+      "[min .. max]", "Mpart-st/s", "ns/pt-st", "rebuilt/st", "peak MiB", "B/part", "visits/p", "<h", "Mvisit/c-s");
 }
 
 std::string steps_table_row(const StepsRow& r) {
@@ -50,7 +50,7 @@ std::string steps_table_row(const StepsRow& r) {
       r.timed_steps, r.ms_per_step.grid, r.ms_per_step.lists, r.ms_per_step.density, r.ms_per_step.forces,
       r.ms_per_step.integrate, r.ms_per_step.total(), r.wall_ms_per_step,
       fmt::format("[{:.3f} .. {:.3f}]", r.wall_ms_min, r.wall_ms_max), 1e-6 * r.particle_steps_per_second,
-      r.ns_per_particle_step, r.lists_rebuilt_per_step, mb(r.peak_rss_bytes - r.baseline_rss_bytes),
+      r.ns_per_particle_step, r.lists_rebuilt_per_step, mib(r.peak_rss_bytes - r.baseline_rss_bytes),
       r.bytes_per_particle, r.pair_visits_per_particle, r.within_h_fraction, 1e-6 * r.pair_visits_per_core_second);
 }
 

@@ -29,6 +29,16 @@ def main():
     with open(os.path.join(build, "compile_commands.json")) as f:
         database = json.load(f)
     by_file = {os.path.realpath(e["file"]): e for e in database}
+    # A target built with CMake's unity build (SPH_UNITY) has one entry per generated file that
+    # includes its sources: each source gets that entry's command.
+    for e in database:
+        if os.sep + "Unity" + os.sep in e["file"]:
+            with open(e["file"]) as f:
+                for source in re.findall(r'^#include "([^"]+)"', f.read(), re.M):
+                    command = e.get("command") or shlex.join(e["arguments"])
+                    by_file.setdefault(os.path.realpath(source),
+                                       {"directory": e["directory"], "file": source,
+                                        "command": command.replace(e["file"], source)})
 
     units = {}  # (directory, flags) -> sources, in the order given
     entries = []

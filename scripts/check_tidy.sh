@@ -68,25 +68,28 @@ fi
 # one by one instead, and the lint says so: the findings are the same either way.
 python3 scripts/tidy_units.py "$build" "$log" "${files[@]}" >"$log/units.txt" || exit 2
 export tidy log
+# The compile commands are GCC's: clang does not know some of its warning options.
+run_tidy() {  # file, log
+  "$tidy" -p "$log" --config-file=.clang-tidy --quiet --extra-arg=-Wno-unknown-warning-option "$1" >"$2" 2>&1
+}
 check_unit() {  # unit, then its sources
   local unit=$1 out
   shift
   out=$log/$(basename "$unit").log
-  "$tidy" -p "$log" --config-file=.clang-tidy --quiet --extra-arg=-Wno-unknown-warning-option "$unit" >"$out" 2>&1 && return 0
+  run_tidy "$unit" "$out" && return 0
   if grep -q '\[clang-diagnostic-' "$out"; then
     echo "check_tidy: $(grep -m1 '\[clang-diagnostic-' "$out" | sed 's/ \[clang-diagnostic-.*//')"
     echo "check_tidy: so the $# sources of $(basename "$unit" .cpp) are checked one by one"
     local s status=0
     for s in "$@"; do
-      "$tidy" -p "$log" --config-file=.clang-tidy --quiet --extra-arg=-Wno-unknown-warning-option "$s" >"$out.$(basename "$s").log" 2>&1 || status=1
+      run_tidy "$s" "$out.$(basename "$s").log" || status=1
     done
     rm -f "$out"
     [ $status -eq 0 ] && return 0
   fi
   echo "$unit" >>"$log/failed"
 }
-export -f check_unit
-# The compile commands are GCC's: clang does not know some of its warning options.
+export -f run_tidy check_unit
 xargs -d '\n' -n1 -P "${JOBS:-$(nproc)}" bash -c 'IFS=$'"'\\t'"' read -ra unit <<<"$1"; check_unit "${unit[@]}"' _ <"$log/units.txt"
 if [ -s "$log/failed" ]; then
   # Each finding once (a header's shows up in every file that includes it).

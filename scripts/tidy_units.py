@@ -22,6 +22,11 @@ import shlex
 import sys
 
 
+def command_of(entry):
+    """A compile database entry's command line, whichever form the entry gives it in."""
+    return entry.get("command") or shlex.join(entry["arguments"])
+
+
 def main():
     if len(sys.argv) < 4:
         sys.exit("usage: tidy_units.py BUILD_DIR OUT_DIR FILE...")
@@ -33,9 +38,9 @@ def main():
     # includes its sources: each source gets that entry's command.
     for e in database:
         if os.sep + "Unity" + os.sep in e["file"]:
+            command = command_of(e)
             with open(e["file"]) as f:
                 for source in re.findall(r'^#include "([^"]+)"', f.read(), re.M):
-                    command = e.get("command") or shlex.join(e["arguments"])
                     by_file.setdefault(os.path.realpath(source),
                                        {"directory": e["directory"], "file": source,
                                         "command": command.replace(e["file"], source)})
@@ -48,7 +53,7 @@ def main():
         if entry is None:
             sys.exit(f"tidy_units: {name} is not in {build}/compile_commands.json: "
                      "a source of src/, apps/ or python/ that CMake builds is expected")
-        command = entry.get("command") or shlex.join(entry["arguments"])
+        command = command_of(entry)
         flags = re.sub(r" -o \S+", " ", command.replace(entry["file"], " "))
         key = (os.path.dirname(path), entry["directory"], flags)
         units.setdefault(key, []).append(path)
@@ -63,8 +68,7 @@ def main():
             for s in sources:
                 f.write(f'#include "{s}"  // NOLINT(bugprone-suspicious-include)\n')
         first = by_file[sources[0]]
-        command = first.get("command") or shlex.join(first["arguments"])
-        command = re.sub(r" -o \S+", f" -o {unit}.o", command.replace(first["file"], unit))
+        command = re.sub(r" -o \S+", f" -o {unit}.o", command_of(first).replace(first["file"], unit))
         entries.append({"directory": directory, "file": unit, "command": command})
         lines.append((len(sources), unit, sources))
 

@@ -74,16 +74,6 @@ std::pair<double, double> parse_range(const std::string& s) {
   return {lo, hi};
 }
 
-/// Creates `dir` if needed, checks that it is writable and removes the images and movie of an
-/// earlier render (only the files a render makes: is_render_output), so that two renders are
-/// never mixed and a user's other files there are kept.
-void prepare_render_directory(const fs::path& dir) {
-  make_writable_directory(dir, "the images");
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(dir, ec))
-    if (is_render_output(entry.path().filename().string()) && !entry.is_directory(ec)) fs::remove(entry.path(), ec);
-}
-
 int render(const RenderCliOptions& opt) {
   // Everything that can be refused is checked before anything is written.
   const auto by = color_by_from_name(opt.color_by);
@@ -134,7 +124,10 @@ int render(const RenderCliOptions& opt) {
     for (const RunDirectory& r : runs) particle_colors(read_frame(r.frames[frames.front()]), style.color, r);
 
   const fs::path out = opt.output ? fs::path(*opt.output) : fs::path(opt.dir) / "render";
-  prepare_render_directory(out);
+  // The images and movie replace an earlier render's (only the files a render makes:
+  // is_render_output) when they are all written, so that two renders are never mixed, a render
+  // that fails leaves the earlier one whole, and a user's other files there are kept.
+  StagedFiles staged(out, is_render_output, "the images");
   std::unique_ptr<VideoWriter> video;
   Stopwatch wall;
   fmt::print(stderr, "sph: render {} frame{} of {} ({}, {}) -> {}\n", frames.size(), frames.size() == 1 ? "" : "s",
@@ -161,7 +154,7 @@ int render(const RenderCliOptions& opt) {
         std::vector<FrameData> data;
         for (const RunDirectory& r : runs) data.push_back(read_frame(r.frames[index]));
         images[k] = render_frame(runs, data, style);
-        if (!opt.no_png) write_png(out / fmt::format("frame_{:06d}.png", index), images[k]);
+        if (!opt.no_png) write_png(staged.path() / fmt::format("frame_{:06d}.png", index), images[k]);
       } catch (const std::exception& e) {
         errors[k] = e.what();
       }
@@ -170,12 +163,14 @@ int render(const RenderCliOptions& opt) {
       if (!errors[k].empty()) throw Error(errors[k]);
     if (opt.mp4) {
       if (!video)
-        video = std::make_unique<VideoWriter>(out / "movie.mp4", images[0].width(), images[0].height(), opt.video_fps);
+        video = std::make_unique<VideoWriter>(staged.path() / "movie.mp4", images[0].width(), images[0].height(),
+                                              opt.video_fps);
       for (std::size_t k = 0; k < n; ++k) video->add(images[k]);
     }
     progress.update(static_cast<std::int64_t>(first + n), 0);
   }
   if (video) video->finish();
+  staged.commit();
   progress.finish();
   const double seconds = wall.elapsed();
   fmt::print(stderr, "sph: done: {} frame{} in {:.2f} s ({:.1f} ms per frame).\n", frames.size(),

@@ -65,10 +65,9 @@ int surface(SurfaceCliOptions opt) {
   const std::vector<std::size_t> frames = parse_frames(opt.frames, run.frames.size());
 
   const fs::path out = opt.output ? fs::path(*opt.output) : fs::path(opt.dir) / "surface";
-  make_writable_directory(out, "the surfaces");
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(out, ec))
-    if (is_surface_output(entry.path().filename().string()) && !entry.is_directory(ec)) fs::remove(entry.path(), ec);
+  // The meshes replace an earlier surface's (only the files sph surface makes) when they are all
+  // written: a command that fails half-way leaves the earlier ones whole.
+  StagedFiles staged(out, is_surface_output, "the surfaces");
 
   fmt::print(
       stderr, "sph: surface of {} frame{} of {} ({}D, voxel {:.3g} m = spacing / {}, smoothing {} spacings) -> {}\n",
@@ -89,9 +88,10 @@ int surface(SurfaceCliOptions opt) {
     mesh_seconds += mesh_wall.elapsed();
     particles += data.size;
     faces += run.dimension == 3 ? mesh.triangles.size() : mesh.segments.size();
-    written = write_surface_frame(out, frames[k], mesh, data.time, formats);
+    written = write_surface_frame(staged.path(), frames[k], mesh, data.time, formats);
     progress.update(static_cast<std::int64_t>(k + 1), 0);
   }
+  staged.commit();
   progress.finish();
   const double seconds = wall.elapsed();
   fmt::print(stderr,
@@ -100,7 +100,8 @@ int surface(SurfaceCliOptions opt) {
              frames.size(), frames.size() == 1 ? "" : "s", seconds, mesh_seconds, particles,
              mesh_seconds > 0 ? 1e-6 * static_cast<double>(particles) / mesh_seconds : 0.0, faces,
              run.dimension == 3 ? "triangles" : "segments");
-  for (const fs::path& p : written) fmt::print(stderr, "  {}{}\n", frames.size() > 1 ? "... " : "", p.string());
+  for (const fs::path& p : written)
+    fmt::print(stderr, "  {}{}\n", frames.size() > 1 ? "... " : "", (out / p.filename()).string());
   return kOk;
 }
 

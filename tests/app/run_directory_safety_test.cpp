@@ -4,6 +4,7 @@
 // not survive beside a new run's frames, `sph render -o DIR` removes only what a render makes,
 // and scene files that are not scenes (huge, a device, a FIFO) are refused.
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -209,6 +210,54 @@ TEST_F(RunDirectory, RenderRemovesOnlyTheFilesARenderMakes) {
   EXPECT_TRUE(fs::exists(at("pics") / "frame_000000.png"));
   for (const char* f : {"frame_holiday.png", "notes.txt", "frame_12.png"})
     EXPECT_TRUE(fs::exists(at("pics") / f)) << f << " is a user's file";
+}
+
+// A render or surface that fails half-way (here a damaged frame, read after the first ones were
+// drawn or meshed) leaves the earlier render's images and movie and the earlier surfaces as they
+// were, and no half-written file or hidden directory beside them.
+TEST_F(RunDirectory, ARenderOrSurfaceThatFailsHalfWayLeavesTheEarlierFilesWhole) {
+  run("d", 20);  // frames 0 to 4
+  const std::vector<std::string> render{"render", "d",       "-o",  "pics",         "--size",
+                                        "64x48",  "--range", "0,2", "--no-progress"};
+  const std::vector<std::string> surface{"surface", "d", "--format", "ply,obj", "--no-progress"};
+  ASSERT_EQ(sph(render).code, 0);
+  ASSERT_EQ(sph(surface).code, 0);
+  spit(at("pics") / "notes.txt", "mine");
+  const auto pics = files(at("pics")), meshes = files(at("d") / "surface");
+  ASSERT_EQ(pics.size(), 6u);     // frame_000000.png ... frame_000004.png, notes.txt
+  ASSERT_EQ(meshes.size(), 10u);  // surface_00000N.ply and .obj
+
+  const fs::path frame = at("d") / "frames" / "frame_000003.vtu";
+  spit(frame, slurp(frame).substr(0, 300));
+  std::vector<std::string> again = render;
+  again[5] = "80x60";  // other images, had they been written
+  const CommandResult r = sph(again);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_CONTAINS(r.err, "frame_000003.vtu");
+  EXPECT_EQ(files(at("pics")), pics) << "the earlier render changed";
+  const CommandResult s = sph({"surface", "d", "--format", "ply", "--resolution", "3", "--no-progress"});
+  EXPECT_EQ(s.code, 2) << s.err;
+  EXPECT_CONTAINS(s.err, "frame_000003.vtu");
+  EXPECT_EQ(files(at("d") / "surface"), meshes) << "the earlier surfaces changed";
+  for (const fs::path& dir : {at("pics"), at("d") / "surface"})
+    for (const auto& e : fs::directory_iterator(dir))
+      EXPECT_EQ(e.path().filename().string().find(".sph-staging"), std::string::npos) << e.path() << " was left";
+
+  // One that fails into a directory of its own leaves no directory; one that succeeds replaces
+  // the whole earlier set (the frames 0 to 2 only: frame 3's images are removed, not kept) and
+  // removes a hidden directory that a killed render left behind.
+  EXPECT_EQ(sph({"render", "d", "-o", "new", "--range", "0,2", "--no-progress"}).code, 2);
+  EXPECT_FALSE(fs::exists(at("new")));
+  fs::create_directories(at("pics") / ".sph-staging-999999999");
+  spit(at("pics") / ".sph-staging-999999999" / "frame_000001.png", "x");
+  again.insert(again.end(), {"--frames", "0,1,2"});
+  const CommandResult ok = sph(again);
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(at("pics"))) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"frame_000000.png", "frame_000001.png", "frame_000002.png", "notes.txt"}));
+  EXPECT_NE(slurp(at("pics") / "frame_000000.png"), pics.at("frame_000000.png")) << "not the new image";
 }
 
 TEST_F(RunDirectory, RenderWithoutFfmpegIsRefusedBeforeAnyImage) {

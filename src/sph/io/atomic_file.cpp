@@ -1,10 +1,14 @@
 #include <sph/io/atomic_file.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cstdio>
 #include <system_error>
+#include <vector>
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <sph/core/error.h>
@@ -70,6 +74,66 @@ void make_writable_directory(const std::filesystem::path& dir, std::string_view 
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error("cannot create the output directory: " + ec.message(), dir.string());
   AtomicFile probe(dir / ".write-test");  // removed unless committed
+}
+
+namespace {
+constexpr std::string_view kStagePrefix = ".sph-staging-";
+
+/// Removes the hidden directories that killed processes left in `dir` (their PID no longer runs).
+void remove_abandoned_stages(const std::filesystem::path& dir) {
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(kStagePrefix, 0) != 0 || !entry.is_directory(ec)) continue;
+    const std::string digits = name.substr(kStagePrefix.size());
+    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) continue;
+    const auto pid = static_cast<pid_t>(std::stol(digits));
+    if (pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH) std::filesystem::remove_all(entry.path(), ec);
+  }
+}
+}  // namespace
+
+StagedFiles::StagedFiles(std::filesystem::path dir, std::function<bool(const std::string&)> is_member,
+                         std::string_view purpose)
+    : dir_(std::move(dir)), is_member_(std::move(is_member)) {
+  std::error_code ec;
+  created_ = !std::filesystem::exists(dir_, ec);
+  make_writable_directory(dir_, purpose);
+  remove_abandoned_stages(dir_);
+  stage_ = dir_ / (std::string(kStagePrefix) + std::to_string(::getpid()));
+  std::filesystem::remove_all(stage_, ec);
+  std::filesystem::create_directory(stage_, ec);
+  if (ec) throw Error("cannot create a directory in this directory: " + ec.message(), dir_.string());
+}
+
+StagedFiles::~StagedFiles() {
+  std::error_code ec;
+  std::filesystem::remove_all(stage_, ec);
+  if (!committed_ && created_ && std::filesystem::is_empty(dir_, ec)) std::filesystem::remove(dir_, ec);
+}
+
+void StagedFiles::commit() {
+  std::error_code ec;
+  std::vector<std::filesystem::path> staged;
+  for (const auto& entry : std::filesystem::directory_iterator(stage_, ec)) staged.push_back(entry.path());
+  if (ec) throw Error("cannot list the finished files: " + ec.message(), stage_.string());
+  std::sort(staged.begin(), staged.end());
+  std::vector<std::string> names;
+  for (const std::filesystem::path& p : staged) {
+    std::filesystem::rename(p, dir_ / p.filename(), ec);
+    if (ec) throw Error("cannot move the finished file into place: " + ec.message(), (dir_ / p.filename()).string());
+    names.push_back(p.filename().string());
+  }
+  committed_ = true;
+  std::sort(names.begin(), names.end());
+  std::vector<std::filesystem::path> earlier;
+  for (const auto& entry : std::filesystem::directory_iterator(dir_, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (is_member_(name) && entry.is_regular_file(ec) && !std::binary_search(names.begin(), names.end(), name))
+      earlier.push_back(entry.path());
+  }
+  for (const std::filesystem::path& p : earlier) std::filesystem::remove(p, ec);
+  std::filesystem::remove(stage_, ec);
 }
 
 void write_file_atomic(const std::filesystem::path& path, std::string_view content) {

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -28,6 +29,37 @@ class AtomicFile {
  private:
   std::filesystem::path path_, tmp_;
   std::ofstream out_;
+  bool committed_ = false;
+};
+
+/// A set of files that replaces an earlier set in a directory together, or not at all (sph
+/// render's images and movie, sph surface's meshes). The new files are written into a hidden
+/// directory inside `dir` (path()); commit() moves each of them into `dir`, over its earlier
+/// namesake, then removes the earlier set's other files (the regular files whose names
+/// `is_member` accepts). Until commit() the earlier files stay as they were: a command that fails
+/// half-way leaves them, and the hidden directory is removed with what it held (one left by a
+/// killed process is removed by the next StagedFiles in `dir`), as is `dir` if it was made for
+/// them. A user's other files are kept.
+class StagedFiles {
+ public:
+  /// Creates `dir` if needed (make_writable_directory, for `purpose`) and the hidden directory.
+  StagedFiles(std::filesystem::path dir, std::function<bool(const std::string&)> is_member, std::string_view purpose);
+  StagedFiles(const StagedFiles&) = delete;
+  StagedFiles& operator=(const StagedFiles&) = delete;
+  /// Removes the hidden directory and what is left in it (everything, unless commit() ran), and
+  /// `dir` too if this created it and nothing was committed.
+  ~StagedFiles();
+
+  /// Where the new files are written.
+  const std::filesystem::path& path() const { return stage_; }
+  /// Moves the new files into place and removes the earlier set's others; throws sph::Error if
+  /// a file cannot be moved.
+  void commit();
+
+ private:
+  std::filesystem::path dir_, stage_;
+  std::function<bool(const std::string&)> is_member_;
+  bool created_ = false;  ///< `dir` did not exist: removed again if nothing was committed
   bool committed_ = false;
 };
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -113,6 +114,50 @@ TEST(HealthRun, StrictMakesTheFirstWarningAFailureInItsStep) {
   EXPECT_EQ(r.message, "failed: " + r.error);
   EXPECT_EQ(r.error.substr(r.error.size() - 11), " (--strict)");
   EXPECT_EQ(nlohmann::json::parse(slurp(tmp / "o" / "summary.json")).at("status"), r.message);
+}
+
+/// stats.csv's last row: its step and the value of `column`.
+std::pair<long long, double> last_row(const fs::path& stats_csv, const std::string& column) {
+  std::ifstream stats(stats_csv);
+  std::string header, line, last;
+  std::getline(stats, header);
+  while (std::getline(stats, line)) last = line;
+  std::vector<std::string> names, cells;
+  for (auto* v : {&names, &cells}) {
+    std::string text = v == &names ? header : last, cell;
+    std::istringstream in(text);
+    while (std::getline(in, cell, ',')) v->push_back(cell);
+  }
+  std::size_t k = 0;
+  while (k < names.size() && names[k] != column) ++k;
+  if (k >= cells.size() || cells.empty()) return {-1, 0};
+  return {std::stoll(cells[0]), std::stod(cells[k])};
+}
+
+// A step that fails, by a --strict warning or by a health check's failure level, has its stats.csv
+// row like every other step: the failure's "at step N" is the last row, and the row shows what
+// failed (here its Mach number). (Until 2026-12-07 the table ended one step before the failure.)
+TEST(HealthRun, AFailingStepHasItsStatsRow) {
+  for (const double speed : {13.0, 45.0}) {  // Mach 0.33 (a warning, --strict) and 1.1 (supersonic: fails)
+    SCOPED_TRACE(speed);
+    TempDir tmp;
+    RunSettings settings{tmp / "o", 0};
+    settings.strict = speed < 20;
+    RunDriver<2, double> run(read_scene_file(SPH_SOURCE_DIR "/scenes/paper/dam_break_2d.json",
+                                             {"Configuration.numberOfSteps=40", "Configuration.outputEveryNSteps=10",
+                                              "FluidBlocks[0].velocity=[" + std::to_string(speed) + ",0]"}),
+                             settings);
+    const RunResult r = run.run();
+    ASSERT_EQ(r.status, RunStatus::Failed) << r.message;
+    EXPECT_NE(r.error.find(speed < 20 ? "Mach 0.3" : "supersonic"), std::string::npos) << r.error;
+    const std::size_t at = r.error.find("at step ");
+    ASSERT_NE(at, std::string::npos) << r.error;
+    const long long step = std::stoll(r.error.substr(at + 8));
+    const auto [row, mach] = last_row(tmp / "o" / "stats.csv", "max_mach");
+    EXPECT_EQ(row, step) << r.error;
+    EXPECT_EQ(row, r.steps_done);
+    EXPECT_GT(mach, speed < 20 ? 0.3 : 1.0);
+  }
 }
 
 TEST(HealthRun, AResumedRunRemembersTheWarningsGivenBeforeItsCheckpoint) {

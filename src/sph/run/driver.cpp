@@ -152,6 +152,18 @@ RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver
     surfaces_written_ = resumed_ ? output_->frames_written() : 0;  // a resumed run's earlier frames have theirs
     write_new_surface();
   }
+  // The steps whose stats rows are written. A step that fails its health checks (or a --strict
+  // one that warns) gets its row too, so that the message's step is stats.csv's last row; one
+  // that blew up (no finite state to measure) has none.
+  std::int64_t rows = sim_.steps_done();
+  const auto failing_step_row = [&] {
+    if (!output_ || rows == sim_.steps_done() || sim_.last_step().step + 1 != sim_.steps_done()) return;
+    rows = sim_.steps_done();
+    try {
+      output_->after_step(sim_, sim_.last_step(), false);
+    } catch (const Error&) {  // (the failure being reported says more than a full disk's)
+    }
+  };
   try {
     while (!finished()) {
       set_barrier();
@@ -161,6 +173,7 @@ RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver
         for (const std::string& w : new_warnings(step)) {
           if (callbacks.warning) callbacks.warning(w);
           if (settings_.strict) {
+            failing_step_row();
             result.error = w + " (--strict)";
             return end(RunStatus::Failed, "failed: " + result.error);
           }
@@ -168,6 +181,7 @@ RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver
       }
       if (on_step) on_step(sim_, step);
       if (output_) {
+        rows = sim_.steps_done();
         output_->after_step(sim_, step, last);
         write_new_surface();
       }
@@ -190,6 +204,7 @@ RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver
         write_checkpoint(settings_.dir, desc_, sim_, *output_, wall_.elapsed(), settings_.checkpoint_every);
     }
   } catch (const Error& e) {
+    failing_step_row();
     result.error = e.what();
     return end(RunStatus::Failed, std::string("failed: ") + e.what());
   }

@@ -675,13 +675,12 @@ const StepInfo& Simulation<D, R>::step() {
     time_ = st.lands ? st.end : time_ + st.dt;
     last_cfl_dt_ = st.cfl_dt;
   }
-  info.health = integrate_and_check<true>(dt);
-  monitor_.check(info.health, steps_, time(), particles_.size());  // (step k: stats.csv's row k)
-  info.seconds.integrate = watch.lap();
-
+  info.health = integrate_and_check<true>(dt);  // (a blow-up throws here: the step has no record)
   info.time = time();
   info.particles = particles_.size();
-  info_ = info;
+  info_ = info;  // the step's record before it is judged: a run writes a failing step's stats row too
+  monitor_.check(info_.health, steps_, time(), particles_.size());  // (step k: stats.csv's row k)
+  info_.seconds.integrate = watch.lap();
   return info_;
 }
 

@@ -1,6 +1,7 @@
 // The strict scene reader: the paper scenes parse, and every user mistake is an sph::Error
 // whose message names the problem (key path, line:col, what was expected).
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <string>
@@ -458,7 +459,15 @@ TEST(SceneReader, DuplicateKeysAreRefused) {
   ASSERT_NE(pos, std::string::npos);
   dup.insert(pos, "\"stiffness\": 2000,\n");
   const std::string m = error_of(dup);
-  EXPECT_CONTAINS(m, "key \"stiffness\" appears twice");
+  // The repeated key is the original one, now at the start of the line after the inserted one.
+  const auto line = 2 + std::count(dup.begin(), dup.begin() + static_cast<std::ptrdiff_t>(pos), '\n');
+  EXPECT_CONTAINS(m, "test.json:" + std::to_string(line) + ":1: key \"stiffness\" appears twice");
+  // The place is that of the key repeated in its own object, not of one of the same name in a
+  // sibling, a parent or a child object, nor of a string value that reads like it.
+  const std::string nested =
+      "{\n \"a\": [{\"k\": 1}, {\"k\": \"\\\"b\\\"\"}],\n \"b\": {\"k\": {\"k\": 3}, \"x\\\"\": 1, \"b\": 0},\n  "
+      "\"b\": 2\n}";
+  EXPECT_CONTAINS(error_of(nested), "test.json:4:3: key \"b\" appears twice");
   // The same key in two different objects is fine.
   json j = valid_scene();
   j["FluidBlocks"].push_back(json{{"start", {0.5, 0}}, {"end", {0.7, 0.2}}});
@@ -561,9 +570,17 @@ TEST(SceneReaderOverrides, EffectiveSceneShowsOverrides) {
 TEST(SceneReaderRobustness, NumberOverflowIsAnSphError) {
   json j = valid_scene();
   std::string text = j.dump(2);
-  text.replace(text.find("\"stiffness\": 1000"), 17, "\"stiffness\": 1e999");
-  EXPECT_CONTAINS(error_of(text), "test.json:");
+  const std::size_t at = text.find("\"stiffness\": 1000");
+  text.replace(at, 17, "\"stiffness\": -1e999");
+  // Its line and column, which nlohmann's exception does not give.
+  const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n');
+  const auto column = at + 13 - text.rfind('\n', at);
+  EXPECT_CONTAINS(error_of(text), "test.json:" + std::to_string(line) + ":" + std::to_string(column) +
+                                      ": the number -1e999 is beyond a double's range");
   EXPECT_CONTAINS(error_of(valid_scene(), {"Fluid.stiffness=1e999"}), "--set Fluid.stiffness");
+  // A key repeated in a --set value's object was silently the last one's value until 2026-12-07.
+  EXPECT_CONTAINS(error_of(valid_scene(), {"Fluid={\"density0\": 1000, \"stiffness\": 1, \"stiffness\": 2}"}),
+                  "--set Fluid: key \"stiffness\" appears twice");
 }
 
 // Before the fix: a misspelt *required* key is reported as the required key missing, without naming the typo

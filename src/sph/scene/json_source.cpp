@@ -1,7 +1,10 @@
 #include <sph/scene/json_source.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <set>
+#include <string_view>
 #include <vector>
 
 #include <fmt/format.h>
@@ -55,6 +58,67 @@ void check_utf8(const std::string& text, const std::string& source) {
                 source);
 }
 
+/// Where in JSON text the parser's position-less refusals are: the first key repeated within one
+/// object, and the first number beyond a double's range (strtod gives an infinity, as the parser
+/// finds "number overflow"). npos where there is none. One walk over the tokens that matter
+/// (strings, numbers, brackets, commas), run only after the parser refused the text.
+struct JsonSpots {
+  std::size_t repeated_key = std::string::npos;
+  std::size_t overflow = std::string::npos;
+};
+
+JsonSpots find_spots(const std::string& text) {
+  JsonSpots spots;
+  struct Level {
+    bool object;
+    std::set<std::string> keys;  // as written, quotes and escapes included
+  };
+  std::vector<Level> levels;
+  bool key_next = false;  // the next string is a key: after '{' or a comma in an object
+  const std::size_t n = text.size();
+  for (std::size_t k = 0; k < n;) {
+    const char c = text[k];
+    if (c == '"') {
+      const std::size_t begin = k++;
+      while (k < n && text[k] != '"') k += text[k] == '\\' ? 2 : 1;
+      k = std::min(k + 1, n);
+      if (key_next && !levels.empty() && !levels.back().keys.insert(text.substr(begin, k - begin)).second &&
+          spots.repeated_key == std::string::npos)
+        spots.repeated_key = begin;
+      key_next = false;
+      continue;
+    }
+    if (c == '-' || (c >= '0' && c <= '9')) {
+      const std::size_t begin = k;
+      while (k < n && std::string_view("+-.eE0123456789").find(text[k]) != std::string_view::npos) ++k;
+      if (!std::isfinite(std::strtod(text.substr(begin, k - begin).c_str(), nullptr)) &&
+          spots.overflow == std::string::npos)
+        spots.overflow = begin;
+      continue;
+    }
+    if (c == '{' || c == '[')
+      levels.push_back({c == '{', {}}), key_next = c == '{';
+    else if (c == '}' || c == ']') {
+      if (!levels.empty()) levels.pop_back();
+      key_next = false;
+    } else if (c == ',')
+      key_next = !levels.empty() && levels.back().object;
+    ++k;
+  }
+  return spots;
+}
+
+}  // namespace
+
+std::size_t repeated_key_at(const std::string& text) { return find_spots(text).repeated_key; }
+
+namespace {
+
+/// "SOURCE:LINE:COLUMN" of byte `at` of `text`, or `source` alone when `at` is npos.
+std::string where(const std::string& text, const std::string& source, std::size_t at) {
+  return at == std::string::npos ? source : source + ":" + line_column(text, at);
+}
+
 }  // namespace
 
 json parse_json(const std::string& text, const std::string& source) {
@@ -79,7 +143,9 @@ json parse_json(const std::string& text, const std::string& source) {
   };
   try {
     json j = json::parse(text, cb, /*allow_exceptions=*/true, /*ignore_comments=*/false);
-    if (!duplicate.empty()) throw Error("key \"" + duplicate + "\" appears twice in the same object", source);
+    if (!duplicate.empty())
+      throw Error("key \"" + duplicate + "\" appears twice in the same object; expected each key once",
+                  where(text, source, find_spots(text).repeated_key));
     return j;
   } catch (const json::parse_error& e) {
     // e.byte is the 1-based offset of the offending character.
@@ -99,6 +165,14 @@ json parse_json(const std::string& text, const std::string& source) {
     // For example a number too large for a double (1e999).
     std::string what = e.what();
     const auto pos = what.find("] ");
+    const std::size_t at = find_spots(text).overflow;
+    if (what.find("number overflow") != std::string::npos && at != std::string::npos) {
+      std::size_t end = at;
+      while (end < text.size() && std::string_view("+-.eE0123456789").find(text[end]) != std::string_view::npos) ++end;
+      throw Error(fmt::format("the number {} is beyond a double's range; expected a magnitude below 1.8e308",
+                              text.substr(at, std::min<std::size_t>(end - at, 40))),
+                  where(text, source, at));
+    }
     throw Error("invalid JSON: " + (pos == std::string::npos ? what : what.substr(pos + 2)), source);
   }
 }

@@ -21,6 +21,10 @@ inline constexpr int kMaxJsonDepth = 64;
 /// numbers out of a double's range.
 nlohmann::json parse_json(const std::string& text, const std::string& source);
 
+/// The offset of the opening quote of the first key repeated within one object of JSON text, or
+/// npos if no key is (keys compared as written).
+std::size_t repeated_key_at(const std::string& text);
+
 /// The offset of the first byte of `s` that is not part of well-formed UTF-8 (no overlong
 /// forms, no surrogates, nothing above U+10FFFF), or npos if all of `s` is well-formed.
 std::size_t invalid_utf8_at(const std::string& s);

@@ -19,7 +19,14 @@ json parse_value(const std::string& key, const std::string& value_text) {
         throw Error(fmt::format("the value is nested more than {} levels deep", kMaxJsonDepth), "--set " + key);
       return true;
     };
-    return json::parse(value_text, depth_limit);
+    json value = json::parse(value_text, depth_limit);
+    if (const std::size_t at = repeated_key_at(value_text); at != std::string::npos) {
+      const std::size_t end = value_text.find(':', at);
+      throw Error(fmt::format("key {} appears twice in the same object of the value; expected each key once",
+                              value_text.substr(at, end == std::string::npos ? 40 : end - at)),
+                  "--set " + key);
+    }
+    return value;
   } catch (const json::parse_error&) {
     return value_text;
   } catch (const json::exception& e) {

@@ -155,9 +155,43 @@ TEST(SceneScales, WithoutGravityOnlyMotionSetsTheSpeed) {
   j["FluidBlocks"][0].erase("velocity");
   const std::string m = error_of(j);
   EXPECT_CONTAINS(m, "Fluid.stiffness");
-  EXPECT_CONTAINS(m, "no gravity and nothing moves");
+  EXPECT_CONTAINS(m, "no gravity, and neither its fluid nor an obstacle moves");
   j["Fluid"]["stiffness"] = 400;
   EXPECT_NEAR(parse(j).body<2>().sim.walls.stiffness, 9e4, 1e-6);  // (1.5 * 2 m/s / 0.01 m)^2
+}
+
+// A moving obstacle stirs the fluid at its surface's speed: without gravity it sets the speed
+// (the scene was refused as one where "nothing moves" until 2026-12-07), and with gravity the
+// larger of the two does.
+TEST(SceneScales, AMovingObstaclesSurfaceSpeedCounts) {
+  json j = tank_2d();
+  j["Configuration"]["gravitation"] = {0, 0};
+  // A 0.2 x 0.1 m paddle turning at 4 rad/s about its centre: its corners at 0.1118 m, 0.447 m/s.
+  j["Obstacles"] = json::parse(R"([{ "start": [0.4, 0.5], "end": [0.6, 0.6],
+    "motion": { "type": "rotation", "center": [0.5, 0.55], "angularVelocity": 4 } }])");
+  const double corner = 4 * std::sqrt(0.1 * 0.1 + 0.05 * 0.05);
+  EXPECT_NEAR(sph::scene_scales<2>(parse(j).body<2>()).max_speed, corner, 1e-9);
+  // Ramped up over a second: the same speed once it is reached.
+  j["Obstacles"][0]["motion"]["rampTime"] = 1.0;
+  EXPECT_NEAR(sph::scene_scales<2>(parse(j).body<2>()).max_speed, corner, 1e-9);
+  // An oscillation of amplitude A and period T peaks at 2 pi A / T.
+  j["Obstacles"][0]["motion"] = json::parse(R"({ "type": "oscillation", "direction": [1, 0], "amplitude": 0.05,
+    "period": 0.5 })");
+  EXPECT_NEAR(sph::scene_scales<2>(parse(j).body<2>()).max_speed, 2 * M_PI * 0.05 / 0.5, 1e-3);
+  // Keyframes: the fastest interval's speed (0.1 m in 0.05 s).
+  j["Obstacles"][0]["motion"] = json::parse(R"({ "type": "keyframes", "keys": [
+    { "time": 0, "translation": [0, 0] }, { "time": 1, "translation": [0.1, 0] },
+    { "time": 1.05, "translation": [0.2, 0] } ] })");
+  EXPECT_NEAR(sph::scene_scales<2>(parse(j).body<2>()).max_speed, 2.0, 1e-9);
+  // A floating body launched at 0.3 m/s.
+  j["Obstacles"][0].erase("motion");
+  j["Obstacles"][0]["dynamic"] = true;
+  j["Obstacles"][0]["density"] = 500;
+  j["Obstacles"][0]["velocity"] = {0, 0.3};
+  EXPECT_NEAR(sph::scene_scales<2>(parse(j).body<2>()).max_speed, 0.3, 1e-12);
+  // With gravity, the fall from the block's top (1.98 m/s) is faster than the body.
+  j["Configuration"].erase("gravitation");
+  EXPECT_NEAR(sph::scene_scales<2>(parse(j).body<2>()).max_speed, std::sqrt(2 * 9.81 * 0.2), 1e-12);
 }
 
 TEST(SceneDefaults, ExplicitValuesAreKept) {

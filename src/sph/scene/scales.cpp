@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
+
+#include <sph/solver/motion.h>
 
 namespace sph {
 
@@ -25,6 +28,31 @@ Vec<D, double> top_of(const Box<D>& b, const Vec<D, double>& down) {
   Vec<D, double> x;
   for (int d = 0; d < D; ++d) x[d] = down[d] > 0 ? b.lo[d] : b.hi[d];
   return x;
+}
+
+/// The largest speed obstacle k's surface reaches: a prescribed motion's over its ramp and a
+/// period after it (an oscillation's), over its keys (keyframes', at their intervals' middles
+/// too); a floating body's at its start (its speed plus its spin times its half diagonal).
+template <int D>
+double obstacle_peak_speed(const SimulationParams<D>& sim, std::size_t k) {
+  const Vec<D, double>& lo = sim.obstacles[k].lo;
+  const Vec<D, double>& hi = sim.obstacles[k].hi;
+  const BodyParams<D>& body = obstacle_body(sim, k);
+  if (body.dynamic)
+    return std::sqrt(norm2(body.velocity)) + std::sqrt(norm2(body.angular_velocity)) * 0.5 * norm(hi - lo);
+  const ObstacleMotion<D>& m = obstacle_motion(sim, k);
+  if (!m.moves()) return 0;
+  std::vector<double> times;
+  const double span = m.ramp_time + (m.type == MotionType::Oscillation ? m.period : 0);
+  constexpr int kSamples = 256;
+  for (int j = 0; j <= kSamples; ++j) times.push_back(span * j / kSamples);
+  for (std::size_t j = 0; j < m.keys.size(); ++j) {
+    times.push_back(m.keys[j].time);
+    if (j > 0) times.push_back(0.5 * (m.keys[j - 1].time + m.keys[j].time));
+  }
+  double fastest = 0;
+  for (const double t : times) fastest = std::max(fastest, max_surface_speed(m, lo, hi, t));
+  return std::isfinite(fastest) ? fastest : 0;  // (an overflowing motion is refused by the preflight)
 }
 
 }  // namespace
@@ -54,6 +82,9 @@ SceneScales scene_scales(const SceneBody<D>& body) {
     s.fall_height = std::max(s.fall_height, top);
     fastest2 = std::max(fastest2, e.speed * e.speed + 2 * s.gravity * top);
   }
+  // A moving obstacle drives the fluid at its surface's speed; a floating body starts at its own.
+  for (std::size_t k = 0; k < sim.obstacles.size(); ++k)
+    fastest2 = std::max(fastest2, std::pow(obstacle_peak_speed(sim, k), 2));
   if (s.gravity > 0) {
     // The depth the fluid fills: its volume over the container's section across g (the
     // container's volume over its extent along g), at most that extent.

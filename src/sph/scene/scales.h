@@ -30,7 +30,8 @@ struct SceneScales {
   /// the floor and the depth all the fluid (blocks and emitters' budgets) would fill, m.
   double head = 0;
   /// The expected largest speed: free fall from the highest fluid to the floor, sqrt(2 g H),
-  /// added (in energy) to a block's initial speed or an emitter's speed, m/s.
+  /// added (in energy) to a block's initial speed or an emitter's speed, or a moving obstacle's
+  /// surface speed (a prescribed motion's peak, a floating body's initial one) if larger, m/s.
   double max_speed = 0;
 };
 
@@ -43,8 +44,8 @@ double stiffness_for_speed(double speed);
 /// The default stiffness: stiffness_for_speed(kDesignSpeedFactor * s.max_speed).
 double default_stiffness(const SceneScales& s);
 
-/// The speed a wall must stop: the expected largest speed, or, when the scene has neither
-/// gravity nor initial motion, a tenth of the sound speed sqrt(stiffness) (the weakly
+/// The speed a wall must stop: the expected largest speed, or, when the scene has no gravity
+/// and nothing in it moves, a tenth of the sound speed sqrt(stiffness) (the weakly
 /// compressible model's own bound on speeds), m/s.
 double wall_impact_speed(const SceneScales& s, double stiffness);
 

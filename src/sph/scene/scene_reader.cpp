@@ -671,8 +671,9 @@ void resolve_defaults(const detail::ReadContext& ctx, SceneBody<D>& body, const 
   if (derived.stiffness) {
     if (!(s.max_speed > 0))
       ctx.fail("Fluid.stiffness",
-               "missing, and no default can be derived: the scene has no gravity and nothing moves initially, so no "
-               "speed sets the sound speed; give stiffness (typical: (10 v)^2 in m^2/s^2 for the largest speed v "
+               "missing, and no default can be derived: the scene has no gravity, and neither its fluid nor an "
+               "obstacle moves, so no speed sets the sound speed; give stiffness (typical: (10 v)^2 in m^2/s^2 for the "
+               "largest speed v "
                "expected)");
     sim.fluid.stiffness = default_stiffness(s);
     check_derived(ctx, "Fluid.stiffness", sim.fluid.stiffness,

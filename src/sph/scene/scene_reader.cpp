@@ -617,7 +617,8 @@ EmitterParams<D> read_emitter(ObjectReader& e, const SimulationParams<D>& sim) {
       e.find("emitEveryNSteps")
           ? static_cast<int>(e.integer("emitEveryNSteps", "an emission interval of at least 1 step", 1, 1'000'000'000))
           : 0;
-  em.max_particles = e.integer("maxParticles", "a positive particle budget", 1, 4'000'000'000LL);
+  em.max_particles =
+      e.integer("maxParticles", "a particle budget, a whole number from 1 to 4000000000", 1, 4'000'000'000LL);
   em.start_time = e.positive("emitStartTime", "a start time >= 0 in s", 0.0, true);
   em.end_time = e.positive("emitEndTime", "an end time > 0 in s", std::numeric_limits<double>::infinity());
   if (!inside<D>(em.origin, sim.container))

@@ -85,6 +85,23 @@ void check_obstacles_inside(const ReadContext& ctx, const SimulationParams<D>& s
       ctx.fail(where, fmt::format("the obstacle {} lies wholly outside the container {}: it can never touch the "
                                   "fluid; move it inside the container or remove it",
                                   box_text<D>(o), box_text<D>(c)));
+    if (obstacle_shape(sim, i)) {
+      // A floating polygon or mesh: clipping its box would not change the shape; moving it does.
+      Vec<D, double> shift{};
+      bool fits = true;
+      for (int d = 0; d < D; ++d) {
+        fits = fits && o.hi[d] - o.lo[d] <= c.hi[d] - c.lo[d];
+        shift[d] = o.lo[d] < c.lo[d] ? c.lo[d] - o.lo[d] : o.hi[d] > c.hi[d] ? c.hi[d] - o.hi[d] : 0.0;
+      }
+      const char* shape = D == 2 ? "polygon" : "mesh";
+      ctx.fail(where, fmt::format("a floating {} must start wholly inside the container {}, and this one reaches "
+                                  "{} (its bounding box); {}",
+                                  shape, box_text<D>(c), box_text<D>(o),
+                                  fits ? fmt::format("move it by {} ({})", point_text<D>(shift),
+                                                     D == 2 ? "add it to each vertex" : "add it to \"translation\"")
+                                       : fmt::format("it is larger than the container: make it smaller{}",
+                                                     D == 2 ? "" : " (\"scale\")")));
+    }
     Box<D> clipped;
     for (int d = 0; d < D; ++d) {
       clipped.lo[d] = std::max(o.lo[d], c.lo[d]);

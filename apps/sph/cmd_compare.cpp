@@ -1,6 +1,7 @@
 // `sph compare SCENE.json -o DIR`: runs the neighbor modes on one scene and reports speed,
 // accuracy against the standard run and the chaos floor, missed pairs, and images.
 
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -122,8 +123,9 @@ int compare(const CompareCliOptions& opt) {
     if (co.audit && result.has_boundary_particles)
       line += fmt::format(" (fluid-boundary {})", r.boundary_missed_pairs());
     if (!r.failure.empty()) line += "  FAILED: " + r.failure;
-    fmt::print(stderr, "{}\n", line);
+    fmt::print(stdout, "{}\n", line);  // (the results to stdout, as bench's tables)
   }
+  std::fflush(stdout);
   fmt::print(stderr, "  report: {}\n", (dir / "report.md").string());
   for (const RunRecord& r : result.runs)
     if (!r.failure.empty()) return kRunFailed;

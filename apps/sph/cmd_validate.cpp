@@ -1,6 +1,7 @@
 // `sph validate [--cases ...] [--quick] [-o DIR]`: runs the validation cases (dam break against
 // Martin & Moyce 1952, resolution study, hydrostatic tanks, conservation) and writes a report.
 
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <sstream>
@@ -78,10 +79,12 @@ int validate(const ValidateCliOptions& opt) {
   const ValidationResult result = run_validation(vo, progress);
   write_validation(dir, result);
 
+  // The results go to stdout (as bench's tables do), what happened around them to stderr.
   fmt::print(stderr, "sph: validated in {:.1f} s:\n", result.seconds);
   for (const ValidationCheck& c : result.checks)
-    fmt::print(stderr, "  {}  {}: {} = {:.4g} (target {}{})\n", c.pass ? "PASS" : "MISS", c.case_name, c.what, c.value,
+    fmt::print(stdout, "  {}  {}: {} = {:.4g} (target {}{})\n", c.pass ? "PASS" : "MISS", c.case_name, c.what, c.value,
                c.target, c.regression ? ", regression bound" : "");
+  std::fflush(stdout);
   fmt::print(stderr, "  report: {}\n", (dir / "report.md").string());
   if (!result.passed()) {
     std::size_t missed = 0;

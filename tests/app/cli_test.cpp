@@ -285,6 +285,10 @@ TEST_F(Cli, CompareWritesTheReportAndRefusesBadModes) {
                          "FluidBlocks[0].end=[0.2,0.4]", "-o", "cmp", "--no-progress"});
   ASSERT_EQ(ok.code, 0) << ok.err;
   EXPECT_CONTAINS(ok.err, "report");
+  // The results go to stdout (to stderr until 2026-12-07), one line per run, the status to stderr.
+  EXPECT_CONTAINS(ok.out, "  standard ");
+  EXPECT_CONTAINS(ok.out, "RMS divergence at end");
+  EXPECT_EQ(ok.err.find("RMS divergence"), std::string::npos) << ok.err;
   EXPECT_TRUE(fs::is_regular_file(work_ / "cmp" / "report.md"));
   EXPECT_TRUE(fs::is_regular_file(work_ / "cmp" / "frame_000020.png"));
   EXPECT_CONTAINS(read_file(work_ / "cmp" / "phases.csv"), "standard (perturbed)");
@@ -353,6 +357,15 @@ TEST_F(Cli, ValidateBoundariesNeedsTheBoundaryParticleDamBreakBeforeRunning) {
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_CONTAINS(r.err, "must say \"boundaryHandling\": \"particles\"");
   EXPECT_FALSE(fs::exists(work_ / "v"));
+}
+
+// sph validate's checks go to stdout, one line each, and its progress and status to stderr.
+TEST_F(Cli, ValidateWritesItsChecksToStdout) {
+  const Result r = sph({"validate", "--quick", "--cases", "conservation", "--no-progress", "-o", "v"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_CONTAINS(r.out, "  PASS  conservation: momentum drift");
+  EXPECT_EQ(r.err.find("PASS"), std::string::npos) << r.err;
+  EXPECT_CONTAINS(r.err, "sph: validated in");
 }
 
 TEST_F(Cli, SceneThatIsADirectory) {

@@ -43,7 +43,7 @@ done
 
 mkdir "$tmp/work"
 cd "$tmp/work"
-"$prefix/bin/sph" validate --quick --no-progress -o validate 2>validate.log || { cat validate.log; fail "sph validate --quick"; }
+"$prefix/bin/sph" validate --quick --no-progress -o validate >validate.log 2>&1 || { cat validate.log; fail "sph validate --quick"; }
 grep -qx "sph: scenes from $prefix/share/sph/scenes/validation" validate.log ||
   { cat validate.log; fail "sph validate did not read the installed scenes ($prefix/share/sph/scenes/validation)"; }
 "$prefix/bin/sph" bench --suite tank --size small --no-progress -o bench >bench.log 2>&1 || { cat bench.log; fail "sph bench --suite tank --size small"; }

@@ -38,7 +38,7 @@ namespace fs = std::filesystem;
 struct RenderCliOptions {
   std::string dir;
   std::optional<std::string> output;  // -o DIR (given empty: refused)
-  std::string color_by = "speed";
+  std::string color_by;               // empty: speed, or what the frames hold (below)
   std::string colormap;
   std::string range;
   std::string frames = "all";
@@ -76,9 +76,9 @@ std::pair<double, double> parse_range(const std::string& s) {
 
 int render(const RenderCliOptions& opt) {
   // Everything that can be refused is checked before anything is written.
-  const auto by = color_by_from_name(opt.color_by);
-  if (!by)
-    throw Error(fmt::format("unknown quantity \"{}\"; expected one of: {}", opt.color_by, color_by_names()),
+  std::optional<ColorBy> by;
+  if (!opt.color_by.empty() && !(by = color_by_from_name(opt.color_by)))
+    throw Error(fmt::format("unknown quantity \"{}\"; expected one of: {}, or none", opt.color_by, color_by_names()),
                 "--color-by");
   std::optional<Colormap> map;
   if (!opt.colormap.empty() && !(map = colormap_from_name(opt.colormap)))
@@ -102,6 +102,23 @@ int render(const RenderCliOptions& opt) {
       fmt::print(stderr, "sph: warning: {} has {} frames, fewer than the others; rendering the first {} of each\n",
                  r.dir.string(), r.frames.size(), count);
   const std::vector<std::size_t> frames = parse_frames(opt.frames, count);
+  if (!by) {
+    // Speed, unless the run left the velocities out (--fields): then the first quantity the
+    // frames hold, or one color when they hold positions only.
+    const FrameData first = read_frame(runs[0].frames[frames.front()]);
+    by = ColorBy::None;
+    for (const ColorBy q : kColorByAll)
+      if (first.field(color_by_field(q))) {
+        by = q;
+        break;
+      }
+    if (by != ColorBy::Speed)
+      fmt::print(stderr, "sph: the frames hold no velocities (the run left them out with --fields): {}\n",
+                 by == ColorBy::None ? std::string("every particle in one color")
+                                     : fmt::format("colored by {}", color_by_name(*by)));
+  }
+  const std::string coloring =
+      *by == ColorBy::None ? std::string("in one color") : fmt::format("colored by {}", color_by_name(*by));
 
   FrameStyle style;
   const bool several = runs.size() > 1;
@@ -134,8 +151,8 @@ int render(const RenderCliOptions& opt) {
              opt.dir,
              several ? fmt::format("{} runs side by side", runs.size()) : fmt::format("{}D", runs[0].dimension),
              opt.surface && runs[0].dimension == 3 ? std::string("the shaded free surface")
-             : opt.surface                         ? fmt::format("colored by {}, with the free surface", opt.color_by)
-                                                   : fmt::format("colored by {}", opt.color_by),
+             : opt.surface                         ? coloring + ", with the free surface"
+                                                   : coloring,
              out.string());
   Progress progress(
       static_cast<std::int64_t>(frames.size()),
@@ -195,8 +212,8 @@ std::function<int()> add_render_command(CLI::App& app) {
                   "Directory for the images and movie (default: DIR/render); the images and movie of an earlier "
                   "render there (frame_NNNNNN.png, movie.mp4) are replaced, other files are kept");
   cmd->add_option("--color-by", opt->color_by,
-                  "Color particles by speed, kinetic_energy, density, pressure or initial_position")
-      ->default_str("speed");
+                  "Color particles by speed, kinetic_energy, density, pressure or initial_position, or none (one "
+                  "color) (default: speed, or the first of these the frames hold; none if they hold positions only)");
   cmd->add_option("--colormap", opt->colormap, "Color map: turbo, viridis or coolwarm (default: by quantity)");
   cmd->add_option("--range", opt->range,
                   "Color range LO,HI (default: over the whole run, 0 or the 0.5th to the 99.5th percentile)")

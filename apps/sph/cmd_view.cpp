@@ -41,6 +41,11 @@ std::vector<ColorBy> parse_color_by(const std::vector<std::string>& items) {
     for (std::string name; std::getline(ss, name, ',');) {
       if (name.empty()) continue;
       const auto by = color_by_from_name(name);
+      if (by == ColorBy::None)
+        throw Error(fmt::format("none is sph render's; the page colors particles in one color when their frames hold "
+                                "no quantity; expected one or more of: {}",
+                                color_by_names()),
+                    "--color-by");
       if (!by)
         throw Error(fmt::format("unknown quantity \"{}\"; expected one of: {}", name, color_by_names()), "--color-by");
       out.push_back(*by);

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <sph/render/color_by.h>
 #include <sph/render/particles.h>
 
 #include "support/expect.h"
@@ -145,6 +146,36 @@ TEST_F(Render, TheChosenFieldCameraAndSizeAreUsed) {
   EXPECT_EQ(a.width, b.width);
   EXPECT_NE(a.rgb, b.rgb);  // another camera
   EXPECT_EQ(c.width, 320);  // initial position: a key, no color bar
+}
+
+// A run that left the velocities out (--fields) is colored by the first quantity its frames hold,
+// and one that kept positions only is drawn in one color, without a bar: `sph run` suggests
+// `sph render` for every run, and these were refused until 2026-12-07 ("no quantity can color
+// them"). `--color-by none` asks for one color; sph view, whose page does it by itself, refuses it.
+TEST_F(Render, FramesWithoutVelocitiesAreColoredByWhatTheyHoldOrInOneColor) {
+  run(kDamBreak, "rho", {"--fields", "density"});
+  run(kDamBreak, "pos", {"--fields", "none"});
+  const CommandResult a = sph({"render", "rho", "--frames", "-1", "--size", "160x120", "-o", "a", "--no-progress"});
+  ASSERT_EQ(a.code, 0) << a.err;
+  EXPECT_CONTAINS(a.err, "colored by density");
+  EXPECT_GT(load_png(tmp_.path() / "a" / "frame_000004.png").width, 160) << "a density color bar";
+  const CommandResult b =
+      sph({"render", "pos", "--frames", "-1", "--size", "160x120", "--flat", "-o", "b", "--no-progress"});
+  ASSERT_EQ(b.code, 0) << b.err;
+  EXPECT_CONTAINS(b.err, "every particle in one color");
+  const auto png = load_png(tmp_.path() / "b" / "frame_000004.png");
+  EXPECT_EQ(png.width, 160) << "no color bar";
+  std::size_t blue = 0;
+  for (std::size_t k = 0; k + 2 < png.rgb.size(); k += 3)
+    blue += png.rgb[k] == sph::kOneColor.r && png.rgb[k + 1] == sph::kOneColor.g && png.rgb[k + 2] == sph::kOneColor.b;
+  EXPECT_GT(blue, 200u) << "the particles' one color";
+  const CommandResult c = sph({"render", "rho", "--frames", "-1", "--size", "160x120", "--flat", "--color-by", "none",
+                               "-o", "c", "--no-progress"});
+  ASSERT_EQ(c.code, 0) << c.err;
+  EXPECT_EQ(load_png(tmp_.path() / "c" / "frame_000004.png").rgb, png.rgb) << "the same picture, asked for";
+  const CommandResult v = sph({"view", "pos", "--color-by", "none", "-o", "pos/view.html"});
+  EXPECT_EQ(v.code, 2) << v.err;
+  EXPECT_CONTAINS(v.err, "--color-by: none is sph render's");
 }
 
 TEST_F(Render, AMovieHasOneFramePerImage) {

@@ -29,6 +29,7 @@ constexpr Info kInfo[] = {
     {ColorBy::Density, "density", "density", "density"},
     {ColorBy::Pressure, "pressure", "pressure", "pressure"},
     {ColorBy::InitialPosition, "initial_position", "initial_position", "initial position", {}, {}, true},
+    {ColorBy::None, "none", "", "one color", {}, {}, true},
 };
 
 const Info& info(ColorBy by) {
@@ -60,7 +61,7 @@ const FrameField& require(const FrameData& frame, ColorBy by, const RunDirectory
                     "with --fields; they hold {}); {}, or run again with the field (sph view shows the "
                     "particles without one)",
                     name, color_by_name(by), held.empty() ? "positions only" : fmt::format("{}", fmt::join(held, ", ")),
-                    colorable.empty() ? std::string("no quantity can color them")
+                    colorable.empty() ? std::string("color them all alike with --color-by none")
                                       : fmt::format("color by {}", fmt::join(colorable, " or "))),
         run.dir.string());
   }
@@ -86,7 +87,7 @@ std::optional<ColorBy> color_by_from_name(std::string_view name) {
 
 std::string color_by_names() {
   std::string s;
-  for (const Info& i : kInfo) s += (s.empty() ? "" : ", ") + std::string(i.name);
+  for (const ColorBy by : kColorByAll) s += (s.empty() ? "" : ", ") + std::string(color_by_name(by));
   return s;
 }
 
@@ -100,13 +101,14 @@ std::string color_by_label(ColorBy by, int dimension) {
 
 std::string_view color_by_field(ColorBy by) { return info(by).field; }
 
-bool color_by_is_scalar(ColorBy by) { return by != ColorBy::InitialPosition; }
+bool color_by_is_scalar(ColorBy by) { return by != ColorBy::InitialPosition && by != ColorBy::None; }
 
 Colormap default_colormap(ColorBy by) {
   return by == ColorBy::Speed || by == ColorBy::KineticEnergy ? Colormap::Turbo : Colormap::Viridis;
 }
 
 std::vector<double> color_values(const FrameData& frame, ColorBy by, const RunDirectory& run) {
+  if (by == ColorBy::None) return std::vector<double>(frame.size, 0.0);
   const FrameField& f = require(frame, by, run);
   std::vector<double> out(frame.size);
   const std::vector<double>& v = f.values;
@@ -124,6 +126,8 @@ std::vector<double> color_values(const FrameData& frame, ColorBy by, const RunDi
         break;
       case ColorBy::InitialPosition:
         out[i] = v[3 * i + 1];
+        break;
+      case ColorBy::None:
         break;
     }
   }
@@ -161,7 +165,8 @@ Rgb initial_position_color(const std::array<double, 3>& x0, const std::array<dou
 }
 
 std::vector<Rgb> particle_colors(const FrameData& frame, const ColorSpec& spec, const RunDirectory& run) {
-  std::vector<Rgb> colors(frame.size);
+  std::vector<Rgb> colors(frame.size, kOneColor);
+  if (spec.by == ColorBy::None) return colors;
   if (spec.by == ColorBy::InitialPosition) {
     const std::vector<double>& x0 = require(frame, spec.by, run).values;
     for (std::size_t i = 0; i < frame.size; ++i)

@@ -20,25 +20,27 @@ enum class ColorBy {
   Density,          ///< kg/m^3 (kg/m^2 in 2D)
   Pressure,         ///< Pa (N/m in 2D)
   InitialPosition,  ///< not a scalar: red, green, blue from the initial x, y, z in the container
+  None,             ///< not a quantity: every particle in one color (frames that hold positions only)
 };
 
-/// Every quantity, in the order above.
+/// Every quantity, in the order above (not None).
 inline constexpr ColorBy kColorByAll[] = {ColorBy::Speed, ColorBy::KineticEnergy, ColorBy::Density, ColorBy::Pressure,
                                           ColorBy::InitialPosition};
 
 /// The quantity's name on the command line: "speed", "kinetic_energy", "density", "pressure",
 /// "initial_position".
 std::string_view color_by_name(ColorBy by);
-/// The quantity with this name, or nullopt.
+/// The quantity with this name ("none": ColorBy::None), or nullopt.
 std::optional<ColorBy> color_by_from_name(std::string_view name);
-/// "speed, kinetic_energy, density, pressure, initial_position" (for messages and --help).
+/// "speed, kinetic_energy, density, pressure, initial_position" (for messages and --help; not
+/// "none").
 std::string color_by_names();
 /// A legend label with the unit for this dimension, e.g. "speed (m/s)", "density (kg/m^2)".
 std::string color_by_label(ColorBy by, int dimension);
 /// The frame field the quantity is computed from ("velocity", "density", "pressure",
 /// "initial_position").
 std::string_view color_by_field(ColorBy by);
-/// False only for InitialPosition (colored by position, no color map, no legend bar).
+/// False for InitialPosition (colored by position) and None: no color map, no legend bar.
 bool color_by_is_scalar(ColorBy by);
 /// The color map that suits the quantity (Turbo for speed and energy, Viridis for density and
 /// pressure).
@@ -68,8 +70,12 @@ struct ColorSpec {
 Rgb initial_position_color(const std::array<double, 3>& x0, const std::array<double, 3>& lo,
                            const std::array<double, 3>& hi);
 
+/// The color of every particle with ColorBy::None: a water blue.
+inline constexpr Rgb kOneColor{60, 125, 205};
+
 /// One color per particle of `frame`: the map over [lo, hi] for scalars; for InitialPosition
-/// each channel grows with the initial coordinate across the container (x red, y green, z blue).
+/// each channel grows with the initial coordinate across the container (x red, y green, z blue);
+/// for None, kOneColor.
 /// Throws sph::Error as color_values does.
 std::vector<Rgb> particle_colors(const FrameData& frame, const ColorSpec& spec, const RunDirectory& run);
 

@@ -184,6 +184,7 @@ Image render_frame(std::span<const RunDirectory> runs, std::span<const FrameData
   if (color_by_is_scalar(style.color.by))
     return add_colorbar(img, style.color.map, style.color.lo, style.color.hi, color_by_label(style.color.by, dim),
                         style.view.background);
+  if (style.color.by == ColorBy::None) return img;     // one color: nothing to explain
   const int scale = style.view.height >= 380 ? 2 : 1;  // as add_colorbar chooses for its labels
   const std::string key = dim == 3 ? "color: initial x red, y green, z blue" : "color: initial x red, y green";
   draw_text(img, 8 * scale, img.height() - text_height(scale) - 6 * scale, key, kInk, scale);

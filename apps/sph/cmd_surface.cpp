@@ -54,6 +54,7 @@ int surface(SurfaceCliOptions opt) {
   if (opt.threads > 0) set_num_threads(opt.threads);
   const RunDirectory run = open_run_directory(opt.dir, frame_format);
   opt.settings.spacing = 2 * run.particle_radius;
+  opt.settings.clip = true, opt.settings.clip_lo = run.box_lo, opt.settings.clip_hi = run.box_hi;  // in the container
   if (const std::string e = surface_settings_error(opt.settings); !e.empty()) {
     const bool res = e.rfind("resolution", 0) == 0, smooth = e.rfind("smoothing", 0) == 0;
     throw Error(e, res ? "--resolution" : smooth ? "--smoothing" : e.rfind("iso", 0) == 0 ? "--iso" : opt.dir);

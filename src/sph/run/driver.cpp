@@ -45,9 +45,12 @@ RunDriver<D, R>::RunDriver(SceneDesc desc, RunSettings settings)
   SPH_CHECK(settings_.checkpoint_every == 0 || !settings_.dir.empty(), "RunDriver: checkpoints need a directory");
   SPH_CHECK(!settings_.surface || !settings_.dir.empty(), "RunDriver: surfaces need a directory");
   if (settings_.surface) {
-    settings_.surface->settings.spacing = 2 * sim_.params().particle_radius;
-    if (const std::string e = surface_settings_error(settings_.surface->settings); !e.empty())
-      throw Error(e, "--surface");
+    SurfaceSettings& s = settings_.surface->settings;
+    s.spacing = 2 * sim_.params().particle_radius;
+    s.clip = true;  // (kept inside the container)
+    for (int d = 0; d < D; ++d)
+      s.clip_lo[d] = sim_.params().container.lo[d], s.clip_hi[d] = sim_.params().container.hi[d];
+    if (const std::string e = surface_settings_error(s); !e.empty()) throw Error(e, "--surface");
   }
   if (!settings_.dir.empty()) {
     prepare_output_directory(settings_.dir);

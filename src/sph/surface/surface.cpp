@@ -247,6 +247,26 @@ class Extractor {
           }
         }
     for (int i = 0; i < kBlockVoxels<D>; ++i) acc[i] = std::max(acc[i], drop[static_cast<std::size_t>(i)]);
+    if (s_.clip) clip_block(lo, acc);
+  }
+
+  /// The container's cut (SurfaceSettings::clip): each value at most iso + d / (2 v), d the
+  /// voxel's distance inside the box (negative outside): iso on the walls, and above the fluid's
+  /// own values a voxel inside them.
+  void clip_block(const std::array<int, 3>& lo, float* acc) const {
+    const int nz = D == 3 ? kBlock : 1;
+    for (int z = 0; z < nz; ++z)
+      for (int y = 0; y < kBlock; ++y)
+        for (int x = 0; x < kBlock; ++x) {
+          const std::array<int, 3> i{lo[0] + x, lo[1] + y, lo[2] + z};
+          double d = std::numeric_limits<double>::infinity();
+          for (int a = 0; a < D; ++a) {
+            const double w = grid_.origin[a] + i[a] * grid_.v;
+            d = std::min({d, w - s_.clip_lo[a], s_.clip_hi[a] - w});
+          }
+          float& value = acc[local_index<D>(x, y, z)];
+          value = std::min(value, static_cast<float>(s_.iso + 0.5 * d / grid_.v));
+        }
   }
 
   /// The values at voxels [8 b, 8 b + 8] of active block k (its upper neighbors' first layers;

@@ -33,6 +33,12 @@ struct SurfaceSettings {
   double resolution = 2;  ///< voxels per spacing (voxel size s / resolution); 0.5 to 8
   double smoothing = 2;   ///< kernel support R in spacings; 1 to 4
   double iso = 0.5;       ///< the iso-value of the color field; 0.05 to 0.95
+  /// The container, when `clip`: the surface is kept inside it. The field is cut by the box's
+  /// walls (the sampled value is at most iso + d / (2 v), d the distance inside the box), so
+  /// water against a wall ends in a flat face on the wall instead of bulging through it (by up
+  /// to half a spacing where the outer particles crowd the wall). z is ignored in 2D.
+  bool clip = false;
+  std::array<double, 3> clip_lo{}, clip_hi{};
 };
 
 /// The reasons extract_surface refuses settings, as one message naming the flag's meaning

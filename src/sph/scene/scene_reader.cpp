@@ -347,9 +347,17 @@ void read_solver(ObjectReader& c, SimulationParams<D>& sim) {
       c.integer("minIterations", "DFSPH's least constant-density iterations, 0 to 10000", 0, 10000, p.min_iterations));
   p.max_iterations = static_cast<int>(
       c.integer("maxIterations", "DFSPH's most constant-density iterations, 1 to 10000", 1, 10000, p.max_iterations));
-  if (p.max_iterations < p.min_iterations)
-    c.ctx().fail(c.child("maxIterations"),
-                 fmt::format("maxIterations = {} is below minIterations = {}", p.max_iterations, p.min_iterations));
+  // (blamed on the key the scene gave; when it gave both, on maxIterations)
+  if (p.max_iterations < p.min_iterations) {
+    if (c.find("maxIterations"))
+      c.ctx().fail(c.child("maxIterations"),
+                   fmt::format("maxIterations = {} is below minIterations = {}; expected at least minIterations",
+                               p.max_iterations, p.min_iterations));
+    c.ctx().fail(c.child("minIterations"),
+                 fmt::format("minIterations = {} is above maxIterations = {} (its default); expected at most "
+                             "maxIterations, or give a larger maxIterations too",
+                             p.min_iterations, p.max_iterations));
+  }
   p.max_error = c.positive("maxError", "DFSPH's tolerance on the average compression, a positive % of the rest density",
                            p.max_error);
   p.divergence_solver = c.boolean("enableDivergenceSolver", "whether DFSPH runs its divergence solve", true);

@@ -35,6 +35,17 @@ inline CLI::Validator positive_number(const std::string& what) {
       "POSITIVE");
 }
 
+/// A CLI11 check that the value is not empty, for options whose absence means a default: given as
+/// "" (an unset shell variable, `--range "$RANGE"`) the option would otherwise be taken as left
+/// out. `expected` says what to give, e.g. "LO,HI with LO < HI, e.g. 0,2.5".
+inline CLI::Validator not_empty(const std::string& expected) {
+  return CLI::Validator(
+      [expected](std::string& text) -> std::string {
+        return text.empty() ? "an empty value; expected " + expected + ", or leave the option out" : std::string();
+      },
+      "");
+}
+
 /// A CLI11 check that the value is a number from `lo` to `hi` (a whole number if T is integral),
 /// with a message that says so: CLI11's CLI::Range says "Value abc not in range ..." for a value
 /// that is not a number at all.

@@ -138,10 +138,12 @@ std::function<int()> add_bench_command(CLI::App& app) {
       ->default_str("small");
   cmd->add_option("--threads", opt->threads,
                   "Comma-separated thread counts to run, e.g. 1,2 (default: 1 and the core count; more threads "
-                  "than cores are allowed and marked with *)");
+                  "than cores are allowed and marked with *)")
+      ->check(not_empty("comma-separated thread counts, e.g. 1,2"));
   cmd->add_option("--precision", opt->precisions,
                   "float, double or float,double (default: both; float only from 1M particles on; the tank runs "
-                  "the scene's own precision)");
+                  "the scene's own precision)")
+      ->check(not_empty("float, double or float,double"));
   cmd->add_option("--repeats", opt->repeats, "Timings per neighbors case and runs per tank mode (medians reported)")
       ->check(in_range(1, 1000))
       ->default_str("5");
@@ -170,7 +172,8 @@ std::function<int()> add_bench_command(CLI::App& app) {
                   "Tank suite: steps per run (default: the whole scene, 1000 at size small)")
       ->check(in_range(std::int64_t{1}, std::int64_t{1'000'000'000}));
   cmd->add_option("--scene-dir", opt->scene_dir,
-                  "Directory holding tank_fill_3d.json (default: the paper scenes installed with sph)");
+                  "Directory holding tank_fill_3d.json (default: the paper scenes installed with sph)")
+      ->check(not_empty("the directory holding tank_fill_3d.json"));
   cmd->add_flag("--no-progress", opt->no_progress, "No progress lines on stderr (the tables still go to stdout)");
   return [opt, cmd]() -> int {
     if (!cmd->parsed()) return kBadInput;

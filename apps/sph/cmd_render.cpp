@@ -213,10 +213,13 @@ std::function<int()> add_render_command(CLI::App& app) {
                   "render there (frame_NNNNNN.png, movie.mp4) are replaced, other files are kept");
   cmd->add_option("--color-by", opt->color_by,
                   "Color particles by speed, kinetic_energy, density, pressure or initial_position, or none (one "
-                  "color) (default: speed, or the first of these the frames hold; none if they hold positions only)");
-  cmd->add_option("--colormap", opt->colormap, "Color map: turbo, viridis or coolwarm (default: by quantity)");
+                  "color) (default: speed, or the first of these the frames hold; none if they hold positions only)")
+      ->check(not_empty("a quantity: " + color_by_names() + ", or none"));
+  cmd->add_option("--colormap", opt->colormap, "Color map: turbo, viridis or coolwarm (default: by quantity)")
+      ->check(not_empty("a color map: turbo, viridis or coolwarm"));
   cmd->add_option("--range", opt->range,
                   "Color range LO,HI (default: over the whole run, 0 or the 0.5th to the 99.5th percentile)")
+      ->check(not_empty("LO,HI with LO < HI, e.g. 0,2.5"))
       ->type_name("LO,HI");
   cmd->add_option("--frames", opt->frames,
                   "Frames to render: all, first, last, or numbers separated by commas (-1 is the last)")
@@ -224,6 +227,7 @@ std::function<int()> add_render_command(CLI::App& app) {
   cmd->add_option("--size", opt->size,
                   "Size of each panel, WIDTHxHEIGHT pixels (default: 1280x720, 640x480 side by side); the image adds a "
                   "caption row above and the color bar to the right")
+      ->check(not_empty("WIDTHxHEIGHT in pixels, e.g. 1280x720"))
       ->type_name("WxH");
   cmd->add_option("--azimuth", opt->azimuth, "3D camera: turn about the vertical axis, degrees")
       ->check(in_range(-360.0, 360.0))
@@ -236,7 +240,8 @@ std::function<int()> add_render_command(CLI::App& app) {
                 "Draw the fluid's free surface (sph surface's mesh, shaded) instead of particles; 2D: the surface "
                 "lines over the particles");
   cmd->add_option("--format", opt->format,
-                  "Which frames to read when the run wrote several formats: " + frame_format_list());
+                  "Which frames to read when the run wrote several formats: " + frame_format_list())
+      ->check(not_empty("a frame format: " + frame_format_list("", " or ")));
   cmd->add_flag("--mp4", opt->mp4, "Also encode the images as movie.mp4 in the output directory (needs ffmpeg)");
   cmd->add_option("--video-fps", opt->video_fps, "Frames per second of the movie")
       ->check(in_range(1.0, 240.0))

@@ -417,6 +417,7 @@ std::function<int()> add_run_command(CLI::App& app) {
                   "Continue the run in DIR from its checkpoint, bitwise identically to a run never interrupted; "
                   "only --steps (a new total), --threads, --checkpoint-every, --strict and --no-progress may be given "
                   "with it (the frame settings are the run's)")
+      ->check(not_empty("the output directory of the run to continue"))
       ->type_name("DIR");
   cmd->add_flag("--overwrite", opt->overwrite,
                 "Start the run even if the output directory holds an unfinished run's checkpoint (interrupted, "

@@ -135,7 +135,8 @@ std::function<int()> add_surface_command(CLI::App& app) {
       ->default_str("0.5")
       ->check(in_range(0.05, 0.95));
   cmd->add_option("--frame-format", opt->frame_format,
-                  "Which frames to read when the run wrote several formats: " + frame_format_list());
+                  "Which frames to read when the run wrote several formats: " + frame_format_list())
+      ->check(not_empty("a frame format: " + frame_format_list("", " or ")));
   cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(in_range(1, 4096));
   cmd->add_flag("--no-progress", opt->no_progress, "No progress output");
   return [opt, cmd]() -> int {

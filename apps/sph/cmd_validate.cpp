@@ -112,6 +112,7 @@ std::function<int()> add_validate_command(CLI::App& app) {
   cmd->add_option("-o,--output", opt->output, "Output directory (report.md, CSVs, plots)")
       ->default_str("out/validation");
   cmd->add_option("--scenes", opt->scenes, "Directory of the validation scenes")
+      ->check(not_empty("the directory of the validation scenes"))
       ->default_str("the validation scenes of sph's data: <prefix>/share/sph/scenes/validation");
   cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(in_range(1, 4096));
   cmd->add_flag("--no-progress", opt->no_progress, "No progress lines");

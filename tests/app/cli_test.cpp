@@ -171,6 +171,34 @@ TEST_F(Cli, MistypedCommandsAndValuesAreNamedAsWhatTheyAre) {
   EXPECT_FALSE(fs::exists(work_ / "out"));
 }
 
+// An option whose absence means a default, given an empty value (an unset shell variable), is
+// refused like any other bad value: until 2026-12-07 these took "" as left out (and `run
+// --resume ""` started a new run instead of continuing one).
+TEST_F(Cli, AnEmptyValueIsRefusedNotTakenAsLeftOut) {
+  good_run("r");
+  const std::vector<std::vector<std::string>> cases{{"render", "r", "--color-by", ""},
+                                                    {"render", "r", "--colormap", ""},
+                                                    {"render", "r", "--range", ""},
+                                                    {"render", "r", "--size", ""},
+                                                    {"render", "r", "--format", ""},
+                                                    {"surface", "r", "--frame-format", ""},
+                                                    {"run", "--resume", ""},
+                                                    {"bench", "--threads", ""},
+                                                    {"bench", "--precision", ""},
+                                                    {"bench", "--scene-dir", ""},
+                                                    {"validate", "--scenes", "", "-o", "v"}};
+  for (const auto& args : cases) {
+    const Result r = sph(args);
+    EXPECT_EQ(r.code, 2) << args[0] << " " << args[args.size() - 2];
+    EXPECT_EQ(count(r.err, "sph: error:"), 1u) << r.err;
+    EXPECT_CONTAINS(r.err, args[args[0] == "validate" ? 2 : args.size() - 2] + ": an empty value; expected ");
+  }
+  EXPECT_FALSE(fs::exists(work_ / "r" / "render"));
+  EXPECT_FALSE(fs::exists(work_ / "r" / "surface"));
+  EXPECT_FALSE(fs::exists(work_ / "v"));
+  EXPECT_FALSE(fs::exists(work_ / "out"));
+}
+
 TEST_F(Cli, UnknownNeighborModeFlag) {
   const Result r = sph({"run", kDamBreak, "--neighbors", "bogus", "-o", "o"});
   EXPECT_EQ(r.code, 2);

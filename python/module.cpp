@@ -82,7 +82,7 @@ void raise_as(const py::object& type, const Error& e, const py::object& key = {}
   PyErr_SetObject(type.ptr(), exc.ptr());
 }
 
-/// The key path a scene error's location names: "SOURCE (--set K): PATH" or "SOURCE: PATH" ->
+/// The key path a scene error's location names: "SOURCE (overrides[\"K\"]): PATH" or "SOURCE: PATH" ->
 /// PATH; None for an error of the whole file (or of its syntax: "SOURCE:LINE:COL").
 py::object scene_key(const Error& e) {
   const std::string& where = e.where();

@@ -34,7 +34,7 @@ std::string json_text(const py::handle& value) {
 
 /// The scene read from `text` (named `source` in messages) with `overrides`, or a SceneError.
 SceneDesc parse(const std::string& text, const std::string& source, const std::vector<std::string>& overrides) {
-  return reading_scene([&] { return parse_scene(text, source, overrides); });
+  return reading_scene([&] { return parse_scene(text, source, overrides, OverrideNaming::Python); });
 }
 
 py::object scene_dict(const SceneDesc& desc) { return py::module_::import("json").attr("loads")(scene_text(desc)); }
@@ -129,7 +129,7 @@ Raises sph.SceneError (key path in `where`) for anything the reader refuses.)doc
       [](const py::object& path_obj, const py::object& overrides) {
         const std::string path = path_arg(path_obj, "path");
         const std::vector<std::string> sets = override_strings(overrides);
-        return Scene{reading_scene([&] { return read_scene_file(path, sets); })};
+        return Scene{reading_scene([&] { return read_scene_file(path, sets, OverrideNaming::Python); })};
       },
       py::arg("path"), py::arg("overrides") = py::none(),
       R"doc(Reads the scene file `path` with the strict reader of `sph run`.

@@ -44,7 +44,12 @@ def test_a_misspelt_key_names_its_path_with_the_message_of_sph_run(tmp_path):
 def test_bad_values_and_overrides(small_2d):
     with pytest.raises(sph.SceneError) as e:
         sph.load_scene(DAM_BREAK, overrides={"Fluid.density0": -5})
-    assert e.value.key == "Fluid.density0" and "--set Fluid.density0" in e.value.where
+    # Named as the argument that gave the value (as "--set KEY" until 2026-12-07, the CLI's flag).
+    assert e.value.key == "Fluid.density0" and 'overrides["Fluid.density0"]' in e.value.where
+    assert "--set" not in str(e.value)
+    with pytest.raises(sph.SceneError) as e:
+        sph.load_scene(DAM_BREAK, overrides={"FluidBlocks[3].end": [1, 1]})
+    assert str(e.value).startswith('overrides["FluidBlocks[3].end"]: ') and "index 3 does not exist" in str(e.value)
     with pytest.raises(sph.SceneError) as e:
         small_2d.with_overrides({"Configuration.neighbors": "fastest"})
     assert e.value.key == "Configuration.neighbors"

@@ -13,7 +13,7 @@ void ReadContext::fail(const std::string& path, const std::string& message) cons
   };
   for (const auto& o : overridden)
     if (within(path, o) || (!path.empty() && within(o, path))) {
-      where = source + " (--set " + o + ")";
+      where = source + " (" + override_name(naming, o) + ")";
       break;
     }
   if (!path.empty()) where += ": " + path;

@@ -15,6 +15,7 @@
 
 #include <sph/core/vec.h>
 #include <sph/scene/json_source.h>
+#include <sph/scene/overrides.h>
 
 namespace sph::detail {
 
@@ -27,6 +28,8 @@ struct ReadContext {
   std::map<std::string, nlohmann::json> replaced;
   /// Appended to every message (set for the check of a replaced value).
   std::string note;
+  /// How the overrides are named in messages (--set KEY, or the Python module's overrides).
+  OverrideNaming naming = OverrideNaming::Flag;
 
   /// Throws sph::Error(message) whose where() names the source, the --set flag that gave the
   /// value (if `path` is, or is within or around, an overridden path) and `path`.
@@ -93,7 +96,10 @@ class ObjectReader {
     if (it == ctx_.replaced.end()) return;
     ReadContext file;
     file.source = ctx_.source;
-    file.note = " (the value in the scene file, which a flag overrides; it must be valid too)";
+    file.naming = ctx_.naming;
+    file.note = ctx_.naming == OverrideNaming::Flag
+                    ? " (the value in the scene file, which a flag overrides; it must be valid too)"
+                    : " (the value in the scene, which an override replaces; it must be valid too)";
     const json one = {{key, it->second}};
     ObjectReader r(one, path_, file, {key});
     read(r);

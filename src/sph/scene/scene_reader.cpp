@@ -791,13 +791,15 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
 
 }  // namespace
 
-SceneDesc parse_scene(const std::string& text, const std::string& source, const std::vector<std::string>& overrides) {
+SceneDesc parse_scene(const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
+                      OverrideNaming naming) {
   json doc = detail::parse_json(text, source);
   if (!doc.is_object())
     throw Error("expected a JSON object { ... } at the top level, got " + detail::describe(doc), source);
   detail::ReadContext ctx;
   ctx.source = source;
-  ctx.overridden = detail::apply_overrides(doc, overrides, &ctx.replaced);
+  ctx.naming = naming;
+  ctx.overridden = detail::apply_overrides(doc, overrides, &ctx.replaced, naming);
   SceneDesc desc;
   desc.source = source;
   ObjectReader root(doc, "", ctx, detail::kRootKeys);
@@ -843,8 +845,8 @@ std::string read_scene_text(const std::string& path) {
   return text;
 }
 
-SceneDesc read_scene_file(const std::string& path, const std::vector<std::string>& overrides) {
-  return parse_scene(read_scene_text(path), path, overrides);
+SceneDesc read_scene_file(const std::string& path, const std::vector<std::string>& overrides, OverrideNaming naming) {
+  return parse_scene(read_scene_text(path), path, overrides, naming);
 }
 
 }  // namespace sph

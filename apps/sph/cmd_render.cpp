@@ -119,6 +119,12 @@ int render(const RenderCliOptions& opt) {
   }
   const std::string coloring =
       *by == ColorBy::None ? std::string("in one color") : fmt::format("colored by {}", color_by_name(*by));
+  if (!color_by_is_scalar(*by))
+    for (const auto& [flag, given] : {std::pair{"--range", !opt.range.empty()}, {"--colormap", !opt.colormap.empty()}})
+      if (given)
+        fmt::print(
+            stderr, "sph: warning: {}: particles {} take no color map: it is ignored\n", flag,
+            *by == ColorBy::None ? std::string("in one color") : "colored by " + std::string(color_by_name(*by)));
 
   FrameStyle style;
   const bool several = runs.size() > 1;

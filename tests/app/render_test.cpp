@@ -159,10 +159,11 @@ TEST_F(Render, FramesWithoutVelocitiesAreColoredByWhatTheyHoldOrInOneColor) {
   ASSERT_EQ(a.code, 0) << a.err;
   EXPECT_CONTAINS(a.err, "colored by density");
   EXPECT_GT(load_png(tmp_.path() / "a" / "frame_000004.png").width, 160) << "a density color bar";
-  const CommandResult b =
-      sph({"render", "pos", "--frames", "-1", "--size", "160x120", "--flat", "-o", "b", "--no-progress"});
+  const CommandResult b = sph(
+      {"render", "pos", "--frames", "-1", "--size", "160x120", "--flat", "--range", "0,1", "-o", "b", "--no-progress"});
   ASSERT_EQ(b.code, 0) << b.err;
   EXPECT_CONTAINS(b.err, "every particle in one color");
+  EXPECT_CONTAINS(b.err, "sph: warning: --range: particles in one color take no color map: it is ignored");
   const auto png = load_png(tmp_.path() / "b" / "frame_000004.png");
   EXPECT_EQ(png.width, 160) << "no color bar";
   std::size_t blue = 0;

@@ -194,8 +194,13 @@ TEST_F(RunDirectory, ANewRunRemovesTheEarlierRunsPicturesAndKeepsOtherFiles) {
   EXPECT_TRUE(fs::exists(at("d") / "render")) << "render/notes.txt is still there";
   fs::remove(at("d") / "render" / "notes.txt");
   spit(at("d") / "render" / "frame_000000.png", "x");
+  // A killed render's hidden files (its process gone) go too; a running one's would stay.
+  fs::create_directories(at("d") / "render" / ".sph-staging-999999999");
+  spit(at("d") / "render" / ".sph-staging-999999999" / "frame_000003.png", "x");
+  fs::create_directories(at("d") / "surface" / ".sph-staging-999999998");
   run("d", 5);
   EXPECT_FALSE(fs::exists(at("d") / "render"));
+  EXPECT_FALSE(fs::exists(at("d") / "surface"));
 }
 
 TEST_F(RunDirectory, RenderRemovesOnlyTheFilesARenderMakes) {

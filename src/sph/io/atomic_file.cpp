@@ -78,8 +78,8 @@ void make_writable_directory(const std::filesystem::path& dir, std::string_view 
 
 namespace {
 constexpr std::string_view kStagePrefix = ".sph-staging-";
+}  // namespace
 
-/// Removes the hidden directories that killed processes left in `dir` (their PID no longer runs).
 void remove_abandoned_stages(const std::filesystem::path& dir) {
   std::error_code ec;
   for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
@@ -91,7 +91,6 @@ void remove_abandoned_stages(const std::filesystem::path& dir) {
     if (pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH) std::filesystem::remove_all(entry.path(), ec);
   }
 }
-}  // namespace
 
 StagedFiles::StagedFiles(std::filesystem::path dir, std::function<bool(const std::string&)> is_member,
                          std::string_view purpose)

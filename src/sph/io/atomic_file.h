@@ -63,6 +63,10 @@ class StagedFiles {
   bool committed_ = false;
 };
 
+/// Removes the hidden directories of StagedFiles in `dir` whose process no longer runs (a
+/// render or surface killed before it finished); nothing else.
+void remove_abandoned_stages(const std::filesystem::path& dir);
+
 /// A fresh temporary name next to `path` (".NAME.tmpPID-N"), for files another program writes
 /// before they are renamed into place; prepare_output_directory removes such names left behind.
 std::filesystem::path temporary_path(const std::filesystem::path& path);

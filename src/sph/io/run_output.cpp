@@ -139,8 +139,10 @@ void prepare_output_directory(const fs::path& dir) {
   remove_stale_temporaries(dir / "frames");
   // Remove what a previous run left, so that frames of two runs are never mixed.
   for (const fs::path& f : files_a_run_replaces(dir)) fs::remove(f, ec);
-  for (const char* sub : {"render", "surface"})
+  for (const char* sub : {"render", "surface"}) {
+    remove_abandoned_stages(dir / sub);  // (a killed render's or surface's hidden files)
     if (fs::is_empty(dir / sub, ec)) fs::remove(dir / sub, ec);
+  }
 }
 
 template <int D, std::floating_point R>

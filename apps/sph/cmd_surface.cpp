@@ -53,8 +53,7 @@ int surface(SurfaceCliOptions opt) {
   if (opt.output) check_output_path(*opt.output, "-o/--output");
   if (opt.threads > 0) set_num_threads(opt.threads);
   const RunDirectory run = open_run_directory(opt.dir, frame_format);
-  opt.settings.spacing = 2 * run.particle_radius;
-  opt.settings.clip = true, opt.settings.clip_lo = run.box_lo, opt.settings.clip_hi = run.box_hi;  // in the container
+  fit_to_run(opt.settings, run.particle_radius, run.box_lo, run.box_hi);
   if (const std::string e = surface_settings_error(opt.settings); !e.empty()) {
     const bool res = e.rfind("resolution", 0) == 0, smooth = e.rfind("smoothing", 0) == 0;
     throw Error(e, res ? "--resolution" : smooth ? "--smoothing" : e.rfind("iso", 0) == 0 ? "--iso" : opt.dir);

@@ -150,8 +150,7 @@ Image render_frame(std::span<const RunDirectory> runs, std::span<const FrameData
     SurfaceMesh mesh;
     if (style.surface) {
       SurfaceSettings settings = style.surface_settings;
-      settings.spacing = 2 * run.particle_radius;
-      settings.clip = true, settings.clip_lo = run.box_lo, settings.clip_hi = run.box_hi;  // kept inside the container
+      fit_to_run(settings, run.particle_radius, run.box_lo, run.box_hi);
       mesh = extract_surface(frame.position, run.dimension, settings);
     }
     if (style.surface && run.dimension == 3) {

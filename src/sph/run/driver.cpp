@@ -46,10 +46,10 @@ RunDriver<D, R>::RunDriver(SceneDesc desc, RunSettings settings)
   SPH_CHECK(!settings_.surface || !settings_.dir.empty(), "RunDriver: surfaces need a directory");
   if (settings_.surface) {
     SurfaceSettings& s = settings_.surface->settings;
-    s.spacing = 2 * sim_.params().particle_radius;
-    s.clip = true;  // (kept inside the container)
-    for (int d = 0; d < D; ++d)
-      s.clip_lo[d] = sim_.params().container.lo[d], s.clip_hi[d] = sim_.params().container.hi[d];
+    const SimulationParams<D>& p = sim_.params();
+    std::array<double, 3> lo{}, hi{};
+    for (int d = 0; d < D; ++d) lo[d] = p.container.lo[d], hi[d] = p.container.hi[d];
+    fit_to_run(s, p.particle_radius, lo, hi);
     if (const std::string e = surface_settings_error(s); !e.empty()) throw Error(e, "--surface");
   }
   if (!settings_.dir.empty()) {

@@ -64,7 +64,7 @@ void check_utf8(const std::string& text, const std::string& source) {
 /// (strings, numbers, brackets, commas), run only after the parser refused the text.
 struct JsonSpots {
   std::size_t repeated_key = std::string::npos;
-  std::size_t overflow = std::string::npos;
+  std::size_t overflow = std::string::npos, overflow_end = std::string::npos;  // [overflow, overflow_end)
 };
 
 JsonSpots find_spots(const std::string& text) {
@@ -93,7 +93,7 @@ JsonSpots find_spots(const std::string& text) {
       while (k < n && std::string_view("+-.eE0123456789").find(text[k]) != std::string_view::npos) ++k;
       if (!std::isfinite(std::strtod(text.substr(begin, k - begin).c_str(), nullptr)) &&
           spots.overflow == std::string::npos)
-        spots.overflow = begin;
+        spots.overflow = begin, spots.overflow_end = k;
       continue;
     }
     if (c == '{' || c == '[')
@@ -165,14 +165,12 @@ json parse_json(const std::string& text, const std::string& source) {
     // For example a number too large for a double (1e999).
     std::string what = e.what();
     const auto pos = what.find("] ");
-    const std::size_t at = find_spots(text).overflow;
-    if (what.find("number overflow") != std::string::npos && at != std::string::npos) {
-      std::size_t end = at;
-      while (end < text.size() && std::string_view("+-.eE0123456789").find(text[end]) != std::string_view::npos) ++end;
-      throw Error(fmt::format("the number {} is beyond a double's range; expected a magnitude below 1.8e308",
-                              text.substr(at, std::min<std::size_t>(end - at, 40))),
-                  where(text, source, at));
-    }
+    const JsonSpots spots = find_spots(text);
+    if (what.find("number overflow") != std::string::npos && spots.overflow != std::string::npos)
+      throw Error(
+          fmt::format("the number {} is beyond a double's range; expected a magnitude below 1.8e308",
+                      text.substr(spots.overflow, std::min<std::size_t>(spots.overflow_end - spots.overflow, 40))),
+          where(text, source, spots.overflow));
     throw Error("invalid JSON: " + (pos == std::string::npos ? what : what.substr(pos + 2)), source);
   }
 }

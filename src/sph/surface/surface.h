@@ -41,6 +41,17 @@ struct SurfaceSettings {
   std::array<double, 3> clip_lo{}, clip_hi{};
 };
 
+/// Sets `s` for a run's particles: the spacing 2 `particle_radius`, and kept inside the container
+/// [lo, hi] (clip). Every surface of a run's frames is made with it (sph surface, sph render
+/// --surface, sph run --surface).
+inline void fit_to_run(SurfaceSettings& s, double particle_radius, const std::array<double, 3>& lo,
+                       const std::array<double, 3>& hi) {
+  s.spacing = 2 * particle_radius;
+  s.clip = true;
+  s.clip_lo = lo;
+  s.clip_hi = hi;
+}
+
 /// The reasons extract_surface refuses settings, as one message naming the flag's meaning
 /// ("resolution must be ..."); empty if `s` is valid.
 std::string surface_settings_error(const SurfaceSettings& s);

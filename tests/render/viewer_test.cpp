@@ -10,6 +10,7 @@
 #include <numeric>
 #include <random>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -278,6 +279,48 @@ TEST(ViewerPage, CompareDirectoryGivesOnePanelPerRun) {
   EXPECT_EQ(data["runs"][1]["frames"].size(), 5u);
 }
 
+/// The --max-frames N that a too-large page's message suggests gives a page within the limit,
+/// when an obstacle's shape (a polygon of 1,500 vertices here) goes into the page too: the
+/// estimate counts the shapes.
+TEST(ViewerPage, TheSuggestedMaxFramesFitsWithALargeShape) {
+  test::TempDir dir;
+  std::string polygon;
+  for (int k = 0; k < 1500; ++k) {
+    const double a = 2 * std::numbers::pi * k / 1500;
+    polygon += fmt::format("{}[{:.6f}, {:.6f}]", k ? ", " : "", 0.45 + 0.08 * std::cos(a), 0.2 + 0.08 * std::sin(a));
+  }
+  test::spit(dir.path() / "scene.json", R"({
+    "version": 1, "name": "shape", "dimension": 2,
+    "Configuration": { "particleRadius": 0.0025 },
+    "Container": { "start": [0, 0], "end": [0.6, 0.4] },
+    "Obstacles": [ { "polygon": [)" + polygon +
+                                            R"(] } ],
+    "FluidBlocks": [ { "start": [0, 0], "end": [0.3, 0.2] } ]
+  })");
+  const fs::path out = dir.path() / "run";
+  const auto r = test::run_sph({"run", (dir.path() / "scene.json").string(), "-o", out.string(), "--steps", "40",
+                                "--set", "Configuration.outputEveryNSteps=2", "--no-progress"},
+                               dir.path(), dir.path() / "err.txt");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const ViewPage whole = build_view_page(out, ViewOptions{});
+  ASSERT_EQ(whole.frames_shown, 21u);
+  ViewOptions limited;
+  limited.max_bytes = whole.html.size() * 3 / 5;
+  std::string refused;
+  try {
+    build_view_page(out, limited);
+  } catch (const Error& e) {
+    refused = e.what();
+  }
+  const std::size_t at = refused.find("--max-frames ");
+  ASSERT_NE(at, std::string::npos) << refused;
+  limited.max_frames = std::stoul(refused.substr(at + 13));
+  ASSERT_GE(limited.max_frames, 2u) << refused;
+  ASSERT_LT(limited.max_frames, 21u) << refused;
+  const ViewPage fits = build_view_page(out, limited);  // throws if the page is above the limit
+  EXPECT_LE(fits.html.size(), limited.max_bytes);
+}
+
 TEST(ViewerPage, Errors) {
   test::TempDir dir;
   const auto message = [](const auto& f) {
@@ -318,6 +361,17 @@ TEST(ViewerPage, Errors) {
   EXPECT_EQ(message([&] { build_view_page(dam_run(), half); }).find("would be about"), std::string::npos);
   half.max_frames = n + 1;
   EXPECT_NE(message([&] { build_view_page(dam_run(), half); }).find("would be about"), std::string::npos);
+  // A limit that not even two frames of the run fit: no --max-frames N to suggest (two is the
+  // fewest it keeps), but a --max-size that two frames fit.
+  ViewOptions tiny;
+  tiny.max_bytes = 1;
+  const std::string no_fit = message([&] { build_view_page(dam_run(), tiny); });
+  EXPECT_EQ(no_fit.find("or fewer"), std::string::npos) << no_fit;
+  const std::size_t size_at = no_fit.find("--max-size (to at least ");
+  ASSERT_NE(size_at, std::string::npos) << no_fit;
+  tiny.max_bytes = static_cast<std::size_t>(std::stod(no_fit.substr(size_at + 24)) * 1e6);
+  tiny.max_frames = 2;
+  EXPECT_EQ(message([&] { build_view_page(dam_run(), tiny); }).find("would be about"), std::string::npos);
 }
 
 }  // namespace

@@ -195,24 +195,34 @@ PageQuantities page_quantities(const std::vector<ColorBy>& asked, const std::vec
 /// Refuses, before the frames are read, a page whose estimated size is above options.max_bytes.
 void check_page_estimate(const fs::path& dir, const ViewOptions& options,
                          const std::vector<std::vector<std::size_t>>& picks, const PageQuantities& q, int dim,
-                         std::size_t max_particles, std::size_t pose_bytes) {
+                         std::size_t max_particles, std::size_t pose_bytes, std::size_t shape_bytes) {
   const std::size_t runs = picks.size();
   std::size_t frames = 0;
   for (const auto& p : picks) frames += p.size();
   const std::size_t per_particle = 2 * static_cast<std::size_t>(dim) + q.scalars.size();
   // What each frame adds, and what the page holds whatever the frames.
   const std::size_t per_frame = base64_size(per_particle * max_particles) + 100 + pose_bytes;
-  const std::size_t fixed = (q.rgb ? base64_size(3 * max_particles) * runs : 0) + detail::viewer_html().size() +
-                            detail::viewer_css().size() + detail::viewer_js().size();
+  const std::size_t fixed = (q.rgb ? base64_size(3 * max_particles) * runs : 0) + shape_bytes +
+                            detail::viewer_html().size() + detail::viewer_css().size() + detail::viewer_js().size();
   const std::size_t estimate = per_frame * frames + fixed;
   if (estimate <= options.max_bytes) return;
   // --max-frames keeps up to N frames of each run.
   const std::size_t fit = options.max_bytes > fixed ? (options.max_bytes - fixed) / (per_frame * runs) : 0;
-  throw Error(fmt::format("the page would be about {:.0f} MB ({} frames of up to {} particles), more than the "
-                          "limit of {:.0f} MB; use --max-frames {} (or fewer), fewer quantities with --color-by, "
-                          "or raise the limit with --max-size",
-                          static_cast<double>(estimate) / 1e6, frames, max_particles,
-                          static_cast<double>(options.max_bytes) / 1e6, std::max<std::size_t>(2, fit)),
+  const std::string what = fmt::format(
+      "the page would be about {:.3g} MB ({} frames of up to {} particles), more "
+      "than the limit of {:.3g} MB",
+      static_cast<double>(estimate) / 1e6, frames, max_particles, static_cast<double>(options.max_bytes) / 1e6);
+  if (fit >= 2)
+    throw Error(fmt::format("{}; use --max-frames {} (or fewer), fewer quantities with --color-by, or raise the "
+                            "limit with --max-size",
+                            what, fit),
+                dir.string());
+  // Not even the least a page shows, two frames of each run, fits: --max-frames cannot help.
+  const double least = static_cast<double>(per_frame * 2 * runs + fixed) / 1e6;
+  throw Error(fmt::format("{}; even 2 frames of each run (the fewest --max-frames keeps) would be about {:.1f} MB: "
+                          "raise the limit with --max-size (to at least {:.0f}), or use fewer quantities with "
+                          "--color-by",
+                          what, least, std::ceil(least)),
               dir.string());
 }
 
@@ -454,8 +464,9 @@ std::string obstacles_json(const RunDirectory& run) {
 
 /// The data block: the header (scene, boxes, obstacles, colorings, notes) around the runs, which
 /// are freed.
-std::string data_json(const RunDirectory& run0, const QuantBox& qb, const std::string& colors,
-                      const std::string& default_color, const std::vector<std::string>& page_notes, std::string& runs) {
+std::string data_json(const RunDirectory& run0, const std::string& obstacles, const QuantBox& qb,
+                      const std::string& colors, const std::string& default_color,
+                      const std::vector<std::string>& page_notes, std::string& runs) {
   std::string notes = "[";
   for (const std::string& n : page_notes) notes += (notes.size() > 1 ? "," : "") + json_string(n);
   notes += ']';
@@ -464,8 +475,8 @@ std::string data_json(const RunDirectory& run0, const QuantBox& qb, const std::s
       "\"box\":{{\"lo\":{},\"hi\":{}}},\"obstacles\":{},\"qbox\":{{\"lo\":{},\"hi\":{}}},\"radius\":{},"
       "\"colors\":{},\"defaultColor\":\"{}\",\"notes\":{},\"runs\":",
       json_string(run0.scene.name), json_string(run0.scene.description), run0.dimension, json_vec3(run0.box_lo),
-      json_vec3(run0.box_hi), obstacles_json(run0), json_vec3(qb.lo), json_vec3(qb.hi),
-      json_number(run0.particle_radius), colors, default_color, notes);
+      json_vec3(run0.box_hi), obstacles, json_vec3(qb.lo), json_vec3(qb.hi), json_number(run0.particle_radius), colors,
+      default_color, notes);
   data += runs;
   runs.clear();
   runs.shrink_to_fit();
@@ -495,7 +506,9 @@ ViewPage build_view_page(const fs::path& dir, const ViewOptions& options) {
   // characters each.
   const std::size_t pose_bytes =
       obstacles_move(run0) ? 400 * run0.scene.visit_body([](const auto& b) { return b.sim.obstacles.size(); }) : 0;
-  check_page_estimate(dir, options, picks, q, run0.dimension, max_particles, pose_bytes);
+  // The obstacles' shapes (a mesh's every vertex and triangle) go into the page once.
+  const std::string obstacles = obstacles_json(run0);
+  check_page_estimate(dir, options, picks, q, run0.dimension, max_particles, pose_bytes, obstacles.size());
 
   // Read every kept frame once: positions quantized now, scalars kept until their run-wide
   // range is known. The range comes from a sample of at most ~4 million values per quantity
@@ -523,7 +536,7 @@ ViewPage build_view_page(const fs::path& dir, const ViewOptions& options) {
                     page.frames_shown, page.frames_total));
   const std::string default_color = !q.all.empty() ? std::string(color_by_name(q.all.front())) : "uniform";
   const std::string data =
-      data_json(run0, qb, colors_json(offered, q.rgb, run0.dimension), default_color, page.notes, runs_part);
+      data_json(run0, obstacles, qb, colors_json(offered, q.rgb, run0.dimension), default_color, page.notes, runs_part);
 
   const std::string html_title = html_escape(run0.scene.name) + " - sph view";
   const std::string generator = html_escape(options.generator);
@@ -533,7 +546,7 @@ ViewPage build_view_page(const fs::path& dir, const ViewOptions& options) {
                                                     {"SPH_DATA", data},
                                                     {"SPH_JS", detail::viewer_js()}});
   if (page.html.size() > options.max_bytes)
-    throw Error(fmt::format("the page is {:.0f} MB, more than the limit of {:.0f} MB; use a smaller --max-frames, "
+    throw Error(fmt::format("the page is {:.3g} MB, more than the limit of {:.3g} MB; use a smaller --max-frames, "
                             "fewer quantities with --color-by, or raise the limit with --max-size",
                             static_cast<double>(page.html.size()) / 1e6, static_cast<double>(options.max_bytes) / 1e6),
                 dir.string());

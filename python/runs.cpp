@@ -155,11 +155,7 @@ py::dict compare_scene(const Scene& scene, const py::object& output, const py::o
   if (!modes.is_none()) {
     co.modes.clear();
     for (const std::string& name : names_arg(modes, "modes")) {
-      const NeighborMode m = parse_neighbor_mode(name, "modes");
-      if (!neighbor_mode_info(m).compared)
-        throw Error(name + " is not compared (too slow to time); expected some of " +
-                        join_neighbor_mode_names(NeighborModeSet::Compared, ", ", " or "),
-                    "modes");
+      const NeighborMode m = parse_neighbor_mode(name, "modes", NeighborModeSet::Compared);
       if (std::find(co.modes.begin(), co.modes.end(), m) != co.modes.end())
         throw Error("mode \"" + name + "\" is listed twice", "modes");
       co.modes.push_back(m);

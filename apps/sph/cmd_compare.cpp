@@ -53,11 +53,7 @@ std::vector<NeighborMode> parse_modes(const std::string& list) {
       throw Error("empty mode name in \"" + list + "\"; expected e.g. " +
                       join_neighbor_mode_names(NeighborModeSet::Compared, ",", ","),
                   "--modes");
-    const NeighborMode m = parse_neighbor_mode(item, "--modes");
-    if (m == NeighborMode::BruteForce)
-      throw Error("brute_force is the test oracle, too slow to compare; expected " +
-                      join_neighbor_mode_names(NeighborModeSet::Compared, ", ", " or "),
-                  "--modes");
+    const NeighborMode m = parse_neighbor_mode(item, "--modes", NeighborModeSet::Compared);
     if (std::find(modes.begin(), modes.end(), m) != modes.end())
       throw Error("mode \"" + item + "\" is listed twice", "--modes");
     modes.push_back(m);

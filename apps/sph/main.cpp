@@ -15,9 +15,11 @@
 #include <fmt/ranges.h>
 #include <CLI/CLI.hpp>
 
+#include <sph/analysis/validation.h>
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
 #include <sph/core/version.h>
+#include <sph/neighbors/neighbor_mode.h>
 
 #include "commands.h"
 
@@ -64,30 +66,35 @@ static void default_to_short_spin(char** argv) {
 int main(int argc, char** argv) {
   default_to_short_spin(argv);
   using namespace sph::app;
-  CLI::App app{
+  // The synopsis names the modes and cases from their tables, so that it lists every one.
+  const std::string synopsis = fmt::format(
       "sph: Smoothed Particle Hydrodynamics fluids in 2D and 3D with adaptive neighbor pairing.\n\n"
-      "  sph run SCENE.json [-o DIR] [--neighbors standard|adaptive|verlet] [--steps N] [--threads N]\n"
+      "  sph run SCENE.json [-o DIR] [--neighbors MODE] [--steps N] [--threads N]\n"
       "                     [--set KEY=VALUE]... [--checkpoint-every N] [--strict]   run a scene (sph run --help);\n"
       "                     health warnings end it \"completed with warnings\" (--strict: failed, exit 1)\n"
       "  sph run --resume DIR [--steps N]   continue an interrupted run from its checkpoint (or a\n"
       "                     finished one further: --steps above the steps it did)\n"
-      "  sph compare SCENE.json [-o DIR] [--modes standard,adaptive,verlet] [--steps N]\n"
-      "                     compare the neighbor modes: speed, accuracy, missed pairs, images\n"
+      "  sph compare SCENE.json [-o DIR] [--modes MODE,...] [--steps N]\n"
+      "                     compare the neighbor modes (all but brute_force unless --modes says):\n"
+      "                     speed, accuracy, missed pairs, images\n"
       "  sph bench [--suite neighbors,steps,tank|all] [--size small|medium|large|full] [--threads 1,2]\n"
       "                     [-o DIR]   benchmark suites: tables, DIR/bench.json and CSVs\n"
-      "  sph validate [--cases martin_moyce,resolution,hydrostatic,conservation|all] [--quick] [-o DIR]\n"
+      "  sph validate [--cases CASE,...|all] [--quick] [-o DIR]\n"
       "                     validate against experiment and physics: report, plots, CSVs (exit 1 on a miss)\n"
-      "  sph render DIR [--color-by speed|kinetic_energy|density|pressure|initial_position] [--mp4]\n"
+      "  sph render DIR [--color-by speed|kinetic_energy|density|pressure|initial_position|none] [--mp4]\n"
       "                     PNG images (and an MP4) of a run's frames; a comparison's runs side by side\n"
       "  sph surface DIR [--frames all] [--resolution 2] [--smoothing 2] [--format ply,obj,vdb]\n"
       "                     free-surface meshes (PLY, OBJ) and OpenVDB level sets of a run's frames\n"
       "  sph view DIR [-o FILE.html] [--max-frames N] [--color-by LIST]\n"
       "                     one HTML page that plays the run in 3D in a browser, offline\n\n"
+      "  MODE: {} (docs/neighbor-modes.md)\n"
+      "  CASE: {} (docs/validation.md)\n\n"
       "Example: sph run scenes/paper/dam_break_2d.json -o out/dam_break_2d\n"
       "         sph render out/dam_break_2d --mp4   (pictures and a movie in out/dam_break_2d/render/)\n"
       "         sph view out/dam_break_2d           (out/dam_break_2d/view.html: open it in a browser)\n"
       "         or open out/dam_break_2d/frames.pvd in ParaView.",
-      "sph"};
+      sph::join_neighbor_mode_names(sph::NeighborModeSet::All, ", ", ", "), fmt::join(sph::kValidationCases, ", "));
+  CLI::App app{synopsis, "sph"};
   app.set_version_flag("--version", std::string("sph ") + sph::kVersion);
   app.require_subcommand(1);
   std::function<int()> run_cmd = add_run_command(app);

@@ -327,6 +327,12 @@ TEST_F(Cli, CompareWritesTheReportAndRefusesBadModes) {
     EXPECT_CONTAINS(r.err, "--modes");
     EXPECT_EQ(count(r.err, "sph: error:"), 1u) << r.err;
     EXPECT_FALSE(fs::exists(work_ / "bad")) << modes;
+    // The modes it lists are those compare takes: not the brute-force oracle.
+    if (std::string(modes) != "adaptive,adaptive") EXPECT_CONTAINS(r.err, "verlet_clusters");
+    EXPECT_EQ(r.err.find("expected one of \"standard\", \"adaptive\", \"verlet\", \"tracked\", "
+                         "\"adaptive_exact\", \"verlet_clusters\", \"brute_force\""),
+              std::string::npos)
+        << r.err;
   }
   const Result missing = sph({"compare", "no_such_scene.json", "-o", "bad"});
   EXPECT_EQ(missing.code, 2);

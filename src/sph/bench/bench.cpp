@@ -126,12 +126,7 @@ std::vector<Precision> parse_precisions(std::string_view list, const std::string
 std::vector<NeighborMode> parse_bench_modes(std::string_view list, const std::string& where) {
   std::vector<NeighborMode> out;
   for (std::string_view item : split(list)) {
-    const std::vector<std::string> accepted = neighbor_mode_names(NeighborModeSet::Compared);
-    if (std::find(accepted.begin(), accepted.end(), item) == accepted.end())
-      throw Error(fmt::format("unknown neighbor mode \"{}\"; expected {}", item,
-                              join_neighbor_mode_names(NeighborModeSet::Compared, ", ", " or ")),
-                  where);
-    const NeighborMode m = parse_neighbor_mode(item, where);
+    const NeighborMode m = parse_neighbor_mode(item, where, NeighborModeSet::Compared);
     if (std::find(out.begin(), out.end(), m) == out.end()) out.push_back(m);
   }
   return out;

@@ -25,12 +25,17 @@ const NeighborModeInfo& neighbor_mode_info(NeighborMode mode) {
 
 std::string_view to_string(NeighborMode mode) { return neighbor_mode_info(mode).name; }
 
-NeighborMode parse_neighbor_mode(std::string_view name, const std::string& where) {
-  for (const NeighborModeInfo& info : kNeighborModes)
-    if (info.name == name) return info.mode;
+NeighborMode parse_neighbor_mode(std::string_view name, const std::string& where, NeighborModeSet set) {
   std::string expected;
   for (const NeighborModeInfo& info : kNeighborModes)
-    expected += (expected.empty() ? "\"" : ", \"") + std::string(info.name) + "\"";
+    if (in_set(info, set)) expected += (expected.empty() ? "\"" : ", \"") + std::string(info.name) + "\"";
+  for (const NeighborModeInfo& info : kNeighborModes) {
+    if (info.name != name) continue;
+    if (in_set(info, set)) return info.mode;
+    throw Error("\"" + std::string(name) + "\" is the tests' oracle (every pair, O(N^2)), too slow to time here; " +
+                    "expected one of " + expected,
+                where);
+  }
   throw Error("unknown neighbor mode \"" + std::string(name) + "\"; expected one of " + expected, where);
 }
 

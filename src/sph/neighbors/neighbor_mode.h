@@ -57,8 +57,10 @@ enum class NeighborModeSet { All, Compared };
 const NeighborModeInfo& neighbor_mode_info(NeighborMode mode);
 /// The mode's name (the table's).
 std::string_view to_string(NeighborMode mode);
-/// Parses a mode name; throws sph::Error naming the accepted values otherwise.
-NeighborMode parse_neighbor_mode(std::string_view name, const std::string& where = {});
+/// Parses a mode name of `set`; throws sph::Error naming the accepted values otherwise (for a
+/// mode outside `set`, why: the brute-force oracle is too slow to time).
+NeighborMode parse_neighbor_mode(std::string_view name, const std::string& where = {},
+                                 NeighborModeSet set = NeighborModeSet::All);
 
 /// The names of the modes of `set`, in the table's order.
 std::vector<std::string> neighbor_mode_names(NeighborModeSet set = NeighborModeSet::All);

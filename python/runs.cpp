@@ -239,7 +239,7 @@ py::dict read_frame_dict(const py::object& path_obj) {
   FrameData frame;
   {
     py::gil_scoped_release release;
-    frame = read_frame(path);
+    frame = read_frame(path, boundary_sample_fields());  // (a run's boundary.vtu too)
   }
   py::dict out;
   out["time"] = frame.time;
@@ -344,8 +344,9 @@ pairs, 0 without boundary particles), "final_rms_divergence", "failure"}], "outp
   m.def("read_frame", &read_frame_dict, py::arg("path"),
         R"doc(Reads a frame file written by sph (.vtu, .vtk, .ply) into a dict of arrays: "time" (s),
 "position" (particles, 3; z = 0 in 2D, float64) and each point field the file holds, by its
-name (velocity (particles, 3), density, pressure, id (uint64), initial_position). Raises
-sph.Error naming the file for anything else.)doc");
+name (velocity (particles, 3), density, pressure, id (uint64), initial_position); a run's
+boundary.vtu gives the boundary samples' "position", "id" and "psi". Raises sph.Error naming
+the file for anything else.)doc");
 }
 
 }  // namespace sph::python

@@ -261,11 +261,12 @@ class PySimulation {
     return out;
   }
 
-  void write_frame(const std::string& path, const py::object& fields) const {
+  void write_frame(const py::object& path_obj, const py::object& fields) const {
+    const std::string path = path_arg(path_obj, "path");
     const std::string ext = std::filesystem::path(path).extension().string();
     const std::optional<FrameFormat> format = parse_frame_format(ext.empty() ? ext : ext.substr(1));
     if (!format)
-      throw Error("expected a frame file name ending in ." + frame_format_list("", " or .") +
+      throw Error("expected a frame file name ending in " + frame_format_list("", " or ", false, ".") +
                       " (the format comes from the extension)",
                   path);
     FrameFields selected;

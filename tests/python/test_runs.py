@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import sph
-from conftest import run_sph, stats_rows, summary, write_scene
+from conftest import DAM_BREAK, SMALL_2D, run_sph, stats_rows, summary, write_scene
 
 
 def test_run_writes_what_sph_run_writes(small_2d, tmp_path):
@@ -26,6 +26,17 @@ def test_run_writes_what_sph_run_writes(small_2d, tmp_path):
     py_rows, cli_rows = stats_rows(tmp_path / "py" / "stats.csv"), stats_rows(tmp_path / "cli" / "stats.csv")
     assert [r["pairs_stored"] for r in py_rows] == [r["pairs_stored"] for r in cli_rows]
     assert summary(tmp_path / "py")["neighbors"] == "adaptive"
+
+
+def test_read_frame_reads_the_boundary_samples_file(tmp_path):
+    scene = sph.load_scene(DAM_BREAK, overrides={**SMALL_2D, "Configuration.boundaryHandling": "particles",
+                                                 "Configuration.outputBoundary": True})
+    sph.run(scene, output=tmp_path / "run", steps=2)
+    b = sph.read_frame(tmp_path / "run" / "boundary.vtu")
+    assert set(b) == {"time", "position", "id", "psi"}
+    n = len(b["position"])
+    assert n > 100 and b["psi"].shape == (n,) and np.all(b["psi"] > 0)
+    assert np.array_equal(b["id"], np.arange(n))  # the sample index
 
 
 def test_run_progress_lines(small_2d, tmp_path, capfd):

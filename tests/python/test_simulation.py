@@ -131,10 +131,12 @@ def test_write_frame_is_read_back(small_2d, tmp_path):
             assert np.array_equal(back["position"][:, :2], sim.positions.astype(np.float32))
         else:
             assert np.array_equal(back["position"][:, :2], sim.positions)
-    sim.write_frame(str(tmp_path / "d.vtu"), fields=["density"])
-    assert set(sph.read_frame(str(tmp_path / "d.vtu"))) == {"time", "position", "density"}
-    with pytest.raises(sph.Error, match="ending in"):
+    sim.write_frame(tmp_path / "d.vtu", fields=["density"])  # a pathlib.Path, as every path argument
+    assert set(sph.read_frame(tmp_path / "d.vtu")) == {"time", "position", "density"}
+    with pytest.raises(sph.Error, match=r"ending in \.vtu, \.vtk or \.ply"):
         sim.write_frame(str(tmp_path / "f.csv"))
+    with pytest.raises(TypeError, match="path"):
+        sim.write_frame(3)
     with pytest.raises(sph.Error, match="not a field frames hold") as e:
         sim.write_frame(str(tmp_path / "f.vtu"), fields=["mass"])
     assert e.value.where == "fields"

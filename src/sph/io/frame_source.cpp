@@ -168,6 +168,11 @@ Source slurp(const fs::path& path) {
 
 }  // namespace detail
 
+std::span<const FieldSpec> boundary_sample_fields() {
+  static const FieldSpec psi{"psi", FieldKind::Real, "kg/m", "kg", "a boundary sample's psi = rho0 V_b"};
+  return {&psi, 1};
+}
+
 FrameData read_frame(const fs::path& file, std::span<const FieldSpec> added) {
   const std::string ext = file.extension().string();
   if (ext != ".vtu" && ext != ".vtk" && ext != ".ply")

@@ -44,6 +44,10 @@ struct FrameData {
 /// had fields added (ParticleSet::add_field), those given in `added`; any other is refused.
 FrameData read_frame(const std::filesystem::path& file, std::span<const FieldSpec> added = {});
 
+/// The field the boundary samples' file (boundary.vtu, Configuration.outputBoundary) holds
+/// besides their ids: each sample's psi. Pass it to read_frame as `added` to read that file.
+std::span<const FieldSpec> boundary_sample_fields();
+
 /// The particles' state as a frame holds it: positions padded to 3 coordinates, the fields
 /// `fields` selects in the set's field order, every value as a double (ids too).
 template <int D, std::floating_point R>

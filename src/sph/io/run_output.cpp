@@ -15,6 +15,7 @@
 #include <sph/core/version.h>
 #include <sph/io/atomic_file.h>
 #include <sph/io/checkpoint.h>
+#include <sph/io/frames.h>
 #include <sph/io/vtk.h>
 #include <sph/scene/scene_writer.h>
 
@@ -188,8 +189,7 @@ void RunOutput<D, R>::write_boundary(const Simulation<D, R>& sim) const {
   if (b.size() == 0) return;
   ParticleSet<D, R> samples;
   samples.reserve(b.size());
-  const std::size_t psi =
-      samples.add_field({"psi", FieldKind::Real, "kg/m", "kg", "a boundary sample's psi = rho0 V_b"});
+  const std::size_t psi = samples.add_field(boundary_sample_fields().front());
   for (std::size_t k = 0; k < b.size(); ++k) samples.add(b.position[k], Vec<D, R>{});
   samples.real_field(psi) = b.psi;
   write_vtu(dir_ / "boundary.vtu", samples, 0.0, FrameFields::only({"id", "psi"}));

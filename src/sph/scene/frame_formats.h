@@ -49,13 +49,14 @@ constexpr std::optional<FrameFormat> parse_frame_format(std::string_view name) {
 
 /// The format names with `quote` around each, ", " between and `last_joint` before the last:
 /// `vtu, vtk or ply`, `"vtu", "vtk", "ply"` (for messages). With `what`, each name is followed by
-/// its description in parentheses (for --help).
-inline std::string frame_format_list(std::string_view quote = "", std::string_view last_joint = ", ",
-                                     bool what = false) {
+/// its description in parentheses (for --help); `prefix` goes before each name (".": `.vtu`).
+inline std::string frame_format_list(std::string_view quote = "", std::string_view last_joint = ", ", bool what = false,
+                                     std::string_view prefix = "") {
   std::string s;
   for (std::size_t k = 0; k < std::size(kFrameFormats); ++k) {
     if (k > 0) s += k + 1 == std::size(kFrameFormats) ? last_joint : std::string_view(", ");
     s += quote;
+    s += prefix;
     s += kFrameFormats[k].name;
     s += quote;
     if (what) (s += " (") += std::string(kFrameFormats[k].what) + ")";

@@ -174,12 +174,12 @@ RunResult RunDriver<D, R>::run(const RunCallbacks& callbacks, const StepObserver
       const bool last = finished();
       if (step.health.new_warnings != 0) {
         for (const std::string& w : new_warnings(step)) {
-          if (callbacks.warning) callbacks.warning(w);
-          if (settings_.strict) {
+          if (settings_.strict) {  // (the failure's message is the warning: it is told once)
             failing_step_row();
             result.error = w + " (--strict)";
             return end(RunStatus::Failed, "failed: " + result.error);
           }
+          if (callbacks.warning) callbacks.warning(w);
         }
       }
       if (on_step) on_step(sim_, step);

@@ -18,6 +18,7 @@
 #include <sph/analysis/validation.h>
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
+#include <sph/core/spelling.h>
 #include <sph/core/version.h>
 #include <sph/neighbors/neighbor_mode.h>
 
@@ -27,22 +28,34 @@ namespace {
 
 /// The first argument that looks like an option but is known neither to `app` nor to any of
 /// its subcommands ("" if none).
-std::string first_unknown_option(CLI::App& app, int argc, char** argv) {
+/// The options `app` takes ("--name", "-n"): its own, and its subcommands' when `subcommands`.
+std::vector<std::string> option_names(const CLI::App& app, bool subcommands) {
   std::vector<const CLI::App*> apps{&app};
-  for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) apps.push_back(sub);
+  if (subcommands)
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) apps.push_back(sub);
+  std::vector<std::string> names;
+  for (const CLI::App* x : apps)
+    for (const CLI::Option* o : x->get_options()) {
+      for (const auto& n : o->get_lnames()) names.push_back("--" + n);
+      for (const auto& n : o->get_snames()) names.push_back("-" + n);
+    }
+  return names;
+}
+
+/// The first argument that looks like an option and is none of sph's, with the option of the
+/// command given (`command`, or the top level's) it was probably meant to be.
+std::string first_unknown_option(CLI::App& app, const CLI::App* command, int argc, char** argv) {
+  const std::vector<std::string> known = option_names(app, true);
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     if (a == "--") break;
     if (a.size() < 2 || a[0] != '-') continue;
     if (std::isdigit(static_cast<unsigned char>(a[1])) || a[1] == '.') continue;  // a negative number
     if (const auto eq = a.find('='); eq != std::string::npos) a = a.substr(0, eq);
-    bool known = false;
-    for (const CLI::App* x : apps)
-      for (const CLI::Option* o : x->get_options()) {
-        for (const auto& n : o->get_lnames()) known = known || a == "--" + n;
-        for (const auto& n : o->get_snames()) known = known || a == "-" + n;
-      }
-    if (!known) return a;
+    if (std::find(known.begin(), known.end(), a) != known.end()) continue;
+    std::vector<std::string> offered = option_names(command ? *command : app, false);
+    if (command) offered.push_back("--help");
+    return a + sph::did_you_mean(a, offered, "");
   }
   return {};
 }
@@ -117,22 +130,34 @@ int main(int argc, char** argv) {
     // CLI11 reports a missing subcommand or argument before an unknown option: name the
     // option the user mistyped first, since that is usually the real mistake.
     std::string message = e.what();
-    const std::string unknown = first_unknown_option(app, argc, argv);
-    if (!unknown.empty()) message = "unknown option " + unknown;
     std::vector<std::string> commands;
     for (const CLI::App* c : app.get_subcommands([](CLI::App*) { return true; })) commands.push_back(c->get_name());
+    // The subcommand the user typed, if any: its options are those a mistyped one is matched
+    // against, and its help the one pointed at.
+    const CLI::App* command = nullptr;
+    for (int i = 1; i < argc && command == nullptr; ++i)
+      if (std::find(commands.begin(), commands.end(), std::string(argv[i])) != commands.end())
+        command = app.get_subcommand(argv[i]);
+    if (dynamic_cast<const CLI::ExtrasError*>(&e) != nullptr && command != nullptr) {
+      // (CLI11: "The following argument(s) was (were) not expected: X Y")
+      const auto colon = message.find(": ");
+      const std::string extra = colon == std::string::npos ? std::string() : message.substr(colon + 2);
+      message = fmt::format("unexpected argument{} {}; sph {} takes only the arguments its help lists",
+                            extra.find(' ') == std::string::npos ? "" : "s", extra, command->get_name());
+    }
+    const std::string unknown = first_unknown_option(app, command, argc, argv);
+    if (!unknown.empty()) message = "unknown option " + unknown;
     // A mistyped command (sph rnu scene.json): CLI11 says only that a subcommand is required.
     if (argc > 1 && argv[1][0] != '-' &&
         std::find(commands.begin(), commands.end(), std::string(argv[1])) == commands.end())
-      message = fmt::format("unknown command \"{}\"; expected one of: {}", argv[1], fmt::join(commands, ", "));
-    // Point at the help of the subcommand the user typed, if any.
-    std::string sub = "run";
-    for (int i = 1; i < argc; ++i)
-      if (std::find(commands.begin(), commands.end(), std::string(argv[i])) != commands.end()) {
-        sub = argv[i];
-        break;
-      }
-    fmt::print(stderr, "sph: error: {}\nRun 'sph --help' or 'sph {} --help' for usage.\n", message, sub);
+      message = fmt::format("unknown command \"{}\"{}; expected one of: {}", argv[1],
+                            sph::did_you_mean(argv[1], commands), fmt::join(commands, ", "));
+    else if (command == nullptr && unknown.empty() && dynamic_cast<const CLI::RequiredError*>(&e) != nullptr)
+      message = fmt::format("expected a command: {}", fmt::join(commands, ", "));
+    if (command == nullptr)
+      fmt::print(stderr, "sph: error: {}\nRun 'sph --help' for usage.\n", message);
+    else
+      fmt::print(stderr, "sph: error: {}\nRun 'sph {} --help' for usage.\n", message, command->get_name());
     return kBadInput;
   }
 

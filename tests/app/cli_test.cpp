@@ -150,7 +150,14 @@ TEST_F(Cli, UnknownFlagAloneIsNamed) {
 TEST_F(Cli, MistypedCommandsAndValuesAreNamedAsWhatTheyAre) {
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
       {{"rnu", kDamBreak},
-       "unknown command \"rnu\"; expected one of: run, compare, bench, validate, render, view, surface"},
+       "unknown command \"rnu\" (did you mean \"run\"?); expected one of: run, compare, bench, validate, render, "
+       "view, surface"},
+      {{}, "expected a command: run, compare, bench, validate, render, view, surface"},
+      {{"run", "--neighbours", "adaptive", "x.json"}, "unknown option --neighbours (did you mean --neighbors?)"},
+      {{"render", "r", "--colour-by", "speed"}, "unknown option --colour-by (did you mean --color-by?)"},
+      {{"--verison"}, "unknown option --verison (did you mean --version?)"},
+      {{"run", "x.json", "extra_arg"},
+       "unexpected argument extra_arg; sph run takes only the arguments its help lists"},
       {{"run", kDamBreak, "--every", "abc"}, "--every: expected a whole number from 0 to"},
       {{"run", kDamBreak, "--threads", "two"}, "--threads: expected a whole number from 1 to 4096, got \"two\""},
       {{"run", kDamBreak, "--steps", "5.5"}, "--steps: expected a whole number from 1 to"},
@@ -164,7 +171,7 @@ TEST_F(Cli, MistypedCommandsAndValuesAreNamedAsWhatTheyAre) {
   std::ofstream(work_ / "afile") << "x";
   for (const auto& [args, message] : cases) {
     const Result r = sph(args);
-    EXPECT_EQ(r.code, 2) << args[0] << " " << args[1];
+    EXPECT_EQ(r.code, 2) << message;
     EXPECT_EQ(count(r.err, "sph: error:"), 1u) << r.err;
     EXPECT_CONTAINS(r.err, message);
   }

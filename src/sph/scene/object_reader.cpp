@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include <sph/core/error.h>
+#include <sph/core/spelling.h>
 
 namespace sph::detail {
 
@@ -29,7 +30,8 @@ ObjectReader::ObjectReader(const json& j, std::string path, const ReadContext& c
     if (allowed_.count(it.key())) continue;
     std::string list;
     for (const auto& k : allowed_) list += (list.empty() ? "" : ", ") + k;
-    ctx_.fail(child(it.key()), "unknown key; expected one of: " + list);
+    const std::vector<std::string> names(allowed_.begin(), allowed_.end());
+    ctx_.fail(child(it.key()), "unknown key" + did_you_mean(it.key(), names) + "; expected one of: " + list);
   }
 }
 

@@ -178,6 +178,7 @@ class Extractor {
     });
     mesh.vertices.reserve(base[na]);
     for (const BlockOut& b : out) mesh.vertices.insert(mesh.vertices.end(), b.vertices.begin(), b.vertices.end());
+    if (s_.clip) clamp_to_container(mesh);
     if constexpr (D == 3) {
       mesh.normals.reserve(base[na]);
       for (const BlockOut& b : out) mesh.normals.insert(mesh.normals.end(), b.normals.begin(), b.normals.end());
@@ -248,6 +249,17 @@ class Extractor {
         }
     for (int i = 0; i < kBlockVoxels<D>; ++i) acc[i] = std::max(acc[i], drop[static_cast<std::size_t>(i)]);
     if (s_.clip) clip_block(lo, acc);
+  }
+
+  /// The cut's faces lie on the walls up to round-off (the interpolation, then the float a
+  /// vertex is stored in): each coordinate is held to the floats within the container.
+  void clamp_to_container(SurfaceMesh& mesh) const {
+    for (int a = 0; a < D; ++a) {
+      float lo = static_cast<float>(s_.clip_lo[a]), hi = static_cast<float>(s_.clip_hi[a]);
+      if (static_cast<double>(lo) < s_.clip_lo[a]) lo = std::nextafter(lo, std::numeric_limits<float>::infinity());
+      if (static_cast<double>(hi) > s_.clip_hi[a]) hi = std::nextafter(hi, -std::numeric_limits<float>::infinity());
+      for (auto& v : mesh.vertices) v[static_cast<std::size_t>(a)] = std::clamp(v[static_cast<std::size_t>(a)], lo, hi);
+    }
   }
 
   /// The container's cut (SurfaceSettings::clip): each value at most iso + d / (2 v), d the

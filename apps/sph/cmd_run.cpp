@@ -172,22 +172,26 @@ void print_done(const RunDriver<D, R>& run, const RunResult& result, bool audit)
   const RunOutput<D, R>& out = *run.output();
   const std::filesystem::path& dir = run.settings().dir;
   const std::int64_t ran = result.steps_done - result.first_step;
-  fmt::print(stderr,
-             "sph: done: {} steps, {} particles, {:.2f} s ({:.3f} ms/step). {} {} frames.\n"
-             "{}"
-             "  {}/stats.csv    per-step energy, neighbors and phase timings\n"
-             "  {}/summary.json totals\n"
-             "{}",
-             ran, run.simulation().particles().size(), result.wall_seconds,
-             1e3 * result.wall_seconds / static_cast<double>(std::max<std::int64_t>(ran, 1)),
-             result.first_step > 0 ? "The run now has" : "Wrote", out.frames_written(),
-             frames_hint(run.scene().output, dir, out.frames_written(), !run.simulation().params().obstacles.empty(),
-                         !run.simulation().bodies().empty()),
-             dir.string(), dir.string(),
-             out.frames_written() > 0
-                 ? fmt::format("  look at it: sph render {0} --mp4 (PNG frames, a movie); sph view {0} (a web page)\n",
-                               shell_word(dir.string()))
-                 : std::string());
+  fmt::print(
+      stderr,
+      "sph: done: {} steps, {} particles, {:.2f} s ({:.3f} ms/step). {} {} frames.\n"
+      "{}{}"
+      "  {}/stats.csv    per-step energy, neighbors and phase timings\n"
+      "  {}/summary.json totals\n"
+      "{}",
+      ran, run.simulation().particles().size(), result.wall_seconds,
+      1e3 * result.wall_seconds / static_cast<double>(std::max<std::int64_t>(ran, 1)),
+      result.first_step > 0 ? "The run now has" : "Wrote", out.frames_written(),
+      frames_hint(run.scene().output, dir, out.frames_written(), !run.simulation().params().obstacles.empty(),
+                  !run.simulation().bodies().empty()),
+      run.settings().surface && out.frames_written() > 0
+          ? fmt::format("  {}/surface/      the free surface of each frame (sph surface's files)\n", dir.string())
+          : std::string(),
+      dir.string(), dir.string(),
+      out.frames_written() > 0
+          ? fmt::format("  look at it: sph render {0} --mp4 (PNG frames, a movie); sph view {0} (a web page)\n",
+                        shell_word(dir.string()))
+          : std::string());
   if (audit)
     fmt::print(stderr,
                "sph: audit: {} pairs within h were missing from the lists, in {} of {} steps; the deepest miss "

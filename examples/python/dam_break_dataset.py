@@ -96,7 +96,7 @@ def generate(seed, count, steps, every, output, threads=None, radius=None):
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0].replace("\n", " "))
     p.add_argument("-o", "--output", default="out/dam_break_dataset")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--count", type=int, default=20, help="dam breaks")

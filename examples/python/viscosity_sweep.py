@@ -43,7 +43,7 @@ def front_curve(scene, viscosity, samples, threads):
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0].replace("\n", " "))
     p.add_argument("-o", "--output", default="out/viscosity_sweep")
     p.add_argument("--quick", action="store_true", help="coarse and short (CI)")
     p.add_argument("--viscosities", type=float, nargs="+")

@@ -92,6 +92,10 @@ def test_compare(small_2d, tmp_path):
     assert verlet["final_rms_divergence"] is not None and r["runs"][0]["final_rms_divergence"] is None
     assert os.path.isfile(r["report"])
     assert sph.compare(small_2d, modes=["verlet"], steps=5, audit=False)["output"] is None
+    done = []  # at every twentieth of the steps, as python.md says
+    sph.compare(small_2d, modes=["verlet"], steps=50, audit=False,
+                progress=lambda label, index, count, d, total: done.append(d) if index == 0 else None)
+    assert done == list(range(2, 51, 2))
     with pytest.raises(sph.Error, match="too slow to time") as e:
         sph.compare(small_2d, modes=["brute_force"])
     assert e.value.where == "modes"

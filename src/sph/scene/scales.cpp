@@ -129,10 +129,6 @@ double least_holding_wall_stiffness(const SceneScales& s, double particle_radius
 
 double critical_wall_damping(double wall_stiffness) { return 2.0 * std::sqrt(wall_stiffness); }
 
-double viscosity_for_sound_speed(int dimension, double alpha, double kernel_radius, double sound_speed,
-                                 double rest_density) {
-  return rest_density * alpha * kernel_radius * sound_speed / (2.0 * (dimension + 2));
-}
 
 template SceneScales scene_scales<2>(const SceneBody<2>&);
 template SceneScales scene_scales<3>(const SceneBody<3>&);

@@ -19,8 +19,6 @@ inline constexpr double kHeadPenetrationFraction = 0.5;
 /// (and a dam break's surge front, 2 sqrt(g H) by Ritter's solution) run faster than the free
 /// fall that starts them.
 inline constexpr double kDesignSpeedFactor = 1.5;
-/// Monaghan's artificial viscosity coefficient alpha the default viscosity is equivalent to.
-inline constexpr double kArtificialViscosityAlpha = 0.1;
 
 /// What a scene's geometry implies, from its parameters, blocks and emitters (SI units).
 struct SceneScales {
@@ -67,10 +65,5 @@ double least_holding_wall_stiffness(const SceneScales& s, double particle_radius
 /// Critical damping of a unit-mass spring of stiffness k_w: 2 sqrt(k_w), 1/s.
 double critical_wall_damping(double wall_stiffness);
 
-/// The dynamic viscosity (Pa s; kg/s in 2D) equivalent to Monaghan's artificial viscosity with
-/// coefficient alpha: nu = alpha h c0 / (2 (D + 2)) (Monaghan 2005, section 4.3), mu = rho0 nu,
-/// with h the kernel support radius and c0 = sqrt(stiffness).
-double viscosity_for_sound_speed(int dimension, double alpha, double kernel_radius, double sound_speed,
-                                 double rest_density);
 
 }  // namespace sph

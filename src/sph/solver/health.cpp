@@ -16,8 +16,9 @@ const HealthWatch& watch(HealthKind kind) { return kHealthWatches[static_cast<st
 
 /// Monaghan's artificial viscosity alpha = 0.1 as a dynamic viscosity: mu = rho0 alpha (h / 2) c0 / 8
 /// (his smoothing length is about half the kernel support h).
-double suggested_viscosity(const HealthScene& s) {
-  return s.rest_density * 0.1 * (0.5 * s.kernel_radius) * s.sound_speed / 8.0;
+double suggested_viscosity(const HealthScene& s) {  // (the default viscosity's formula)
+  return viscosity_for_sound_speed(s.dimension, kArtificialViscosityAlpha, s.kernel_radius, s.sound_speed,
+                                   s.rest_density);
 }
 
 /// The setting that shortens the steps, with its value: "Configuration.timeStepSize (now 0.0001
@@ -69,6 +70,7 @@ std::string speed_advice(const HealthScene& s, double v) {
 template <int D>
 HealthScene health_scene(const SimulationParams<D>& p) {
   HealthScene s;
+  s.dimension = D;
   s.sound_speed = std::sqrt(std::max(p.fluid.stiffness, 0.0));
   s.kernel_radius = p.kernel_radius;
   s.particle_radius = p.particle_radius;

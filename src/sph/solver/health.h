@@ -86,6 +86,7 @@ inline constexpr HealthWatch kHealthWatches[kHealthKinds] = {
 
 /// The scene's scales the monitor needs (from SimulationParams).
 struct HealthScene {
+  int dimension = 3;
   double sound_speed = 1;  ///< c0 = sqrt(Fluid.stiffness), m/s
   double kernel_radius = 0, particle_radius = 0, rest_density = 1000;
   double stiffness = 0, viscosity = 0, wall_stiffness = 0, wall_damping = 0, time_step = 0;

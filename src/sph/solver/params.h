@@ -359,4 +359,16 @@ bool any_dynamic_body(const SimulationParams<D>& p) {
   return std::any_of(p.bodies.begin(), p.bodies.end(), [](const BodyParams<D>& b) { return b.dynamic; });
 }
 
+/// Monaghan's artificial viscosity coefficient alpha the default viscosity is equivalent to
+/// (and the health monitor's advice names).
+inline constexpr double kArtificialViscosityAlpha = 0.1;
+
+/// The dynamic viscosity (Pa s; kg/s in 2D) equivalent to Monaghan's artificial viscosity with
+/// coefficient alpha: nu = alpha h c0 / (2 (D + 2)) (Monaghan 2005, section 4.3), mu = rho0 nu,
+/// with h the kernel support radius and c0 = sqrt(stiffness).
+inline double viscosity_for_sound_speed(int dimension, double alpha, double kernel_radius, double sound_speed,
+                                        double rest_density) {
+  return rest_density * alpha * kernel_radius * sound_speed / (2.0 * (dimension + 2));
+}
+
 }  // namespace sph

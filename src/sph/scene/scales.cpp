@@ -129,7 +129,6 @@ double least_holding_wall_stiffness(const SceneScales& s, double particle_radius
 
 double critical_wall_damping(double wall_stiffness) { return 2.0 * std::sqrt(wall_stiffness); }
 
-
 template SceneScales scene_scales<2>(const SceneBody<2>&);
 template SceneScales scene_scales<3>(const SceneBody<3>&);
 

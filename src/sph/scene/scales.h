@@ -65,5 +65,4 @@ double least_holding_wall_stiffness(const SceneScales& s, double particle_radius
 /// Critical damping of a unit-mass spring of stiffness k_w: 2 sqrt(k_w), 1/s.
 double critical_wall_damping(double wall_stiffness);
 
-
 }  // namespace sph

@@ -337,8 +337,9 @@ modes: names of sph.NEIGHBOR_MODES that are compared (default: all but brute_for
 compare; standard, the reference, is always run); output: the report's directory (report.md, CSVs, images and, with
 run_frames, each mode's frames), or None for no files; frames, perturbation (of h: the chaos
 floor) and audit as the flags. progress: True, or a callable progress(label, index, count,
-steps_done, steps), called at every twentieth of each run's steps and at its last. "speedup": the mean seconds of the standard runs (the reference and the
-perturbed one) divided by this run's. Returns {"scene", "steps", "threads", "audited", "runs": [{"label", "mode",
+steps_done, steps), called at every twentieth of each run's steps and at its last.
+"speedup": the mean seconds of the standard runs (the reference and the perturbed one)
+divided by this run's. Returns {"scene", "steps", "threads", "audited", "runs": [{"label", "mode",
 "perturbed", "seconds", "speedup", "steps", "missed_pairs", "boundary_missed_pairs" (fluid-boundary
 pairs, 0 without boundary particles), "final_rms_divergence", "failure"}], "output", "report"}.)doc");
   m.def("read_frame", &read_frame_dict, py::arg("path"),

@@ -26,8 +26,6 @@
 
 namespace {
 
-/// The first argument that looks like an option but is known neither to `app` nor to any of
-/// its subcommands ("" if none).
 /// The options `app` takes ("--name", "-n"): its own, and its subcommands' when `subcommands`.
 std::vector<std::string> option_names(const CLI::App& app, bool subcommands) {
   std::vector<const CLI::App*> apps{&app};
@@ -42,8 +40,8 @@ std::vector<std::string> option_names(const CLI::App& app, bool subcommands) {
   return names;
 }
 
-/// The first argument that looks like an option and is none of sph's, with the option of the
-/// command given (`command`, or the top level's) it was probably meant to be.
+/// The first argument that looks like an option and is none of sph's ("" if none), with the
+/// option of the command given (`command`, or the top level's) it was probably meant to be.
 std::string first_unknown_option(CLI::App& app, const CLI::App* command, int argc, char** argv) {
   const std::vector<std::string> known = option_names(app, true);
   for (int i = 1; i < argc; ++i) {

@@ -102,10 +102,16 @@ int render(const RenderCliOptions& opt) {
       fmt::print(stderr, "sph: warning: {} has {} frames, fewer than the others; rendering the first {} of each\n",
                  r.dir.string(), r.frames.size(), count);
   const std::vector<std::size_t> frames = parse_frames(opt.frames, count);
+  // The first run's first frame, read once for what needs it before rendering.
+  std::optional<FrameData> first_frame;
+  const auto first_of_first_run = [&]() -> const FrameData& {
+    if (!first_frame) first_frame = read_frame(runs[0].frames[frames.front()]);
+    return *first_frame;
+  };
   if (!by) {
     // Speed, unless the run left the velocities out (--fields): then the first quantity the
     // frames hold, or one color when they hold positions only.
-    const FrameData first = read_frame(runs[0].frames[frames.front()]);
+    const FrameData& first = first_of_first_run();
     by = ColorBy::None;
     for (const ColorBy q : kColorByAll)
       if (first.field(color_by_field(q))) {
@@ -122,9 +128,7 @@ int render(const RenderCliOptions& opt) {
   if (!color_by_is_scalar(*by))
     for (const auto& [flag, given] : {std::pair{"--range", !opt.range.empty()}, {"--colormap", !opt.colormap.empty()}})
       if (given)
-        fmt::print(
-            stderr, "sph: warning: {}: particles {} take no color map: it is ignored\n", flag,
-            *by == ColorBy::None ? std::string("in one color") : "colored by " + std::string(color_by_name(*by)));
+        fmt::print(stderr, "sph: warning: {}: particles {} take no color map: it is ignored\n", flag, coloring);
 
   FrameStyle style;
   const bool several = runs.size() > 1;
@@ -144,7 +148,12 @@ int render(const RenderCliOptions& opt) {
   // A field the frames lack is refused before anything is written (the range above found it
   // for scalars; initial position needs the first frame read).
   if (!color_by_is_scalar(*by))
-    for (const RunDirectory& r : runs) particle_colors(read_frame(r.frames[frames.front()]), style.color, r);
+    for (const RunDirectory& r : runs) {
+      if (&r == &runs[0])
+        particle_colors(first_of_first_run(), style.color, r);
+      else
+        particle_colors(read_frame(r.frames[frames.front()]), style.color, r);
+    }
 
   const fs::path out = opt.output ? fs::path(*opt.output) : fs::path(opt.dir) / "render";
   // The images and movie replace an earlier render's (only the files a render makes:

@@ -167,6 +167,12 @@ TEST_F(Cli, MistypedCommandsAndValuesAreNamedAsWhatTheyAre) {
       {{"run", "--resume", "afile"},
        "afile: is a file, not a directory; expected the output directory of an earlier run"},
       {{"view", "nowhere", "-o", ""}, "-o/--output: an empty file name"},
+      {{"run", kDamBreak, "--steps", "2", "-o", "afile/out/deeper"},
+       "cannot create the output directory: afile is a file, not a directory; expected a directory path for the "
+       "run's output"},
+      {{"bench", "--suite", "neighbors", "-o", "afile/b"},
+       "cannot create the output directory: afile is a file, not a directory; expected a directory path for the "
+       "benchmark results"},
   };
   std::ofstream(work_ / "afile") << "x";
   for (const auto& [args, message] : cases) {

@@ -181,7 +181,7 @@ TEST(Health, AParticleOutsideTheContainerWarnsOnceAndOneBeyondHFails) {
   EXPECT_EQ(first.health.outside_id, 100u);
   EXPECT_EQ(first.health.new_warnings, 1u << static_cast<int>(HealthKind::Outside));
   const std::string w = sim.health().warning(HealthKind::Outside);
-  EXPECT_NE(w.find("1 particles outside the container at step 1"), std::string::npos) << w;
+  EXPECT_NE(w.find("1 particle outside the container at step 1"), std::string::npos) << w;
   EXPECT_NE(w.find("particle id 100"), std::string::npos) << w;
   EXPECT_NE(w.find("Container.wallStiffness >= (v / r)^2"), std::string::npos) << w;
   const StepInfo& second = sim.step();  // the wall pushes it back in over a few steps
@@ -283,6 +283,7 @@ TEST(Health, EnergyGrowthInAClosedSceneWarns) {
   s.new_warnings = 0, s.energy = 250.0;
   const std::string e = error_of([&] { monitor.check(s, 2, 3e-3, 10); });
   EXPECT_NE(e.find("simulation gained energy at step 2"), std::string::npos) << e;
+  EXPECT_NE(e.find("total energy 250 J is 150 % of its scale above the initial 100 J"), std::string::npos) << e;
   scene.closed = false;  // an emitter adds energy: not judged
   HealthMonitor open(scene);
   open.set_initial(100.0, 1.0);

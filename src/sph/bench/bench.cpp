@@ -214,13 +214,7 @@ std::vector<Precision> steps_precisions(const BenchOptions& options, int side) {
 }
 
 void prepare_bench_directory(const std::filesystem::path& dir) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-    throw Error("exists and is not a directory; expected a directory for the benchmark results", dir.string());
-  fs::create_directories(dir, ec);
-  if (ec) throw Error("cannot create the output directory: " + ec.message(), dir.string());
-  { AtomicFile probe(dir / ".write-test"); }  // throws sph::Error naming the path if not writable
+  make_writable_directory(dir, "the benchmark results");  // throws sph::Error naming the path
   // An earlier run's files stay until this run has results to put in their place
   // (write_bench_files removes those of suites it did not run): a run stopped before its first
   // suite ends leaves them as they were.

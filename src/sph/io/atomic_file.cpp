@@ -11,6 +11,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <fmt/format.h>
 #include <sph/core/error.h>
 
 namespace sph {
@@ -72,7 +73,22 @@ void make_writable_directory(const std::filesystem::path& dir, std::string_view 
   if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
     throw Error("exists and is not a directory; expected a directory for " + std::string(purpose), dir.string());
   std::filesystem::create_directories(dir, ec);
-  if (ec) throw Error("cannot create the output directory: " + ec.message(), dir.string());
+  if (ec) {
+    // Name the part of the path that stops it: "Not a directory" alone does not say which.
+    for (std::filesystem::path up = dir.parent_path(); !up.empty() && up != up.parent_path(); up = up.parent_path()) {
+      std::error_code probe_ec;
+      if (!std::filesystem::exists(up, probe_ec)) continue;
+      if (!std::filesystem::is_directory(up, probe_ec))
+        throw Error(fmt::format("cannot create the output directory: {} is a file, not a directory; expected a "
+                                "directory path for {}",
+                                up.string(), purpose),
+                    dir.string());
+      break;
+    }
+    throw Error(
+        fmt::format("cannot create the output directory: {}; expected a writable place for {}", ec.message(), purpose),
+        dir.string());
+  }
   AtomicFile probe(dir / ".write-test");  // removed unless committed
 }
 

@@ -156,8 +156,9 @@ void HealthMonitor::check(HealthStats& st, std::int64_t step, double time, std::
                       wall_advice(s, std::max(top_speed, speed))));
     if (count > 0 && fraction > watch(kind).warn)
       warn(st, kind,
-           fmt::format("{} particles {} {} (the deepest, particle id {}, {:.3g} m past the wall at {:.3g} m/s); {}",
-                       count, where, at(), id, depth, speed, wall_advice(s, std::max(top_speed, speed))));
+           fmt::format("{} particle{} {} {} (the deepest, particle id {}, {:.3g} m past the wall at {:.3g} m/s); {}",
+                       count, count == 1 ? "" : "s", where, at(), id, depth, speed,
+                       wall_advice(s, std::max(top_speed, speed))));
   };
   contained(HealthKind::Outside, st.outside, st.outside_depth, st.outside_id, st.outside_speed,
             "outside the container");
@@ -228,9 +229,9 @@ void HealthMonitor::check(HealthStats& st, std::int64_t step, double time, std::
     };
     if (growth > watch(HealthKind::Energy).fail)
       fail(
-          fmt::format("simulation gained energy {}: total energy {:.4g} J is {:.3g} times its scale above the "
+          fmt::format("simulation gained energy {}: total energy {:.4g} J is {:.0f} % of its scale above the "
                       "initial {:.4g} J; {}",
-                      at(), st.energy, growth, initial_energy_, advice()));
+                      at(), st.energy, 100.0 * growth, initial_energy_, advice()));
     if (growth > watch(HealthKind::Energy).warn)
       warn(st, HealthKind::Energy,
            fmt::format("total energy {:.4g} J {} is {:.1f} % of its scale above the initial {:.4g} J; {}", st.energy,

@@ -35,6 +35,20 @@ std::int64_t whole_number_arg(const py::handle& value, const char* name, std::in
   return py::cast<std::int64_t>(value);
 }
 
+std::vector<std::string> run_overrides(const py::object& neighbors, const py::object& steps) {
+  std::vector<std::string> sets;
+  if (!neighbors.is_none()) {
+    if (!py::isinstance<py::str>(neighbors))
+      throw py::type_error("neighbors must be a mode name: " +
+                           join_neighbor_mode_names(NeighborModeSet::All, ", ", " or "));
+    sets.push_back("Configuration.neighbors=\"" + py::cast<std::string>(neighbors) + "\"");
+  }
+  if (!steps.is_none())
+    sets.push_back("Configuration.numberOfSteps=" +
+                   std::to_string(whole_number_arg(steps, "steps", 1, std::int64_t{1'000'000'000'000})));
+  return sets;
+}
+
 int thread_count_arg(const py::handle& threads) {
   if (threads.is_none()) return num_threads();
   return static_cast<int>(whole_number_arg(threads, "threads", 1, 4096));

@@ -66,6 +66,11 @@ SceneDesc with_overrides(const SceneDesc& desc, const std::vector<std::string>& 
 /// to cast Python instance to C++ type").
 std::int64_t whole_number_arg(const py::handle& value, const char* name, std::int64_t lo, std::int64_t hi);
 
+/// The overrides that run()'s, compare()'s and Simulation()'s keyword arguments stand for, as
+/// `sph run`'s flags stand for --set values: `neighbors` (None or a mode's name; TypeError
+/// otherwise) and `steps` (None or a whole number of steps).
+std::vector<std::string> run_overrides(const py::object& neighbors, const py::object& steps);
+
 /// The threads a call asks for: its `threads` argument (a whole number from 1 to 4096), or all
 /// the parallel loops' threads for None.
 int thread_count_arg(const py::handle& threads);

@@ -34,22 +34,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// The overrides that run()'s and compare()'s keyword arguments stand for, as `sph run`'s flags
-/// stand for --set values.
-std::vector<std::string> run_overrides(const py::object& neighbors, const py::object& steps) {
-  std::vector<std::string> sets;
-  if (!neighbors.is_none()) {
-    if (!py::isinstance<py::str>(neighbors))
-      throw py::type_error("neighbors must be a mode name: " +
-                           join_neighbor_mode_names(NeighborModeSet::All, ", ", " or "));
-    sets.push_back("Configuration.neighbors=\"" + py::cast<std::string>(neighbors) + "\"");
-  }
-  if (!steps.is_none())
-    sets.push_back("Configuration.numberOfSteps=" +
-                   std::to_string(whole_number_arg(steps, "steps", 1, std::int64_t{1'000'000'000'000})));
-  return sets;
-}
-
 /// A progress callback: None or False (none), True (a line on stderr every 10 %), or a callable.
 struct Progress {
   py::object callable;

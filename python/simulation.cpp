@@ -64,14 +64,7 @@ inline constexpr bool kIsVec = !std::is_arithmetic_v<E>;
 class PySimulation {
  public:
   PySimulation(const Scene& scene, const py::object& neighbors, const py::object& threads) {
-    std::vector<std::string> sets;
-    if (!neighbors.is_none()) {
-      if (!py::isinstance<py::str>(neighbors))
-        throw py::type_error("neighbors must be a mode name: " +
-                             join_neighbor_mode_names(NeighborModeSet::All, ", ", " or "));
-      sets.push_back("Configuration.neighbors=\"" + py::cast<std::string>(neighbors) + "\"");
-    }
-    SceneDesc desc = with_overrides(scene.desc, sets);
+    SceneDesc desc = with_overrides(scene.desc, run_overrides(neighbors, py::none()));
     threads_ = thread_count_arg(threads);
     py::gil_scoped_release release;
     use_threads(threads_);

@@ -19,6 +19,7 @@
 #include <sph/io/frames.h>
 #include <sph/io/run_directory.h>
 #include <sph/surface/mesh_files.h>
+#include <sph/surface/solid_cut.h>
 #include <sph/surface/surface.h>
 
 #include "cli_checks.h"
@@ -84,6 +85,7 @@ int surface(SurfaceCliOptions opt) {
   for (std::size_t k = 0; k < frames.size(); ++k) {
     const FrameData data = read_frame(run.frames[frames[k]]);
     Stopwatch mesh_wall;
+    opt.settings.solids = run_obstacles_distance(run, data.time);  // (where the obstacles are then)
     const SurfaceMesh mesh = extract_surface(data.position, run.dimension, opt.settings);
     mesh_seconds += mesh_wall.elapsed();
     particles += data.size;

@@ -9,6 +9,7 @@
 
 #include <sph/core/error.h>
 #include <sph/render/frame_image.h>
+#include <sph/surface/solid_cut.h>
 
 #include "support/expect.h"
 
@@ -204,6 +205,34 @@ TEST(FrameImage, FloatingBodiesAreDrawnWhereTheRunsTableHasThem) {
   // Without a table, where it started.
   run.bodies.clear();
   EXPECT_EQ(run_obstacles(run, 0.9)[0].translation, (std::array<double, 3>{0, 0, 0}));
+}
+
+TEST(FrameImage, TheSurfacesCutIsTheObstaclesWhereTheFrameHasThem) {
+  // run_obstacles_distance (the solids a frame's surface is cut by) puts each obstacle where
+  // run_obstacles draws it: the paddle of run_with_moving_obstacles at 1.4 .. 1.6 at t = 0.5 s.
+  const RunDirectory moving = run_with_moving_obstacles();
+  const SolidDistance at_half = run_obstacles_distance(moving, 0.5);
+  ASSERT_TRUE(at_half);
+  EXPECT_NEAR(at_half({1.5, 0.15, 0}, 1), -0.1, 1e-12);  // inside, 0.1 from its sides
+  EXPECT_NEAR(at_half({1.7, 0.15, 0}, 1), 0.1, 1e-12);
+  EXPECT_GT(at_half({0.3, 0.15, 0}, 1), 0.7);  // where it is at rest: fluid's space (the stirrer 0.75 away)
+  EXPECT_NEAR(run_obstacles_distance(moving, 0.0)({0.3, 0.15, 0}, 1), -0.1, 1e-12);
+  // The floating box at t = 1 s, from bodies.csv: [0.9, 1.1] x [0.4, 0.6] (a square turned by 90 degrees).
+  RunDirectory floating = run2d("floating");
+  SceneBody<2> body;
+  body.sim.obstacles = {Box<2>{{{0.2, 0}}, {{0.4, 0.2}}}};
+  BodyParams<2> b;
+  b.dynamic = true;
+  b.density = 500;
+  body.sim.bodies = {b};
+  floating.scene.set_body(body);
+  const double h = std::sqrt(0.5);
+  floating.bodies = {BodyPoseRow{0.0, 0, {0.3, 0.1, 0}, {1, 0, 0, 0}},
+                     BodyPoseRow{1.0, 0, {1.0, 0.5, 0}, {h, 0, 0, h}}};
+  EXPECT_NEAR(run_obstacles_distance(floating, 1.0)({1.0, 0.5, 0}, 1), -0.1, 1e-12);
+  EXPECT_NEAR(run_obstacles_distance(floating, 1.0)({1.25, 0.5, 0}, 1), 0.15, 1e-12);
+  // No obstacles: no cut.
+  EXPECT_FALSE(run_obstacles_distance(run2d("empty"), 0.0));
 }
 
 TEST(FrameImage, RunObstaclesOfA3DSceneTurnAboutTheirAxis) {

@@ -1,6 +1,7 @@
 #include <sph/surface/surface.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -174,6 +175,65 @@ TEST(Surface, ClippedToTheContainerNoVertexLiesOutsideIt) {
     }
     const double box = (2.0 - 0.03) * (1.6 - 0.03) * (dim == 3 ? 1.2 - 0.03 : 1.0);
     EXPECT_NEAR(enclosed_measure(cut) / box, 0.995, 0.01);  // (0.998 in 2D, 0.993 in 3D: the free edges rounded)
+  }
+}
+
+TEST(Surface, CutByTheSolidsNoVertexLiesInsideOne) {
+  // Fluid around a ball (radius 0.35 about c), its nearest particles crowding it: 0.2 spacings
+  // from its surface where the solver keeps them half a spacing off. The colour field reaches
+  // into the ball there; the cut puts the surface on the ball's.
+  const std::array<double, 3> c{1.0, 0.8, 0.6};
+  const double radius = 0.35;
+  const auto ball_distance = [&](const std::array<double, 3>& x, int dim) {
+    double r2 = 0;
+    for (int a = 0; a < dim; ++a) r2 += (x[a] - c[a]) * (x[a] - c[a]);
+    return std::sqrt(r2) - radius;
+  };
+  for (const int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    std::vector<double> p;
+    const auto all = dim == 3 ? block(20, 16, 12) : block(20, 16, 1);
+    for (std::size_t i = 0; i < all.size(); i += 3) {
+      const std::array<double, 3> x{all[i], all[i + 1], all[i + 2]};
+      if (ball_distance(x, dim) > 0.2 * kS) p.insert(p.end(), {x[0], x[1], x[2]});
+    }
+    SurfaceSettings s = settings();
+    const auto deepest = [&](const SurfaceMesh& m) {
+      double d = 0;
+      for (const auto& v : m.vertices) d = std::max(d, -ball_distance({v[0], v[1], v[2]}, dim));
+      return d;
+    };
+    const SurfaceMesh free = extract_surface(p, dim, s);
+    EXPECT_GT(deepest(free), 0.1 * kS) << "without the cut the surface closes inside the ball";
+    std::atomic<std::size_t> calls{0};
+    s.solids = [&](const std::array<double, 3>& x, double reach) {
+      ++calls;
+      return std::min(ball_distance(x, dim), 2 * reach);  // (beyond reach: any value above it)
+    };
+    const SurfaceMesh cut = extract_surface(p, dim, s);
+    EXPECT_LT(deepest(cut), 0.02 * kS) << "the cut puts the surface on the ball's";
+    if (dim == 3) expect_closed_and_oriented(cut);
+    // What the cut surface leaves out of the whole block's holds the ball (and the lattice's
+    // jagged shell around it: 1.07 of it in 3D, 1.10 in 2D); the uncut one's did not.
+    const double ball =
+        dim == 3 ? 4.0 / 3.0 * std::numbers::pi * std::pow(radius, 3) : std::numbers::pi * radius * radius;
+    EXPECT_LT(enclosed_measure(cut), enclosed_measure(free));
+    const double whole = enclosed_measure(extract_surface(all, dim, settings()));
+    EXPECT_GT((whole - enclosed_measure(cut)) / ball, 1.0);
+    EXPECT_LT((whole - enclosed_measure(cut)) / ball, 1.15);
+    // Blocks far from the ball are passed over after one call: most of the calls are the
+    // voxels of the blocks that hold part of the cut.
+    const std::size_t voxels = cut.blocks * (dim == 3 ? 512u : 64u);
+    EXPECT_LT(calls.load(), voxels / 2) << "blocks far from the solids are not sampled voxel by voxel";
+    // The same bits for any thread count, the cut included.
+    for (const int t : {2, 3}) {
+      set_num_threads(t);
+      const SurfaceMesh again = extract_surface(p, dim, s);
+      EXPECT_EQ(again.vertices, cut.vertices);
+      EXPECT_EQ(again.triangles, cut.triangles);
+      EXPECT_EQ(again.segments, cut.segments);
+    }
+    set_num_threads(1);
   }
 }
 

@@ -9,7 +9,7 @@
 #include <sph/core/error.h>
 #include <sph/render/compose.h>
 #include <sph/render/font.h>
-#include <sph/solver/rigid_body.h>
+#include <sph/surface/solid_cut.h>
 #include <sph/surface/surface.h>
 
 namespace sph {
@@ -63,30 +63,11 @@ SolidBox placed_box(const SimulationParams<D>& sim, std::size_t k, const RigidPo
   return s;
 }
 
-/// Obstacle k of `sim` placed at `time` (obstacle_solid): a floating body where `bodies` (a run's
-/// bodies.csv) has it at `time` (a frame's), where it started if `bodies` is empty.
+/// Obstacle k of `sim` placed at `time` (obstacle_solid; obstacle_pose_at()).
 template <int D>
 SolidBox placed_obstacle(const SimulationParams<D>& sim, std::size_t k, double time,
                          std::span<const BodyPoseRow> bodies) {
-  SPH_CHECK(k < sim.obstacles.size(), "no such obstacle");
-  if (!obstacle_body(sim, k).dynamic) return placed_box(sim, k, pose_at(obstacle_motion(sim, k), time));
-  const BodyPoseRow* nearest = nullptr;
-  for (const BodyPoseRow& r : bodies)
-    if (r.obstacle == k && (!nearest || std::abs(r.time - time) < std::abs(nearest->time - time))) nearest = &r;
-  if (bodies.empty()) return placed_box(sim, k, RigidPose<D>{});  // (no table: where it started)
-  // bodies.csv has a row for each body at each frame's time: none there means the table lost rows
-  // (open_run_directory refuses a floating run's directory without one), and a neighbouring
-  // frame's pose would put the body where it was not.
-  if (!nearest || std::abs(nearest->time - time) > 1e-9 * std::max(1.0, std::abs(time)))
-    throw Error(fmt::format("has no row of obstacle {} (a floating body) at t = {} s, the time of a frame; expected "
-                            "the table sph run wrote with the frames (the run directory is incomplete)",
-                            k, time),
-                "bodies.csv");
-  RigidBodyState<D> state;
-  for (int a = 0; a < D; ++a) state.position[a] = nearest->position[static_cast<std::size_t>(a)];
-  state.orientation = nearest->orientation;
-  // (placed about its centre of mass at rest, as the simulation places it)
-  return placed_box(sim, k, body_pose(state, obstacle_mass_properties(sim, k, 1.0).center));
+  return placed_box(sim, k, obstacle_pose_at(sim, k, time, bodies));
 }
 
 }  // namespace
@@ -151,6 +132,7 @@ Image render_frame(std::span<const RunDirectory> runs, std::span<const FrameData
     if (style.surface) {
       SurfaceSettings settings = style.surface_settings;
       fit_to_run(settings, run.particle_radius, run.box_lo, run.box_hi);
+      settings.solids = run_obstacles_distance(run, frame.time);
       mesh = extract_surface(frame.position, run.dimension, settings);
     }
     if (style.surface && run.dimension == 3) {

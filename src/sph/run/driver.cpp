@@ -7,6 +7,7 @@
 #include <sph/io/atomic_file.h>
 #include <sph/run/memory.h>
 #include <sph/scene/builders.h>
+#include <sph/surface/solid_cut.h>
 
 namespace sph {
 
@@ -86,7 +87,9 @@ void RunDriver<D, R>::write_new_surface() {
   parallel_for(ps.size(), [&](std::size_t i) {
     for (int d = 0; d < D; ++d) xyz[3 * i + static_cast<std::size_t>(d)] = static_cast<double>(ps.position[i][d]);
   });
-  const SurfaceMesh mesh = extract_surface(xyz, D, settings_.surface->settings);
+  SurfaceSettings settings = settings_.surface->settings;
+  settings.solids = obstacles_distance(sim_.params(), sim_.obstacle_poses());  // (where they are now)
+  const SurfaceMesh mesh = extract_surface(xyz, D, settings);
   const std::filesystem::path dir = settings_.dir / "surface";
   make_writable_directory(dir, "the surfaces");
   write_surface_frame(dir, index, mesh, sim_.time(), settings_.surface->formats);

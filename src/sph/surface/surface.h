@@ -21,11 +21,18 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
 
 namespace sph {
+
+/// The signed distance from a point x (world units; z ignored in 2D) to the solids the fluid
+/// cannot enter, negative inside them: exact where it is below `reach`, and any value above
+/// `reach` elsewhere. It is called from several threads at once (solid_cut.h makes one for a
+/// run's obstacles).
+using SolidDistance = std::function<double(const std::array<double, 3>& x, double reach)>;
 
 /// How a surface is made from particles.
 struct SurfaceSettings {
@@ -39,6 +46,10 @@ struct SurfaceSettings {
   /// to half a spacing where the outer particles crowd the wall). z is ignored in 2D.
   bool clip = false;
   std::array<double, 3> clip_lo{}, clip_hi{};
+  /// The obstacles, when set: the field is cut by them as by the container's walls (each value
+  /// at most iso + d / (2 v), d the voxel's distance outside the solids), so that water against
+  /// an obstacle ends on its surface instead of closing over it a particle radius inside it.
+  SolidDistance solids;
 };
 
 /// Sets `s` for a run's particles: the spacing 2 `particle_radius`, and kept inside the container

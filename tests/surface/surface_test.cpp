@@ -178,6 +178,35 @@ TEST(Surface, ClippedToTheContainerNoVertexLiesOutsideIt) {
   }
 }
 
+TEST(Surface, WaterAgainstAWallEndsInAFlatFaceOnIt) {
+  // A block whose outer particles sit half a spacing off the walls at x, y, z = 0 (as the
+  // boundary particles keep them): the wall face is flat on the wall, its vertices exactly on it
+  // (the field reaches about 1 there, with the particles' images beyond the wall), where the
+  // field alone falls to about iso and ripples with the lattice.
+  for (const int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    const auto p = dim == 3 ? block(20, 16, 12) : block(20, 16, 1);
+    SurfaceSettings s = settings();
+    s.clip = true;
+    s.clip_lo = {0, 0, 0};
+    s.clip_hi = {10, 10, 10};
+    const SurfaceMesh m = extract_surface(p, dim, s);
+    // The face on x = 0, away from its edges: every vertex within half a spacing of the wall is on it.
+    std::size_t on = 0, off = 0;
+    for (const auto& v : m.vertices) {
+      if (!(v[0] < 0.5 * kS && v[1] > 0.3 && v[1] < 1.3 && (dim == 2 || (v[2] > 0.3 && v[2] < 0.9)))) continue;
+      (v[0] == 0.0f ? on : off) += 1;
+    }
+    EXPECT_GT(on, 0u);
+    EXPECT_EQ(off, 0u) << "vertices of the wall face off the wall: a face bumpy at the particles' scale";
+    if (dim == 3) expect_closed_and_oriented(m);
+    // The images add nothing beyond the walls: the volume is the water's, the far sides rounded.
+    const double box = 2.0 * 1.6 * (dim == 3 ? 1.2 : 1.0);
+    EXPECT_LE(enclosed_measure(m), box);
+    EXPECT_GT(enclosed_measure(m) / box, 0.98);
+  }
+}
+
 TEST(Surface, CutByTheSolidsNoVertexLiesInsideOne) {
   // Fluid around a ball (radius 0.35 about c), its nearest particles crowding it: 0.2 spacings
   // from its surface where the solver keeps them half a spacing off. The colour field reaches

@@ -564,6 +564,44 @@ std::string surface_settings_error(const SurfaceSettings& s) {
   return {};
 }
 
+namespace {
+
+/// The particles and, with the container's cut, each one's images across the walls within the
+/// kernel's support R of it (across each wall, and across each pair and the three of the walls
+/// it is near, for the edges and corners): the field then sees the water go on beyond a wall it
+/// touches, as the solver's boundary does, and reaches about 1 on the wall, where the cut makes
+/// the flat face, instead of about iso with the lattice's ripple (a surface bumpy at the
+/// particles' scale along every wall). Particles outside the box keep no images.
+std::vector<double> with_wall_images(std::span<const double> positions, int dim, const SurfaceSettings& s) {
+  std::vector<double> out(positions.begin(), positions.end());
+  const double reach = s.smoothing * s.spacing;
+  const std::size_t n = positions.size() / 3;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* x = positions.data() + 3 * i;
+    // Per axis: the particle's own coordinate, then its images across the walls within reach.
+    std::array<std::array<double, 3>, 3> choices{};
+    std::array<int, 3> count{1, 1, 1};
+    bool inside = true;
+    for (int a = 0; a < dim; ++a) {
+      const double lo = s.clip_lo[a], hi = s.clip_hi[a];
+      if (!(x[a] >= lo && x[a] <= hi)) inside = false;
+      choices[a][0] = x[a];
+      if (x[a] - lo < reach) choices[a][count[a]++] = 2 * lo - x[a];
+      if (hi - x[a] < reach) choices[a][count[a]++] = 2 * hi - x[a];
+    }
+    if (!inside) continue;
+    for (int cz = 0; cz < count[2]; ++cz)
+      for (int cy = 0; cy < count[1]; ++cy)
+        for (int cx = 0; cx < count[0]; ++cx) {
+          if (cx == 0 && cy == 0 && cz == 0) continue;
+          out.insert(out.end(), {choices[0][cx], choices[1][cy], dim == 3 ? choices[2][cz] : x[2]});
+        }
+  }
+  return out;
+}
+
+}  // namespace
+
 SurfaceMesh extract_surface(std::span<const double> positions, int dimension, const SurfaceSettings& settings) {
   if (const std::string e = surface_settings_error(settings); !e.empty()) throw Error(e, "surface");
   SPH_CHECK(dimension == 2 || dimension == 3, "extract_surface: dimension must be 2 or 3");
@@ -575,6 +613,12 @@ SurfaceMesh extract_surface(std::span<const double> positions, int dimension, co
     m.dimension = dimension;
     m.voxel_size = settings.spacing / settings.resolution;
     return m;
+  }
+  std::vector<double> imaged;
+  if (settings.clip) {
+    // (a non-finite position has no images, and the originals come first: the refusal names it)
+    imaged = with_wall_images(positions, dimension, settings);
+    positions = imaged;
   }
   if (dimension == 3) return Extractor<3>(positions, settings).run();
   return Extractor<2>(positions, settings).run();

@@ -40,10 +40,13 @@ struct SurfaceSettings {
   double resolution = 2;  ///< voxels per spacing (voxel size s / resolution); 0.5 to 8
   double smoothing = 2;   ///< kernel support R in spacings; 1 to 4
   double iso = 0.5;       ///< the iso-value of the color field; 0.05 to 0.95
-  /// The container, when `clip`: the surface is kept inside it. The field is cut by the box's
-  /// walls (the sampled value is at most iso + d / (2 v), d the distance inside the box), so
-  /// water against a wall ends in a flat face on the wall instead of bulging through it (by up
-  /// to half a spacing where the outer particles crowd the wall). z is ignored in 2D.
+  /// The container, when `clip`: the surface is kept inside it. Each particle within R of a
+  /// wall is mirrored across it (and across each pair and the three of the walls it is near),
+  /// so that the field goes on beyond a wall the water touches as the water would, and the
+  /// field is cut by the box's walls (the sampled value is at most iso + d / (2 v), d the
+  /// distance inside the box): water against a wall ends in a flat face on the wall, neither
+  /// bulging through it (by up to half a spacing where the outer particles crowd the wall) nor
+  /// rippling at the particles' scale where they keep half a spacing off it. z is ignored in 2D.
   bool clip = false;
   std::array<double, 3> clip_lo{}, clip_hi{};
   /// The obstacles, when set: the field is cut by them as by the container's walls (each value

@@ -172,9 +172,9 @@ TEST(FrameImage, RunObstaclesArePlacedAtTheFramesTime) {
   EXPECT_EQ(at_rest[1].translation, (std::array<double, 3>{0, 0, 0}));
 }
 
-TEST(FrameImage, FloatingBodiesAreDrawnWhereTheRunsTableHasThem) {
-  // A floating box [0.2, 0.4] x [0, 0.2] (centre 0.3, 0.1) whose bodies.csv rows put it at
-  // (1, 0.5) turned by 90 degrees at t = 1 s, and back at rest at t = 0.
+/// run2d with a floating box [0.2, 0.4] x [0, 0.2] (centre 0.3, 0.1) whose bodies.csv rows put it
+/// at (1, 0.5) turned by 90 degrees at t = 1 s, and at rest at t = 0.
+RunDirectory run_with_floating_box() {
   RunDirectory run = run2d("floating");
   SceneBody<2> body;
   body.sim.obstacles = {Box<2>{{{0.2, 0}}, {{0.4, 0.2}}}};
@@ -185,6 +185,11 @@ TEST(FrameImage, FloatingBodiesAreDrawnWhereTheRunsTableHasThem) {
   run.scene.set_body(body);
   const double h = std::sqrt(0.5);
   run.bodies = {BodyPoseRow{0.0, 0, {0.3, 0.1, 0}, {1, 0, 0, 0}}, BodyPoseRow{1.0, 0, {1.0, 0.5, 0}, {h, 0, 0, h}}};
+  return run;
+}
+
+TEST(FrameImage, FloatingBodiesAreDrawnWhereTheRunsTableHasThem) {
+  RunDirectory run = run_with_floating_box();
   // Each frame's row: t = 0 at rest, t = 1 moved and turned.
   EXPECT_TRUE(run_obstacles(run, 0.0)[0].axis_aligned());
   EXPECT_NEAR(run_obstacles(run, 0.0)[0].translation[0], 0.0, 1e-12);
@@ -218,17 +223,7 @@ TEST(FrameImage, TheSurfacesCutIsTheObstaclesWhereTheFrameHasThem) {
   EXPECT_GT(at_half({0.3, 0.15, 0}, 1), 0.7);  // where it is at rest: fluid's space (the stirrer 0.75 away)
   EXPECT_NEAR(run_obstacles_distance(moving, 0.0)({0.3, 0.15, 0}, 1), -0.1, 1e-12);
   // The floating box at t = 1 s, from bodies.csv: [0.9, 1.1] x [0.4, 0.6] (a square turned by 90 degrees).
-  RunDirectory floating = run2d("floating");
-  SceneBody<2> body;
-  body.sim.obstacles = {Box<2>{{{0.2, 0}}, {{0.4, 0.2}}}};
-  BodyParams<2> b;
-  b.dynamic = true;
-  b.density = 500;
-  body.sim.bodies = {b};
-  floating.scene.set_body(body);
-  const double h = std::sqrt(0.5);
-  floating.bodies = {BodyPoseRow{0.0, 0, {0.3, 0.1, 0}, {1, 0, 0, 0}},
-                     BodyPoseRow{1.0, 0, {1.0, 0.5, 0}, {h, 0, 0, h}}};
+  const RunDirectory floating = run_with_floating_box();
   EXPECT_NEAR(run_obstacles_distance(floating, 1.0)({1.0, 0.5, 0}, 1), -0.1, 1e-12);
   EXPECT_NEAR(run_obstacles_distance(floating, 1.0)({1.25, 0.5, 0}, 1), 0.15, 1e-12);
   // No obstacles: no cut.

@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <type_traits>
 #include <utility>
 #include <variant>
@@ -24,6 +26,7 @@
 #include <sph/neighbors/neighbor_mode.h>
 #include <sph/run/driver.h>
 #include <sph/scene/dispatch.h>
+#include <sph/surface/surface.h>
 
 #include "module.h"
 
@@ -282,6 +285,38 @@ class PySimulation {
     });
   }
 
+  /// The free surface now (RunDriver::surface): {"vertices": (n, 3) float32, "normals": (n, 3)
+  /// float32 (3D; (0, 3) in 2D), "triangles": (m, 3) uint32 (3D) or "segments": (m, 2) uint32
+  /// (2D), "voxel_size": float}.
+  py::dict surface(double resolution, double smoothing, double iso) const {
+    SurfaceSettings settings;
+    settings.resolution = resolution, settings.smoothing = smoothing, settings.iso = iso;
+    settings.spacing = 1;  // (the scene's, set by RunDriver::surface: here only the three are checked)
+    if (const std::string e = surface_settings_error(settings); !e.empty()) throw py::value_error(e);
+    SurfaceMesh mesh;
+    visit([&](const auto& d) {
+      const Busy busy(busy_);
+      py::gil_scoped_release release;
+      use_threads(threads_);
+      mesh = d.surface(settings);
+    });
+    const auto rows = [](const auto& v, auto zero) {
+      constexpr std::size_t kCols = std::tuple_size_v<std::decay_t<decltype(v[0])>>;
+      py::array_t<decltype(zero)> a({static_cast<py::ssize_t>(v.size()), static_cast<py::ssize_t>(kCols)});
+      if (!v.empty()) std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(v[0]));
+      return a;
+    };
+    py::dict out;
+    out["vertices"] = rows(mesh.vertices, 0.0f);
+    out["normals"] = rows(mesh.normals, 0.0f);
+    if (mesh.dimension == 3)
+      out["triangles"] = rows(mesh.triangles, std::uint32_t{0});
+    else
+      out["segments"] = rows(mesh.segments, std::uint32_t{0});
+    out["voxel_size"] = mesh.voxel_size;
+    return out;
+  }
+
   Scene scene() const {
     return visit([](const auto& d) { return Scene{d.scene()}; });
   }
@@ -501,6 +536,15 @@ after the current step with KeyboardInterrupt; the simulation stays usable.)doc"
       .def("neighbor_lists", &PySimulation::neighbor_lists,
            "Every list of the last step as (offsets, indices): particle i's neighbors are "
            "indices[offsets[i]:offsets[i + 1]] (copies).")
+      .def("surface", &PySimulation::surface, py::kw_only(), py::arg("resolution") = 2.0, py::arg("smoothing") = 2.0,
+           py::arg("iso") = 0.5,
+           R"doc(The water's free surface now, as sph run --surface meshes each frame (docs/visualization.md,
+"Surfaces"): resolution voxels per particle spacing (0.5 to 8), smoothing the kernel radius in
+spacings (1 to 4), iso the colour field's level (0.05 to 0.95); cut by the container's walls and
+the obstacles where they are now. A dict: "vertices" (n, 3) float32, "normals" (n, 3) float32
+(outward; (0, 3) in 2D), "triangles" (m, 3) uint32 (3D, counter-clockwise seen from outside) or
+"segments" (m, 2) uint32 (2D, the water on their left), "voxel_size" (m). ValueError for a
+setting out of range.)doc")
       .def("write_frame", &PySimulation::write_frame, py::arg("path"), py::arg("fields") = py::none(),
            "Writes the particles as one frame file, as sph run writes its frames; the format comes from the "
            "extension (.vtu, .vtk, .ply); fields: the point fields (default: all frames hold).");

@@ -214,3 +214,59 @@ def test_bodies_are_the_bodies_csv_rows(tmp_path):
     assert [last["vx"], last["vy"]] == body["velocity"] and last["wz"] == body["angular_velocity"]
     assert [last["fx"], last["fy"]] == body["force"] and last["mz"] == body["moment"]
     assert body["velocity"][1] < 0  # it fell onto the water
+
+
+def read_surface_ply(path):
+    """The vertices (x y z and normals, float32) and triangles of a binary PLY `sph surface` wrote."""
+    data = open(path, "rb").read()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode().splitlines()
+    count = {line.split()[1]: int(line.split()[2]) for line in header if line.startswith("element")}
+    vertices = np.frombuffer(data, dtype="<f4", count=6 * count["vertex"], offset=end).reshape(-1, 6)
+    faces = np.frombuffer(data, dtype=np.dtype([("n", "u1"), ("v", "<u4", 3)]), count=count["face"],
+                          offset=end + vertices.nbytes)
+    assert np.all(faces["n"] == 3)
+    return vertices, faces["v"]
+
+
+def test_surface_is_the_one_sph_run_writes_and_ends_on_the_walls(small_3d, tmp_path):
+    # The block after 20 steps, meshed through the API and by `sph run --surface`: the same mesh.
+    path = write_scene(small_3d, tmp_path / "scene.json")
+    out = tmp_path / "run"
+    run_sph("run", path, "-o", out, "--steps", STEPS, "--every", STEPS, "--surface", "--surface-format", "ply",
+            "--no-progress")
+    vertices, triangles = read_surface_ply(out / "surface" / "surface_000001.ply")
+    sim = sph.Simulation(small_3d)
+    sim.step(STEPS)
+    mesh = sim.surface()
+    assert set(mesh) == {"vertices", "normals", "triangles", "voxel_size"}
+    assert mesh["vertices"].dtype == np.float32 and mesh["triangles"].dtype == np.uint32
+    assert np.array_equal(mesh["vertices"], vertices[:, :3])
+    assert np.array_equal(mesh["normals"], vertices[:, 3:])
+    assert np.array_equal(mesh["triangles"], triangles)
+    assert mesh["voxel_size"] == pytest.approx(0.01)  # spacing 0.02 / resolution 2
+    # Closed: each directed edge once, its reverse once.
+    edges = {(int(a), int(b)) for t in mesh["triangles"] for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))}
+    assert len(edges) == 3 * len(mesh["triangles"])
+    assert all((b, a) in edges for a, b in edges)
+    # Inside the container, and finer settings give more vertices.
+    assert mesh["vertices"].min() >= 0 and mesh["vertices"].max() <= 0.3
+    assert len(sim.surface(resolution=3)["vertices"]) > len(mesh["vertices"])
+
+
+def test_surface_in_2d_is_segments_and_bad_settings_are_refused(small_2d):
+    sim = sph.Simulation(small_2d)
+    mesh = sim.surface()
+    assert set(mesh) == {"vertices", "normals", "segments", "voxel_size"}
+    assert mesh["normals"].shape == (0, 3) and mesh["segments"].shape[1] == 2
+    assert np.all(mesh["vertices"][:, 2] == 0)
+    # One closed loop around the column (every vertex starts one segment and ends one).
+    starts, ends = np.sort(mesh["segments"][:, 0]), np.sort(mesh["segments"][:, 1])
+    assert np.array_equal(starts, ends) and len(np.unique(starts)) == len(mesh["vertices"])
+    for kwargs, message in [({"resolution": 9}, "resolution must be 0.5 to 8"),
+                            ({"smoothing": 0.5}, "smoothing must be 1 to 4"),
+                            ({"iso": 1.0}, "iso must be 0.05 to 0.95")]:
+        with pytest.raises(ValueError, match=message):
+            sim.surface(**kwargs)
+    with pytest.raises(TypeError):
+        sim.surface(2.0)  # keyword arguments only

@@ -35,6 +35,14 @@ Simulation<D, R> build_simulation(const SceneDesc& desc, const RunSettings& sett
   return make_simulation<D, R>(desc, initial);
 }
 
+/// `s` fitted to the scene's particle spacing and cut by its container (fit_to_run).
+template <int D>
+void fit_to_scene(SurfaceSettings& s, const SimulationParams<D>& p) {
+  std::array<double, 3> lo{}, hi{};
+  for (int d = 0; d < D; ++d) lo[d] = p.container.lo[d], hi[d] = p.container.hi[d];
+  fit_to_run(s, p.particle_radius, lo, hi);
+}
+
 }  // namespace
 
 template <int D, std::floating_point R>
@@ -47,10 +55,7 @@ RunDriver<D, R>::RunDriver(SceneDesc desc, RunSettings settings)
   SPH_CHECK(!settings_.surface || !settings_.dir.empty(), "RunDriver: surfaces need a directory");
   if (settings_.surface) {
     SurfaceSettings& s = settings_.surface->settings;
-    const SimulationParams<D>& p = sim_.params();
-    std::array<double, 3> lo{}, hi{};
-    for (int d = 0; d < D; ++d) lo[d] = p.container.lo[d], hi[d] = p.container.hi[d];
-    fit_to_run(s, p.particle_radius, lo, hi);
+    fit_to_scene(s, sim_.params());
     if (const std::string e = surface_settings_error(s); !e.empty()) throw Error(e, "--surface");
   }
   if (!settings_.dir.empty()) {
@@ -82,18 +87,23 @@ template <int D, std::floating_point R>
 void RunDriver<D, R>::write_new_surface() {
   if (!settings_.surface || !output_ || output_->frames_written() == surfaces_written_) return;
   const std::size_t index = output_->frames_written() - 1;
+  const SurfaceMesh mesh = surface(settings_.surface->settings);
+  const std::filesystem::path dir = settings_.dir / "surface";
+  make_writable_directory(dir, "the surfaces");
+  write_surface_frame(dir, index, mesh, sim_.time(), settings_.surface->formats);
+  surfaces_written_ = output_->frames_written();
+}
+
+template <int D, std::floating_point R>
+SurfaceMesh RunDriver<D, R>::surface(SurfaceSettings settings) const {
+  fit_to_scene(settings, sim_.params());
+  settings.solids = obstacles_distance(sim_.params(), sim_.obstacle_poses());  // (where they are now)
   const ParticleSet<D, R>& ps = sim_.particles();
   std::vector<double> xyz(3 * ps.size(), 0.0);
   parallel_for(ps.size(), [&](std::size_t i) {
     for (int d = 0; d < D; ++d) xyz[3 * i + static_cast<std::size_t>(d)] = static_cast<double>(ps.position[i][d]);
   });
-  SurfaceSettings settings = settings_.surface->settings;
-  settings.solids = obstacles_distance(sim_.params(), sim_.obstacle_poses());  // (where they are now)
-  const SurfaceMesh mesh = extract_surface(xyz, D, settings);
-  const std::filesystem::path dir = settings_.dir / "surface";
-  make_writable_directory(dir, "the surfaces");
-  write_surface_frame(dir, index, mesh, sim_.time(), settings_.surface->formats);
-  surfaces_written_ = output_->frames_written();
+  return extract_surface(xyz, D, settings);
 }
 
 template <int D, std::floating_point R>

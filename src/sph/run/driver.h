@@ -132,6 +132,11 @@ class RunDriver {
   /// directory (SPH_CHECK) that has not run(). Throws the step's sph::Error (a blow-up, a failed
   /// health check); its warnings are new_warnings() of what it returns.
   const StepInfo& step();
+  /// The free surface of the particles now (sph/surface/surface.h), made as `sph run --surface`
+  /// makes each frame's: `settings` (resolution, smoothing, iso) fitted to the scene's particle
+  /// spacing and cut by its container and its obstacles where they are now. Throws sph::Error
+  /// for bad settings (surface_settings_error).
+  SurfaceMesh surface(SurfaceSettings settings) const;
   /// The texts of the health warnings a step raised first (HealthMonitor::warning), in the
   /// order of the health kinds: what run() reports through RunCallbacks::warning.
   std::vector<std::string> new_warnings(const StepInfo& step) const;

@@ -63,23 +63,16 @@ SolidBox placed_box(const SimulationParams<D>& sim, std::size_t k, const RigidPo
   return s;
 }
 
-/// Obstacle k of `sim` placed at `time` (obstacle_solid; obstacle_pose_at()).
-template <int D>
-SolidBox placed_obstacle(const SimulationParams<D>& sim, std::size_t k, double time,
-                         std::span<const BodyPoseRow> bodies) {
-  return placed_box(sim, k, obstacle_pose_at(sim, k, time, bodies));
-}
-
 }  // namespace
 
 SolidBox obstacle_solid(const SimulationParams<2>& sim, std::size_t k, double time,
                         std::span<const BodyPoseRow> bodies) {
-  return placed_obstacle(sim, k, time, bodies);
+  return placed_box(sim, k, obstacle_pose_at(sim, k, time, bodies));
 }
 
 SolidBox obstacle_solid(const SimulationParams<3>& sim, std::size_t k, double time,
                         std::span<const BodyPoseRow> bodies) {
-  return placed_obstacle(sim, k, time, bodies);
+  return placed_box(sim, k, obstacle_pose_at(sim, k, time, bodies));
 }
 
 std::vector<SolidBox> run_obstacles(const RunDirectory& run, double time) {

@@ -14,9 +14,9 @@ namespace {
 
 const HealthWatch& watch(HealthKind kind) { return kHealthWatches[static_cast<std::size_t>(kind)]; }
 
-/// Monaghan's artificial viscosity alpha = 0.1 as a dynamic viscosity: mu = rho0 alpha (h / 2) c0 / 8
-/// (his smoothing length is about half the kernel support h).
-double suggested_viscosity(const HealthScene& s) {  // (the default viscosity's formula)
+/// Monaghan's artificial viscosity alpha = 0.1 as a dynamic viscosity, by the formula the scene
+/// reader's default viscosity uses (viscosity_for_sound_speed, solver/params.h).
+double suggested_viscosity(const HealthScene& s) {
   return viscosity_for_sound_speed(s.dimension, kArtificialViscosityAlpha, s.kernel_radius, s.sound_speed,
                                    s.rest_density);
 }

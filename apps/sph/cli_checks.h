@@ -19,6 +19,7 @@
 
 #include <sph/core/error.h>
 #include <sph/io/run_directory.h>
+#include <sph/neighbors/neighbor_mode.h>
 
 namespace sph::app {
 
@@ -33,6 +34,21 @@ inline CLI::Validator positive_number(const std::string& what) {
         return "expected a positive number (" + what + "), got " + text;
       },
       "POSITIVE");
+}
+
+/// A CLI11 check that the value names a neighbor mode, with parse_neighbor_mode's message (the
+/// modes, and the one a misspelling was probably meant to be).
+inline CLI::Validator neighbor_mode_check() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        try {
+          parse_neighbor_mode(text);
+          return {};
+        } catch (const Error& e) {
+          return e.message();
+        }
+      },
+      "MODE");
 }
 
 /// A CLI11 check that the value is not empty, for options whose absence means a default: given as

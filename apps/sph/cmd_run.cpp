@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
@@ -57,9 +58,10 @@ struct RunOptions {
 };
 
 /// The comma-separated names of `list` as a JSON array of strings, each checked against
-/// `choices`; `none` (if given) stands for the empty list. Throws sph::Error naming `flag`.
+/// `choices`; `none` (if given), alone, stands for the empty list, which `none_means` says in
+/// words. Throws sph::Error naming `flag`.
 std::string name_list_json(const std::string& list, const std::vector<std::string>& choices, const std::string& flag,
-                           const char* none = nullptr) {
+                           const char* none = nullptr, const char* none_means = nullptr) {
   std::string expected;
   for (const auto& c : choices) expected += (expected.empty() ? "" : ", ") + c;
   if (none && list == none) return "[]";
@@ -68,10 +70,15 @@ std::string name_list_json(const std::string& list, const std::vector<std::strin
   while (true) {
     const std::size_t comma = list.find(',', begin);
     const std::string name = list.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+    if (none && name == none)
+      throw Error(fmt::format("\"{}\" ({}) cannot be combined with other names; give it alone, or list the ones "
+                              "wanted from {}",
+                              none, none_means, expected),
+                  flag);
     if (std::find(choices.begin(), choices.end(), name) == choices.end())
       throw Error(fmt::format("{}\"{}\" is not one of {}; expected a comma-separated list such as {},{}{}",
                               name.empty() ? "an empty name in the list: " : "", name, expected, choices[0], choices[1],
-                              none ? fmt::format(" (or {} for none)", none) : std::string()),
+                              none ? fmt::format(", or {} alone ({})", none, none_means) : std::string()),
                   flag);
     if (std::find(names.begin(), names.end(), name) != names.end())
       throw Error("\"" + name + "\" is given twice; expected each name at most once", flag);
@@ -100,9 +107,9 @@ std::vector<std::string> output_overrides(const RunOptions& opt) {
   if (opt.formats)
     sets.push_back("Configuration.outputFormats=" + name_list_json(*opt.formats, frame_format_names(), "--format"));
   if (opt.fields)
-    sets.push_back(
-        "Configuration.outputFields=" +
-        name_list_json(*opt.fields, {std::begin(kFrameFieldNames), std::end(kFrameFieldNames)}, "--fields", "none"));
+    sets.push_back("Configuration.outputFields=" +
+                   name_list_json(*opt.fields, {std::begin(kFrameFieldNames), std::end(kFrameFieldNames)}, "--fields",
+                                  "none", "positions only"));
   return sets;
 }
 
@@ -352,9 +359,20 @@ int run(const RunOptions& opt) {
       opt.output ? std::filesystem::path(*opt.output) : std::filesystem::path("out") / desc.name;
   check_new_run_directory(dir, opt.overwrite, "-o/--output", "--overwrite",
                           "continue it with sph run --resume " + shell_word(dir.string()));
-  if (!files_a_run_replaces(dir).empty())
-    fmt::print(stderr, "sph: replacing the earlier run's files in {} (its frames, stats, summary and pictures)\n",
-               dir.string());
+  if (const std::vector<std::filesystem::path> replaced = files_a_run_replaces(dir); !replaced.empty()) {
+    std::error_code ec;
+    if (std::filesystem::exists(dir / kRunIdentityFile, ec)) {
+      fmt::print(stderr, "sph: replacing the earlier run's files in {} (its frames, stats, summary and pictures)\n",
+                 dir.string());
+    } else {  // (--overwrite of files no run of this directory wrote: name them)
+      std::vector<std::string> names;
+      for (std::size_t k = 0; k < replaced.size() && k < 3; ++k)
+        names.push_back(replaced[k].lexically_relative(dir).string());
+      if (replaced.size() > 3) names.push_back(fmt::format("{} more", replaced.size() - 3));
+      fmt::print(stderr, "sph: replacing files a run writes in {} ({}): --overwrite was given\n", dir.string(),
+                 fmt::join(names, ", "));
+    }
+  }
   return dispatch(desc, [&]<int D, class R>() { return run_scene<D, R>(desc, opt, dir, nullptr); });
 }
 
@@ -366,7 +384,7 @@ std::function<int()> add_run_command(CLI::App& app) {
   cmd->add_option("scene", opt->scene, "Scene file (JSON; see docs/scene-format.md); required unless --resume");
   cmd->add_option("-o,--output", opt->output, "Output directory (default: out/<scene name>)");
   cmd->add_option("--neighbors", opt->neighbors, "Neighbor strategy, overriding the scene's Configuration.neighbors")
-      ->check(CLI::IsMember(neighbor_mode_names()));
+      ->check(neighbor_mode_check());
   cmd->add_option("--steps", opt->steps, "Number of steps, overriding Configuration.numberOfSteps")
       ->check(in_range(std::int64_t{1}, std::int64_t{1'000'000'000'000}));
   cmd->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(in_range(1, 4096));

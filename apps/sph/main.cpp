@@ -9,6 +9,7 @@
 #include <exception>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -54,6 +55,38 @@ std::string first_unknown_option(CLI::App& app, const CLI::App* command, int arg
     std::vector<std::string> offered = option_names(command ? *command : app, false);
     if (command) offered.push_back("--help");
     return a + sph::did_you_mean(a, offered, "");
+  }
+  return {};
+}
+
+/// `description` as the rest of a sentence: its first letter in lower case.
+std::string lower_first(std::string description) {
+  if (!description.empty())
+    description[0] = static_cast<char>(std::tolower(static_cast<unsigned char>(description[0])));
+  return description;
+}
+
+/// CLI11's message for a missing argument or value, said as sph's messages say things (what is
+/// missing, and what is expected), or "" for the other errors. CLI11 says "scene is required"
+/// and "--output: 1 required TEXT missing".
+std::string missing_value_message(const CLI::ParseError& e, const CLI::App& command) {
+  const std::string message = e.what();
+  if (dynamic_cast<const CLI::RequiredError*>(&e) != nullptr) {
+    const auto end = message.find(" is required");
+    if (end == std::string::npos) return {};
+    const CLI::Option* o = command.get_option_no_throw(message.substr(0, end));
+    if (o == nullptr || !o->get_positional()) return {};
+    std::string name = o->get_name();
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::toupper(c); });
+    return fmt::format("sph {} needs {}: {}", command.get_name(), name, lower_first(o->get_description()));
+  }
+  if (dynamic_cast<const CLI::ArgumentMismatch*>(&e) != nullptr) {
+    const auto colon = message.find(": ");
+    if (colon == std::string::npos || message.find(" missing", colon) == std::string::npos) return {};
+    const std::string flag = message.substr(0, colon);
+    const CLI::Option* o = command.get_option_no_throw(flag);
+    if (o == nullptr) return {};
+    return fmt::format("{} needs a value: {}", flag, lower_first(o->get_description()));
   }
   return {};
 }
@@ -143,6 +176,8 @@ int main(int argc, char** argv) {
       message = fmt::format("unexpected argument{} {}; sph {} takes only the arguments its help lists",
                             extra.find(' ') == std::string::npos ? "" : "s", extra, command->get_name());
     }
+    if (command != nullptr)
+      if (std::string missing = missing_value_message(e, *command); !missing.empty()) message = std::move(missing);
     const std::string unknown = first_unknown_option(app, command, argc, argv);
     if (!unknown.empty()) message = "unknown option " + unknown;
     // A mistyped command (sph rnu scene.json): CLI11 says only that a subcommand is required.

@@ -173,6 +173,20 @@ TEST_F(Cli, MistypedCommandsAndValuesAreNamedAsWhatTheyAre) {
       {{"bench", "--suite", "neighbors", "-o", "afile/b"},
        "cannot create the output directory: afile is a file, not a directory; expected a directory path for the "
        "benchmark results"},
+      // A missing argument or value, in words (CLI11 said "scene is required", "--output: 1
+      // required TEXT missing" and "--neighbors: adaptiv not in {standard,adaptive,...}").
+      {{"compare"}, "sph compare needs SCENE: scene file (JSON; see docs/scene-format.md)"},
+      {{"render"}, "sph render needs DIR: a run's output directory (sph run -o DIR)"},
+      {{"surface"}, "sph surface needs DIR: a run's output directory (sph run -o DIR)"},
+      {{"run", kDamBreak, "-o"}, "--output needs a value: output directory (default: out/<scene name>)"},
+      {{"run", kDamBreak, "--threads"}, "--threads needs a value: worker threads (default: all cores)"},
+      {{"run", kDamBreak, "--neighbors", "adaptiv"},
+       "--neighbors: unknown neighbor mode \"adaptiv\" (did you mean \"adaptive\"?); expected one of \"standard\""},
+      {{"compare", kDamBreak, "--modes", "verlte"}, "unknown neighbor mode \"verlte\" (did you mean \"verlet\"?)"},
+      {{"run", kDamBreak, "--fields", "none,id"},
+       "--fields: \"none\" (positions only) cannot be combined with other names; give it alone, or list the ones "
+       "wanted from velocity, density"},
+      {{"run", kDamBreak, "--fields", "vel"}, ", or none alone (positions only)"},
   };
   std::ofstream(work_ / "afile") << "x";
   for (const auto& [args, message] : cases) {

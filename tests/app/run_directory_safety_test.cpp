@@ -314,7 +314,11 @@ TEST_F(RunDirectory, AUsersOwnFilesThatARunWouldReplaceAreRefusedUnlessOverwrite
   expect_refused(sph({"compare", kDamBreak, "--steps", "2", "-o", ""}), {"-o/--output: an empty directory name"});
   // An earlier run's directory is replaced as before; --overwrite allows the user's.
   run("d", 5);
-  run("mine", 2, {"--overwrite"});
+  r = sph({"run", kDamBreak, "--steps", "2", "--no-progress", "-o", "mine", "--overwrite"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  // It says which files it replaced: they are the user's, not an earlier run's.
+  EXPECT_CONTAINS(r.err, "sph: replacing files a run writes in mine (stats.csv, scene.json, frames/frame_000000.vtu)");
+  EXPECT_EQ(r.err.find("the earlier run's files"), std::string::npos) << r.err;
   EXPECT_EQ(slurp(at("mine") / "notes.txt"), "mine") << "a file no run writes is kept";
   EXPECT_TRUE(fs::exists(at("mine") / "run.json"));
 }

@@ -154,7 +154,7 @@ TEST_F(TrueMessages, AnEmitterHeightIsRefusedIn2DAsTheDocsSay) {
                                "Emitters=[{\"translation\":[0.5,0.5],\"direction\":[1,0],\"velocity\":1,\"width\":4,"
                                "\"height\":4,\"maxParticles\":10}]",
                                "-o", "o"});
-  expect_refused(r, {"Emitters[0].height: unknown key"});
+  expect_refused(r, {"Emitters[0].height: not a key of a 2D emitter", "a line of `width` particles"});
   EXPECT_EQ(doc("docs/physics.md").find("ignored in 2D"), std::string::npos);
   EXPECT_CONTAINS(doc("docs/scene-format.md"), "| `height` | particles | required in 3D, refused in 2D |");
 }

@@ -1,6 +1,7 @@
 #include <sph/neighbors/neighbor_mode.h>
 
 #include <sph/core/error.h>
+#include <sph/core/spelling.h>
 
 namespace sph {
 
@@ -36,7 +37,9 @@ NeighborMode parse_neighbor_mode(std::string_view name, const std::string& where
                     "expected one of " + expected,
                 where);
   }
-  throw Error("unknown neighbor mode \"" + std::string(name) + "\"; expected one of " + expected, where);
+  throw Error("unknown neighbor mode \"" + std::string(name) + "\"" + did_you_mean(name, neighbor_mode_names(set)) +
+                  "; expected one of " + expected,
+              where);
 }
 
 std::vector<std::string> neighbor_mode_names(NeighborModeSet set) {

@@ -160,6 +160,11 @@ json parse_json(const std::string& text, const std::string& source) {
     std::string what = e.what();
     const auto pos = what.find("syntax error");
     if (pos != std::string::npos) what = what.substr(pos);
+    // A comment (// or /*) where the error is: JSON has none, and the parser's words do not say so.
+    const std::size_t near = end >= 2 ? end - 2 : 0;
+    const std::string around = text.substr(near, end + 2 - near);
+    if (around.find("//") != std::string::npos || around.find("/*") != std::string::npos)
+      what += " (JSON has no comments: remove the // or /* */ text, or put a note in the scene's \"description\")";
     throw Error("JSON syntax error: " + what, fmt::format("{}:{}:{}", source, line, col));
   } catch (const json::exception& e) {
     // For example a number too large for a double (1e999).

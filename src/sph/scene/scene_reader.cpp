@@ -618,6 +618,10 @@ EmitterParams<D> read_emitter(ObjectReader& e, const SimulationParams<D>& sim) {
   em.direction = *unit;
   em.speed = e.positive("velocity", "a positive emission speed in m/s");
   em.width = static_cast<int>(e.integer("width", "a nozzle width of 1 to 10000 particles", 1, 10000));
+  if constexpr (D == 2)
+    if (e.find("height"))
+      e.ctx().fail(e.child("height"),
+                   "not a key of a 2D emitter: a 2D nozzle is a line of `width` particles; height is for 3D scenes");
   em.height = D == 3 ? static_cast<int>(e.integer("height", "a nozzle height of 1 to 10000 particles", 1, 10000)) : 1;
   em.spacing = 2.0 * sim.particle_radius;
   // Absent: 16, or the fewest steps a batch needs to clear the nozzle (check_emitter_travel).
@@ -758,7 +762,8 @@ void read_body(ObjectReader& root, SceneDesc& desc) {
   if (std::none_of(sim.motions.begin(), sim.motions.end(), [](const ObstacleMotion<D>& m) { return m.moves(); }))
     sim.motions.clear();
   if (!any_dynamic_body(sim)) sim.bodies.clear();
-  root.array_of_objects("Emitters", detail::emitter_keys(D), [&](ObjectReader& e, std::size_t) {
+  // (every dimension's keys: read_emitter says why a 3D key is not one of a 2D scene)
+  root.array_of_objects("Emitters", detail::emitter_keys(3), [&](ObjectReader& e, std::size_t) {
     sim.emitters.push_back(read_emitter<D>(e, sim));
     total += static_cast<double>(sim.emitters.back().max_particles);
   });

@@ -15,11 +15,13 @@ std::vector<TimeStepLimit> time_step_limits(const SimulationParams<D>& p) {
   std::vector<TimeStepLimit> out;
   const double dt = p.time_step;
   const double h = p.kernel_radius;
-  auto add = [&](const char* name, double warn, double refuse) { out.push_back({name, dt / warn, warn, refuse}); };
+  auto add = [&](const char* name, double warn, double refuse, const char* keys) {
+    out.push_back({name, dt / warn, warn, refuse, false, keys});
+  };
   const double c = std::sqrt(p.fluid.stiffness);
   // DFSPH solves for its pressure: there is no sound speed to resolve.
   if (c > 0 && p.method == SimulationMethod::Wcsph) {
-    add("acoustic CFL (dt <= 0.4 h / sqrt(stiffness))", 0.4 * h / c, 1.0 * h / c);
+    add("acoustic CFL (dt <= 0.4 h / sqrt(stiffness))", 0.4 * h / c, 1.0 * h / c, "a lower Fluid.stiffness");
     out.back().acoustic = true;
   }
   const double nu = p.fluid.viscosity / p.fluid.rest_density;
@@ -31,33 +33,38 @@ std::vector<TimeStepLimit> time_step_limits(const SimulationParams<D>& p) {
   if (p.fluid.viscosity_model == ViscosityModel::Paper && p.fluid.viscosity_solve == ViscositySolve::Explicit &&
       nu > 0) {
     if (p.fluid.kernel == KernelKind::Paper)
-      add("viscous diffusion (dt <= 0.125 h^2 rho0 / viscosity)", 0.125 * h * h / nu, 0.5 * h * h / nu);
+      add("viscous diffusion (dt <= 0.125 h^2 rho0 / viscosity)", 0.125 * h * h / nu, 0.5 * h * h / nu,
+          "a lower Fluid.viscosity, or Fluid.viscositySolver \"implicit\" (no step limit)");
     else
       add("viscous diffusion (dt <= 0.0625 h^2 rho0 / viscosity with the cubic spline and Wendland C2)",
-          0.0625 * h * h / nu, 0.25 * h * h / nu);
+          0.0625 * h * h / nu, 0.25 * h * h / nu,
+          "a lower Fluid.viscosity, or Fluid.viscositySolver \"implicit\" (no step limit)");
   }
   // Artificial viscosity's diffusion, nu = alpha h c / (2 (D + 2)) (Monaghan 2005), is below the
   // acoustic limit's for alpha < 1; it is checked the same way.
   const double nu_art = p.fluid.alpha * h * c / (2.0 * (D + 2));
   if (p.fluid.viscosity_model == ViscosityModel::Artificial && nu_art > 0)
     add("artificial viscosity's diffusion (dt <= 0.125 h^2 / nu, nu = alpha h c0 / (2 (D + 2)))",
-        0.125 * h * h / nu_art, 0.5 * h * h / nu_art);
+        0.125 * h * h / nu_art, 0.5 * h * h / nu_art, "a lower Fluid.artificialViscosityAlpha or Fluid.stiffness");
   // Boundary particles' friction (Akinci et al. 2012) is an artificial viscosity at the walls
   // with nu = sigma h c0 / (2 (D + 2)): the same diffusion limit.
   const double nu_wall = p.boundary.friction * h * c / (2.0 * (D + 2));
   if (p.boundary.handling == BoundaryHandling::Particles && nu_wall > 0)
     add("boundary friction's diffusion (dt <= 0.125 h^2 / nu, nu = boundaryFriction h c0 / (2 (D + 2)))",
-        0.125 * h * h / nu_wall, 0.5 * h * h / nu_wall);
+        0.125 * h * h / nu_wall, 0.5 * h * h / nu_wall, "a lower Configuration.boundaryFriction or Fluid.stiffness");
   // Penalty walls only: boundary particles act through the pressure (the acoustic limit).
   const bool springs = p.boundary.handling == BoundaryHandling::Penalty;
   if (springs && p.walls.stiffness > 0) {
     const double w = std::sqrt(p.walls.stiffness);
-    add("wall spring (dt <= 0.5 / sqrt(wall stiffness))", 0.5 / w, 1.5 / w);
+    add("wall spring (dt <= 0.5 / sqrt(wall stiffness))", 0.5 / w, 1.5 / w, "a lower Container.wallStiffness");
   }
   if (springs && p.walls.damping > 0)
-    add("wall damping (dt <= 0.5 / wall damping)", 0.5 / p.walls.damping, 1.5 / p.walls.damping);
+    add("wall damping (dt <= 0.5 / wall damping)", 0.5 / p.walls.damping, 1.5 / p.walls.damping,
+        "a lower Container.wallDamping");
   const double g = norm(p.gravity);
-  if (g > 0) add("gravity (dt <= 0.25 sqrt(h / |g|))", 0.25 * std::sqrt(h / g), std::sqrt(h / g));
+  if (g > 0)
+    add("gravity (dt <= 0.25 sqrt(h / |g|))", 0.25 * std::sqrt(h / g), std::sqrt(h / g),
+        "a larger Configuration.kernelRadius or a weaker Configuration.gravitation");
   return out;
 }
 
@@ -76,8 +83,8 @@ std::vector<std::string> check_time_step(const SimulationParams<D>& p) {
     if (p.time_step > l.dt_refuse)
       throw Error(fmt::format("time step {:.4g} s is unstable by the {} criterion, which gives {:.4g} s here; a "
                               "step above {:.4g} s is refused (and one above {:.4g} s warned of). Lower "
-                              "timeStepSize (or give \"auto\"), or change the parameter in the criterion",
-                              p.time_step, l.name, l.dt_warn, l.dt_refuse, l.dt_warn),
+                              "Configuration.timeStepSize (or give \"auto\"), or allow a longer step with {}",
+                              p.time_step, l.name, l.dt_warn, l.dt_refuse, l.dt_warn, l.keys),
                   "Configuration.timeStepSize");
     if (p.time_step > l.dt_warn)
       warnings.push_back(fmt::format("time step {:.4g} s exceeds the {} limit of {:.4g} s; the run may be unstable",

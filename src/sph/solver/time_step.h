@@ -15,6 +15,7 @@ struct TimeStepLimit {
   double dt_warn;         ///< largest dt that passes without a warning, s
   double dt_refuse;       ///< dt above this is refused, s
   bool acoustic = false;  ///< the acoustic CFL limit (CFL steps take it with the flow's speed)
+  std::string keys;       ///< the scene keys that set the limit, for the refusal's advice
 };
 
 /// Evaluates the stability limits of explicit WCSPH with penalty walls for these params:

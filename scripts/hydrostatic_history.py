@@ -51,8 +51,8 @@ def main():
     sim = sph.Simulation(scene)
     for _ in range(samples):
         sim.step(scene.steps // samples)
-        v, m = sim.velocities, sim.masses
-        kinetic = 0.5 * float((m[:, None] * v * v).sum())
+        v = sim.velocities  # (every particle has the one mass, sim.particle_mass)
+        kinetic = 0.5 * sim.particle_mass * float((v * v).sum())
         surface, worst, out = profile(sim, dim, dx, rho0, g)
         print(f"t {sim.time:.2f} s  KE {kinetic:.2e} J  surface {surface:.5f} m  worst bin {worst:.3f}  "
               f"top {out[0][0]:.3f} middle {out[len(out) // 2][0]:.3f} bottom {out[-1][0]:.3f}", flush=True)

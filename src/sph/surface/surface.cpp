@@ -606,8 +606,9 @@ SurfaceMesh extract_surface(std::span<const double> positions, int dimension, co
   if (const std::string e = surface_settings_error(settings); !e.empty()) throw Error(e, "surface");
   SPH_CHECK(dimension == 2 || dimension == 3, "extract_surface: dimension must be 2 or 3");
   SPH_CHECK(positions.size() % 3 == 0, "extract_surface: 3 coordinates per particle");
-  if (positions.size() > 3 * std::size_t{std::numeric_limits<std::uint32_t>::max() / 2})
-    throw Error("more than 2^31 particles in one frame; mesh parts of it", "surface");
+  // (the extractor counts particles in 32 bits: the frame's, and again with the walls' images)
+  const std::size_t most = 3 * std::size_t{std::numeric_limits<std::uint32_t>::max() / 2};
+  if (positions.size() > most) throw Error("more than 2^31 particles in one frame; mesh parts of it", "surface");
   if (positions.empty()) {
     SurfaceMesh m;
     m.dimension = dimension;
@@ -619,6 +620,9 @@ SurfaceMesh extract_surface(std::span<const double> positions, int dimension, co
     // (a non-finite position has no images, and the originals come first: the refusal names it)
     imaged = with_wall_images(positions, dimension, settings);
     positions = imaged;
+    if (positions.size() > most)
+      throw Error("more than 2^31 particles in one frame with their images across the walls; mesh parts of it",
+                  "surface");
   }
   if (dimension == 3) return Extractor<3>(positions, settings).run();
   return Extractor<2>(positions, settings).run();

@@ -35,6 +35,12 @@ std::int64_t whole_number_arg(const py::handle& value, const char* name, std::in
   return py::cast<std::int64_t>(value);
 }
 
+double real_arg(const py::handle& value, const char* name) {
+  if (py::isinstance<py::bool_>(value) || !(py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value)))
+    throw py::type_error(std::string(name) + " must be a number, got " + py::cast<std::string>(py::repr(value)));
+  return py::cast<double>(value);
+}
+
 std::vector<std::string> run_overrides(const py::object& neighbors, const py::object& steps) {
   std::vector<std::string> sets;
   if (!neighbors.is_none()) {

@@ -66,6 +66,10 @@ SceneDesc with_overrides(const SceneDesc& desc, const std::vector<std::string>& 
 /// to cast Python instance to C++ type").
 std::int64_t whole_number_arg(const py::handle& value, const char* name, std::int64_t lo, std::int64_t hi);
 
+/// A keyword argument's real number (a Python int or float, not a bool: pybind11's double would
+/// take True as 1.0): TypeError naming `name` otherwise. The caller checks its range.
+double real_arg(const py::handle& value, const char* name);
+
 /// The overrides that run()'s, compare()'s and Simulation()'s keyword arguments stand for, as
 /// `sph run`'s flags stand for --set values: `neighbors` (None or a mode's name; TypeError
 /// otherwise) and `steps` (None or a whole number of steps).

@@ -133,8 +133,8 @@ py::dict run_scene(const Scene& scene, const py::object& output_arg, const py::o
 }
 
 py::dict compare_scene(const Scene& scene, const py::object& output, const py::object& modes, const py::object& steps,
-                       const py::object& threads, const py::object& frames_arg, double perturbation, bool audit,
-                       bool run_frames, const py::object& progress_arg) {
+                       const py::object& threads, const py::object& frames_arg, const py::object& perturbation_arg,
+                       bool audit, bool run_frames, const py::object& progress_arg) {
   CompareOptions co;
   if (!modes.is_none()) {
     co.modes.clear();
@@ -147,6 +147,7 @@ py::dict compare_scene(const Scene& scene, const py::object& output, const py::o
     if (co.modes.empty()) throw Error("no mode given", "modes");
   }
   const int frames = static_cast<int>(whole_number_arg(frames_arg, "frames", 1, 100));
+  const double perturbation = real_arg(perturbation_arg, "perturbation");
   if (!(perturbation >= 0 && perturbation <= 0.1)) throw py::value_error("perturbation must be 0 to 0.1 (of h)");
   co.frames = frames;
   co.perturbation = perturbation;

@@ -288,9 +288,11 @@ class PySimulation {
   /// The free surface now (RunDriver::surface): {"vertices": (n, 3) float32, "normals": (n, 3)
   /// float32 (3D; (0, 3) in 2D), "triangles": (m, 3) uint32 (3D) or "segments": (m, 2) uint32
   /// (2D), "voxel_size": float}.
-  py::dict surface(double resolution, double smoothing, double iso) const {
+  py::dict surface(const py::object& resolution, const py::object& smoothing, const py::object& iso) const {
     SurfaceSettings settings;
-    settings.resolution = resolution, settings.smoothing = smoothing, settings.iso = iso;
+    settings.resolution = real_arg(resolution, "resolution");
+    settings.smoothing = real_arg(smoothing, "smoothing");
+    settings.iso = real_arg(iso, "iso");
     settings.spacing = 1;  // (the scene's, set by RunDriver::surface: here only the three are checked)
     if (const std::string e = surface_settings_error(settings); !e.empty()) throw py::value_error(e);
     SurfaceMesh mesh;

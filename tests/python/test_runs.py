@@ -103,3 +103,7 @@ def test_compare(small_2d, tmp_path):
         sph.compare(small_2d, modes=["fastest"])
     assert e.value.where == "modes"
     assert "verlet_clusters" in str(e.value) and "brute_force" not in str(e.value)  # the modes compare takes
+    with pytest.raises(TypeError, match="perturbation must be a number"):
+        sph.compare(small_2d, modes=["verlet"], perturbation=True)  # (pybind11 alone took True as 1.0)
+    with pytest.raises(ValueError, match="perturbation must be 0 to 0.1"):
+        sph.compare(small_2d, modes=["verlet"], perturbation=0.5)

@@ -270,3 +270,6 @@ def test_surface_in_2d_is_segments_and_bad_settings_are_refused(small_2d):
             sim.surface(**kwargs)
     with pytest.raises(TypeError):
         sim.surface(2.0)  # keyword arguments only
+    for kwargs in [{"resolution": True}, {"smoothing": "2"}, {"iso": None}]:
+        with pytest.raises(TypeError, match=f"{next(iter(kwargs))} must be a number"):
+            sim.surface(**kwargs)  # (pybind11 alone took True as 1.0)

@@ -16,6 +16,7 @@
 
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
+#include <sph/core/spelling.h>
 #include <sph/core/timer.h>
 #include <sph/io/atomic_file.h>
 #include <sph/io/frame_format.h>
@@ -78,11 +79,13 @@ int render(const RenderCliOptions& opt) {
   // Everything that can be refused is checked before anything is written.
   std::optional<ColorBy> by;
   if (!opt.color_by.empty() && !(by = color_by_from_name(opt.color_by)))
-    throw Error(fmt::format("unknown quantity \"{}\"; expected one of: {}, or none", opt.color_by, color_by_names()),
+    throw Error(fmt::format("unknown quantity \"{}\"{}; expected one of: {}, or none", opt.color_by,
+                            did_you_mean(opt.color_by, color_by_list()), color_by_names()),
                 "--color-by");
   std::optional<Colormap> map;
   if (!opt.colormap.empty() && !(map = colormap_from_name(opt.colormap)))
-    throw Error(fmt::format("unknown color map \"{}\"; expected viridis, coolwarm or turbo", opt.colormap),
+    throw Error(fmt::format("unknown color map \"{}\"{}; expected viridis, coolwarm or turbo", opt.colormap,
+                            did_you_mean(opt.colormap, kColormapNames)),
                 "--colormap");
   std::optional<FrameFormat> format;
   if (!opt.format.empty() && !(format = parse_frame_format(opt.format)))

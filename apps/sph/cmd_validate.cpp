@@ -43,10 +43,7 @@ std::vector<std::string> parse_cases(const std::string& list) {
         if (std::find(cases.begin(), cases.end(), c) == cases.end()) cases.emplace_back(c);
       continue;
     }
-    if (std::find(kValidationCases.begin(), kValidationCases.end(), item) == kValidationCases.end())
-      throw Error("unknown case \"" + item +
-                      "\"; expected martin_moyce, resolution, hydrostatic, boundaries, dfsph, conservation or all",
-                  "--cases");
+    check_validation_case(item);
     if (std::find(cases.begin(), cases.end(), item) != cases.end())
       throw Error("case \"" + item + "\" is listed twice", "--cases");
     cases.push_back(item);

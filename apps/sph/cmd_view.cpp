@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include <sph/core/error.h>
+#include <sph/core/spelling.h>
 #include <sph/core/version.h>
 #include <sph/io/atomic_file.h>
 #include <sph/render/viewer.h>
@@ -47,7 +48,9 @@ std::vector<ColorBy> parse_color_by(const std::vector<std::string>& items) {
                                 color_by_names()),
                     "--color-by");
       if (!by)
-        throw Error(fmt::format("unknown quantity \"{}\"; expected one of: {}", name, color_by_names()), "--color-by");
+        throw Error(fmt::format("unknown quantity \"{}\"{}; expected one of: {}", name,
+                                did_you_mean(name, color_by_list()), color_by_names()),
+                    "--color-by");
       out.push_back(*by);
     }
   }

@@ -187,6 +187,14 @@ TEST_F(Cli, MistypedCommandsAndValuesAreNamedAsWhatTheyAre) {
        "--fields: \"none\" (positions only) cannot be combined with other names; give it alone, or list the ones "
        "wanted from velocity, density"},
       {{"run", kDamBreak, "--fields", "vel"}, ", or none alone (positions only)"},
+      // Every vocabulary suggests the name a misspelling was probably meant to be.
+      {{"validate", "--cases", "hydrostatc"}, "--cases: unknown case \"hydrostatc\" (did you mean \"hydrostatic\"?)"},
+      {{"bench", "--suite", "stpes"}, "--suite: unknown suite \"stpes\" (did you mean \"steps\"?)"},
+      {{"bench", "--size", "larg"}, "--size: unknown size \"larg\" (did you mean \"large\"?)"},
+      {{"bench", "--precision", "flaot"}, "--precision: unknown precision \"flaot\" (did you mean \"float\"?)"},
+      {{"render", ".", "--colormap", "virdis"}, "--colormap: unknown color map \"virdis\" (did you mean \"viridis\"?)"},
+      {{"render", ".", "--color-by", "spede"}, "--color-by: unknown quantity \"spede\" (did you mean \"speed\"?)"},
+      {{"view", ".", "--color-by", "densty"}, "--color-by: unknown quantity \"densty\" (did you mean \"density\"?)"},
   };
   std::ofstream(work_ / "afile") << "x";
   for (const auto& [args, message] : cases) {

@@ -178,6 +178,10 @@ double lattice_gradient_consistency(int dimension, double spacing, double h, boo
 inline constexpr std::array<const char*, 6> kValidationCases{"martin_moyce", "resolution", "hydrostatic",
                                                              "boundaries",   "dfsph",      "conservation"};
 
+/// Throws sph::Error (naming --cases) unless `name` is one of kValidationCases: the cases, and the
+/// one a misspelling was probably meant to be.
+void check_validation_case(std::string_view name);
+
 struct ValidationOptions {
   std::vector<std::string> cases{kValidationCases.begin(), kValidationCases.end()};
   bool quick = false;               ///< coarse, short versions with regression bounds (CI)

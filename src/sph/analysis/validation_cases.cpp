@@ -9,9 +9,11 @@
 #include <map>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <sph/core/error.h>
 #include <sph/core/parallel.h>
+#include <sph/core/spelling.h>
 #include <sph/core/timer.h>
 #include <sph/core/vec.h>
 #include <sph/io/frames.h>
@@ -431,13 +433,7 @@ std::vector<std::string> front_modes(bool quick) {
 std::vector<std::string> selected_cases(const std::vector<std::string>& cases) {
   std::vector<std::string> out;
   for (const std::string& c : cases) {
-    if (std::find(kValidationCases.begin(), kValidationCases.end(), c) == kValidationCases.end())
-      throw Error(
-          fmt::format(
-              "unknown case \"{}\"; expected martin_moyce, resolution, hydrostatic, boundaries, dfsph, conservation or "
-              "all",
-              c),
-          "--cases");
+    check_validation_case(c);
     if (std::find(out.begin(), out.end(), c) == out.end()) out.push_back(c);
   }
   return out;
@@ -675,6 +671,13 @@ void run_conservation(ValidationResult& res, FrontRuns& fronts, const Validation
 }
 
 }  // namespace
+
+void check_validation_case(std::string_view name) {
+  if (std::find(kValidationCases.begin(), kValidationCases.end(), name) != kValidationCases.end()) return;
+  throw Error(fmt::format("unknown case \"{}\"{}; expected {} or all", name, did_you_mean(name, kValidationCases),
+                          fmt::join(kValidationCases, ", ")),
+              "--cases");
+}
 
 void check_validation_scenes(const ValidationOptions& opt) {
   const std::vector<std::string> cases = selected_cases(opt.cases);

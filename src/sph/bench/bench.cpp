@@ -8,6 +8,7 @@
 
 #include <sph/core/data_dir.h>
 #include <sph/core/error.h>
+#include <sph/core/spelling.h>
 #include <sph/io/atomic_file.h>
 #include <sph/neighbors/neighbor_mode.h>
 #include <sph/scene/scene_reader.h>
@@ -64,6 +65,17 @@ TimingStats summarize(std::vector<double> seconds) {
   return s;
 }
 
+namespace {
+
+/// The one message for a suite that is none of kBenchSuites.
+[[noreturn]] void unknown_suite(std::string_view name, const std::string& where) {
+  throw Error(fmt::format("unknown suite \"{}\"{}; expected a comma-separated list of neighbors, steps, tank, or all",
+                          name, did_you_mean(name, kBenchSuites)),
+              where);
+}
+
+}  // namespace
+
 std::vector<std::string> parse_bench_suites(std::string_view list, const std::string& where) {
   constexpr const char* kExpected = "expected a comma-separated list of neighbors, steps, tank, or all";
   std::vector<std::string> suites;
@@ -76,7 +88,7 @@ std::vector<std::string> parse_bench_suites(std::string_view list, const std::st
     }
     const auto known =
         std::find_if(std::begin(kBenchSuites), std::end(kBenchSuites), [&](const char* s) { return item == s; });
-    if (known == std::end(kBenchSuites)) throw Error(fmt::format("unknown suite \"{}\"; {}", item, kExpected), where);
+    if (known == std::end(kBenchSuites)) unknown_suite(item, where);
     if (std::find(suites.begin(), suites.end(), item) == suites.end()) suites.emplace_back(item);
   }
   // Always run in the documented order, whatever the order given.
@@ -89,7 +101,9 @@ std::vector<std::string> parse_bench_suites(std::string_view list, const std::st
 BenchSize parse_bench_size(std::string_view name, const std::string& where) {
   for (BenchSize s : {BenchSize::Small, BenchSize::Medium, BenchSize::Large, BenchSize::Full})
     if (name == to_string(s)) return s;
-  throw Error(fmt::format("unknown size \"{}\"; expected small, medium, large or full", name), where);
+  throw Error(fmt::format("unknown size \"{}\"{}; expected small, medium, large or full", name,
+                          did_you_mean(name, std::array{"small", "medium", "large", "full"})),
+              where);
 }
 
 std::vector<int> parse_thread_list(std::string_view list, const std::string& where) {
@@ -117,7 +131,9 @@ std::vector<Precision> parse_precisions(std::string_view list, const std::string
     else if (item == "double")
       p = Precision::Double;
     else
-      throw Error(fmt::format("unknown precision \"{}\"; expected float, double or float,double", item), where);
+      throw Error(fmt::format("unknown precision \"{}\"{}; expected float, double or float,double", item,
+                              did_you_mean(item, std::array{"float", "double"})),
+                  where);
     if (std::find(out.begin(), out.end(), p) == out.end()) out.push_back(p);
   }
   return out;
@@ -137,7 +153,7 @@ void validate_bench_options(const BenchOptions& o) {
   for (const auto& s : o.suites)
     if (std::find_if(std::begin(kBenchSuites), std::end(kBenchSuites), [&](const char* k) { return s == k; }) ==
         std::end(kBenchSuites))
-      throw Error(fmt::format("unknown suite \"{}\"; expected neighbors, steps, tank or all", s), "--suite");
+      unknown_suite(s, "--suite");
   for (int t : o.threads)
     if (t < 1 || t > 4096) throw Error(fmt::format("bad thread count {}; expected 1 to 4096", t), "--threads");
   if (o.repeats < 1 || o.repeats > 1000)

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <concepts>
 #include <cstddef>
 #include <span>
 #include <string>
@@ -58,6 +59,15 @@ inline std::string did_you_mean(std::string_view name, std::span<const std::stri
   const std::string best = closest_name(name, candidates);
   if (best.empty()) return {};
   return " (did you mean " + std::string(quote) + best + std::string(quote) + "?)";
+}
+
+/// did_you_mean over any range of names (a table's `const char*`s, string_views).
+template <class Names>
+requires(!std::convertible_to<const Names&, std::span<const std::string>>) inline std::string
+    did_you_mean(std::string_view name, const Names& names, std::string_view quote = "\"") {
+  std::vector<std::string> candidates;
+  for (const auto& n : names) candidates.emplace_back(n);
+  return did_you_mean(name, std::span<const std::string>(candidates), quote);
 }
 
 }  // namespace sph

@@ -85,9 +85,15 @@ std::optional<ColorBy> color_by_from_name(std::string_view name) {
   return std::nullopt;
 }
 
+std::vector<std::string> color_by_list() {
+  std::vector<std::string> names;
+  for (const ColorBy by : kColorByAll) names.emplace_back(color_by_name(by));
+  return names;
+}
+
 std::string color_by_names() {
   std::string s;
-  for (const ColorBy by : kColorByAll) s += (s.empty() ? "" : ", ") + std::string(color_by_name(by));
+  for (const std::string& name : color_by_list()) s += (s.empty() ? "" : ", ") + name;
   return s;
 }
 

@@ -35,6 +35,8 @@ std::optional<ColorBy> color_by_from_name(std::string_view name);
 /// "speed, kinetic_energy, density, pressure, initial_position" (for messages and --help; not
 /// "none").
 std::string color_by_names();
+/// The same names one by one.
+std::vector<std::string> color_by_list();
 /// A legend label with the unit for this dimension, e.g. "speed (m/s)", "density (kg/m^2)".
 std::string color_by_label(ColorBy by, int dimension);
 /// The frame field the quantity is computed from ("velocity", "density", "pressure",

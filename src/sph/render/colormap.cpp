@@ -104,20 +104,15 @@ Rgb colormap(Colormap map, double value, double lo, double hi, Rgb nan_color) {
 }
 
 std::string_view colormap_name(Colormap map) {
-  switch (map) {
-    case Colormap::Viridis:
-      return "viridis";
-    case Colormap::Coolwarm:
-      return "coolwarm";
-    case Colormap::Turbo:
-      return "turbo";
-  }
+  const auto k = static_cast<std::size_t>(map);
+  if (k < std::size(kColormapNames)) return kColormapNames[k];
   return "viridis";
 }
 
 std::optional<Colormap> colormap_from_name(std::string_view name) {
-  for (const Colormap m : {Colormap::Viridis, Colormap::Coolwarm, Colormap::Turbo})
-    if (colormap_name(m) == name) return m;
+  static_assert(std::size(kColormapNames) == static_cast<std::size_t>(Colormap::Turbo) + 1, "a name per map");
+  for (std::size_t k = 0; k < std::size(kColormapNames); ++k)
+    if (kColormapNames[k] == name) return static_cast<Colormap>(k);
   return std::nullopt;
 }
 

@@ -27,6 +27,8 @@ std::string_view colormap_name(Colormap map);
 
 /// The map with this (lowercase) name, or nullopt.
 std::optional<Colormap> colormap_from_name(std::string_view name);
+/// Every map's name, in the enum's order.
+inline constexpr std::string_view kColormapNames[] = {"viridis", "coolwarm", "turbo"};
 
 /// Color k of a categorical palette for series on a white background: distinct hues that stay
 /// distinguishable for the common forms of color blindness (after Okabe & Ito), repeating after 8.

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <numeric>
 #include <string>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -17,6 +19,7 @@ namespace sph {
 namespace {
 
 constexpr int kBlock = 8;            // voxels per block edge
+constexpr float kSnap = 1e-4f;       // a vertex closer to a voxel than this (in voxels) is put on it
 constexpr int kPadded = kBlock + 1;  // a block's values and its upper neighbors' first layer
 // Dense per-block arrays cost 8 bytes a block of the bounding grid; the values 4 bytes a voxel
 // of the blocks near particles.
@@ -63,6 +66,9 @@ int padded_index(int x, int y, int z) {
 struct BlockOut {
   std::vector<std::uint16_t> keys;  // local_index(a) * 8 + direction, ascending
   std::vector<std::array<float, 3>> vertices;
+  // The vertices put on a voxel (within kSnap of it): {the voxel's global index, the vertex's index
+  // in `vertices`}. Several edges end there; weld() makes them one vertex.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> on_voxel;
   std::vector<std::array<float, 3>> normals;  // 3D
   std::vector<std::array<std::uint32_t, 3>> triangles;
   std::vector<std::array<std::uint32_t, 2>> segments;
@@ -191,10 +197,58 @@ class Extractor {
       mesh.triangles.insert(mesh.triangles.end(), b.triangles.begin(), b.triangles.end());
       mesh.segments.insert(mesh.segments.end(), b.segments.begin(), b.segments.end());
     }
+    weld(out, base, mesh);
     return mesh;
   }
 
  private:
+  /// Where the field is iso at a voxel, or within a float's rounding of iso (the walls' cut makes
+  /// it so at every voxel on a wall, when the grid's planes fall on it), every edge from that
+  /// voxel ends in a vertex on it or a hair from it: several vertices at one point once rounded
+  /// to floats, and faces of no area between them. find_vertices puts each vertex within kSnap
+  /// of a voxel on it; here those of one voxel become the first of them (in vertex order, the
+  /// same for any thread count), the faces left with a repeated vertex go (a face (a, a, b) runs
+  /// along (a, b) both ways, so the mesh stays closed), and so do the vertices merged away.
+  /// Their normals are all the voxel's gradient.
+  static void weld(const std::vector<BlockOut>& out, const std::vector<std::uint32_t>& base, SurfaceMesh& mesh) {
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> on;
+    for (std::size_t k = 0; k < out.size(); ++k)
+      for (const auto& [voxel, v] : out[k].on_voxel) on.emplace_back(voxel, base[k] + v);
+    if (on.empty()) return;
+    std::sort(on.begin(), on.end());
+    std::vector<std::uint32_t> to(mesh.vertices.size());
+    std::iota(to.begin(), to.end(), 0u);
+    bool merged = false;
+    for (std::size_t i = 1; i < on.size(); ++i)
+      if (on[i].first == on[i - 1].first) to[on[i].second] = to[on[i - 1].second], merged = true;
+    if (!merged) return;
+    // New indices: the vertices that stay, in their order.
+    std::vector<std::uint32_t> index(mesh.vertices.size());
+    std::uint32_t kept = 0;
+    for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+      if (to[v] == v) {
+        index[v] = kept;
+        mesh.vertices[kept] = mesh.vertices[v];
+        if (!mesh.normals.empty()) mesh.normals[kept] = mesh.normals[v];
+        ++kept;
+      }
+    mesh.vertices.resize(kept);
+    if (!mesh.normals.empty()) mesh.normals.resize(kept);
+    const auto remap = [&](auto& faces) {
+      std::size_t n = 0;
+      for (auto f : faces) {
+        for (auto& v : f) v = index[to[v]];
+        bool repeated = false;
+        for (std::size_t a = 0; a < f.size(); ++a)
+          for (std::size_t b = a + 1; b < f.size(); ++b) repeated = repeated || f[a] == f[b];
+        if (!repeated) faces[n++] = f;
+      }
+      faces.resize(n);
+    };
+    remap(mesh.triangles);
+    remap(mesh.segments);
+  }
+
   std::array<std::int64_t, 3> block_coords(std::uint32_t b) const {
     const auto id = static_cast<std::int64_t>(b);
     return {id % grid_.blocks[0], (id / grid_.blocks[0]) % grid_.blocks[1], id / (grid_.blocks[0] * grid_.blocks[1])};
@@ -366,9 +420,19 @@ class Extractor {
             const auto e = bits(d);
             const float fb = p[static_cast<std::size_t>(padded_index<D>(x + e[0], y + e[1], z + e[2]))];
             if ((fa > iso) == (fb > iso)) continue;
-            const float t = (iso - fa) / (fb - fa);
+            float t = (iso - fa) / (fb - fa);
+            // (a vertex within kSnap of a voxel is put on it: see weld())
+            if (t < kSnap) t = 0.0f;
+            if (t > 1.0f - kSnap) t = 1.0f;
             std::array<float, 3> v{0, 0, 0};
             const std::array<int, 3> a{x, y, z};
+            if (t == 0.0f || t == 1.0f) {  // (on voxel a, or on a + e)
+              std::uint64_t g = 0;
+              for (int c = D - 1; c >= 0; --c)
+                g = g * static_cast<std::uint64_t>(grid_.blocks[c] * kBlock) +
+                    static_cast<std::uint64_t>(bc[c] * kBlock + a[c] + (t == 1.0f ? e[c] : 0));
+              out.on_voxel.emplace_back(g, static_cast<std::uint32_t>(out.vertices.size()));
+            }
             for (int c = 0; c < D; ++c)
               v[c] = static_cast<float>(grid_.origin[c] +
                                         grid_.v * (static_cast<double>(bc[c] * kBlock + a[c]) + t * e[c]));

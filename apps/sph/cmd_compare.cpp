@@ -112,7 +112,10 @@ int compare(const CompareCliOptions& opt) {
   for (std::size_t k = 0; k < result.runs.size(); ++k) {
     const RunRecord& r = result.runs[k];
     const double t = r.totals.total();
-    std::string line = fmt::format("  {:<22} {:8.3f} s  {:5.2f}x", r.label, t, t > 0 ? ref / t : 0.0);
+    // (the first run is the reference, as in report.md: its ratio against the standard runs' mean
+    // would read as a speed of its own)
+    std::string line = k == 0 ? fmt::format("  {:<22} {:8.3f} s  reference", r.label, t)
+                              : fmt::format("  {:<22} {:8.3f} s  {:5.2f}x", r.label, t, t > 0 ? ref / t : 0.0);
     if (k > 0 && !result.divergence[k].empty())
       line += fmt::format("  RMS divergence at end {:.3g} h", result.divergence[k].back().rms);
     if (co.audit) line += fmt::format("  missed pairs {}", r.missed_pairs());

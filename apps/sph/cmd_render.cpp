@@ -210,9 +210,19 @@ int render(const RenderCliOptions& opt) {
   const double seconds = wall.elapsed();
   fmt::print(stderr, "sph: done: {} frame{} in {:.2f} s ({:.1f} ms per frame).\n", frames.size(),
              frames.size() == 1 ? "" : "s", seconds, 1e3 * seconds / static_cast<double>(frames.size()));
-  if (!opt.no_png)
-    fmt::print(stderr, "  {}/frame_{:06d}.png{}\n", out.string(), frames.front(),
-               frames.size() > 1 ? fmt::format(" ... frame_{:06d}.png", frames.back()) : "");
+  if (!opt.no_png) {
+    // The pictures written: all of them when few, first ... last when they run on without a gap.
+    const auto name = [](std::size_t f) { return fmt::format("frame_{:06d}.png", f); };
+    std::string pictures = name(frames.front());
+    if (frames.size() <= 3) {
+      for (std::size_t k = 1; k < frames.size(); ++k) pictures += ", " + name(frames[k]);
+    } else if (frames.back() - frames.front() + 1 == frames.size()) {
+      pictures += " ... " + name(frames.back());
+    } else {
+      pictures += fmt::format(", {}, ... {} ({} pictures)", name(frames[1]), name(frames.back()), frames.size());
+    }
+    fmt::print(stderr, "  {}/{}\n", out.string(), pictures);
+  }
   if (video)
     fmt::print(stderr, "  {}/movie.mp4 ({} frames at {} per second)\n", out.string(), video->frames(), opt.video_fps);
   return kOk;

@@ -65,6 +65,7 @@ TEST_F(Render, EveryFrameBecomesAnImageWithOneColorScaleForTheRun) {
   const CommandResult r = sph({"render", "db", "--no-progress"});
   ASSERT_EQ(r.code, 0) << r.err;
   const fs::path out = tmp_.path() / "db" / "render";
+  EXPECT_CONTAINS(r.err, "/frame_000000.png ... frame_000004.png\n");  // (the five, without a gap)
   EXPECT_EQ(pngs_in(out), (std::vector<std::string>{"frame_000000.png", "frame_000001.png", "frame_000002.png",
                                                     "frame_000003.png", "frame_000004.png"}));
   const auto first = load_png(out / "frame_000000.png");
@@ -86,6 +87,13 @@ TEST_F(Render, EveryFrameBecomesAnImageWithOneColorScaleForTheRun) {
   const CommandResult again = sph({"render", "db", "--frames", "last", "--no-progress"});
   ASSERT_EQ(again.code, 0) << again.err;
   EXPECT_EQ(pngs_in(out), (std::vector<std::string>{"frame_000004.png"}));
+  // The closing line names the pictures written: a few by name, not as a range with a gap.
+  const CommandResult two = sph({"render", "db", "--frames", "0,-1", "--no-progress"});
+  ASSERT_EQ(two.code, 0) << two.err;
+  EXPECT_CONTAINS(two.err, "/frame_000000.png, frame_000004.png\n");
+  const CommandResult four = sph({"render", "db", "--frames", "0,1,3,4", "--no-progress"});
+  ASSERT_EQ(four.code, 0) << four.err;
+  EXPECT_CONTAINS(four.err, "/frame_000000.png, frame_000001.png, ... frame_000004.png (4 pictures)\n");
 }
 
 TEST_F(Render, ObstaclesAreDrawnAsSolidBoxes) {

@@ -174,6 +174,13 @@ TEST_F(TrueMessages, TheCompareReportCallsTheStandardRunTheReference) {
   }
   EXPECT_EQ(references, 2u) << "the speed and the kinetic energy tables\n" << report;
   EXPECT_CONTAINS(report, "x |");  // the other runs keep their ratio
+  // The summary on the screen says the same: the first line (standard) is the reference, not a
+  // ratio of its own against the standard runs' mean.
+  const std::string first = r.out.substr(0, r.out.find('\n'));
+  EXPECT_CONTAINS(first, "standard");
+  EXPECT_CONTAINS(first, "s  reference");
+  EXPECT_EQ(first.find("x  "), std::string::npos) << first;
+  EXPECT_CONTAINS(r.out, "x  RMS divergence");  // (adaptive's line keeps its ratio)
 }
 
 }  // namespace

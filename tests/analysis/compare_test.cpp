@@ -15,6 +15,8 @@
 #include <sph/analysis/compare.h>
 #include <sph/scene/scene_reader.h>
 
+#include "support/png_decode.h"
+
 namespace sph {
 namespace {
 
@@ -106,6 +108,20 @@ TEST_F(Compare, WritesEveryPromisedFileWithContent) {
   EXPECT_EQ(line_count(read_file(dir_ / "divergence.csv")), 1u + res.runs[0].samples.size());
   EXPECT_NE(report.find("| adaptive |"), std::string::npos);
   EXPECT_NE(report.find("chaos floor"), std::string::npos);
+  // The pictures share one color scale (kinetic energy, 2D): their color bars, the strip right of
+  // the panels, are the same image, though the fluid is faster at the later step.
+  const auto first = test::decode_png(read_file(dir_ / "frame_000060.png"));
+  const auto last = test::decode_png(read_file(dir_ / "frame_000120.png"));
+  ASSERT_EQ(first.width, last.width);
+  ASSERT_EQ(first.height, last.height);
+  const auto bar = [](const test::DecodedPng& d) {
+    std::vector<std::uint8_t> strip;
+    for (int y = 0; y < d.height; ++y)
+      strip.insert(strip.end(), d.rgb.begin() + 3 * (y * d.width + d.width - 100),
+                   d.rgb.begin() + 3 * (y * d.width + d.width));
+    return strip;
+  };
+  EXPECT_EQ(bar(first), bar(last));
   // No stray temporary files.
   for (const auto& e : fs::directory_iterator(dir_))
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos);

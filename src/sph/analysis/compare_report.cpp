@@ -118,24 +118,31 @@ const Snapshot* image_snapshot(const RunRecord& r, std::int64_t step) {
   return nullptr;
 }
 
+/// The largest kinetic energy of a particle in the non-perturbed runs' pictures, at every image
+/// step: the top of one color scale for all the report's pictures (as sph render keeps one for a
+/// run's frames), 1 if none moves.
+double largest_image_energy(const CompareResult& res, double mass) {
+  double ke_max = 0;
+  for (const std::int64_t step : res.image_steps)
+    for (const RunRecord& r : res.runs) {
+      const Snapshot* snap = r.perturbed ? nullptr : image_snapshot(r, step);
+      if (!snap) continue;
+      for (const auto& v : snap->velocity)
+        if (!std::isnan(v[0])) ke_max = std::max(ke_max, 0.5 * mass * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+    }
+  return ke_max > 0 ? ke_max : 1;
+}
+
 /// Side-by-side images of the non-perturbed runs at one image step.
-Image frame_image(const CompareResult& res, std::int64_t step, double mass) {
+Image frame_image(const CompareResult& res, std::int64_t step, double mass, double ke_max) {
   std::vector<Image> panels;
   std::vector<std::string> captions;
   const ParticleView view =
       default_particle_view(res.dimension, res.dimension == 2 ? 640 : 560, res.dimension == 2 ? 420 : 520);
-  // Color scale: kinetic energy (2D, like the paper's Fig. 2) from 0 to the largest value in any
-  // of the runs shown; initial position (3D without emitters, like Fig. 3); emission order otherwise.
+  // Color scale: kinetic energy (2D, like the paper's Fig. 2) from 0 to ke_max
+  // (largest_image_energy); initial position (3D without emitters, like Fig. 3); emission order otherwise.
   const bool by_energy = res.dimension == 2;
   const bool by_initial = !by_energy && !res.has_emitters;
-  double ke_max = 0;
-  for (const RunRecord& r : res.runs) {
-    const Snapshot* snap = r.perturbed ? nullptr : image_snapshot(r, step);
-    if (!snap) continue;
-    for (const auto& v : snap->velocity)
-      if (!std::isnan(v[0])) ke_max = std::max(ke_max, 0.5 * mass * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
-  }
-  if (ke_max <= 0) ke_max = 1;
   // The obstacles where they are at this step.
   const auto at = std::find(res.image_steps.begin(), res.image_steps.end(), step);
   std::span<const SolidBox> solids;
@@ -460,7 +467,8 @@ void write_comparison(const std::filesystem::path& dir, const CompareResult& res
             res, "Pairs within h missing from the lists (audit)", "missed pairs per step", false,
             [](const RunRecord& r, std::size_t i) { return static_cast<double>(r.steps[i].missed_pairs); }, true));
   // Frames.
-  for (std::int64_t s : res.image_steps) write_png(dir / frame_file(s), frame_image(res, s, res.particle_mass));
+  const double ke_max = largest_image_energy(res, res.particle_mass);
+  for (std::int64_t s : res.image_steps) write_png(dir / frame_file(s), frame_image(res, s, res.particle_mass, ke_max));
   write_file_atomic(dir / "report.md", report_md(res, comparison_files(res)));
 }
 

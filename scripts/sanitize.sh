@@ -268,7 +268,9 @@ stage_fuzz() {
   # build-fuzz/findings, never into the source tree.
   rm -rf build-fuzz/corpus build-fuzz/findings
   mkdir -p build-fuzz/corpus build-fuzz/findings
-  cp scenes/*/*.json tests/scene/bad/*.json tests/fuzz/seeds/*.json build-fuzz/corpus/
+  # (each under its path, / as _: scenes/paper/block_3d.json and scenes/dfsph/block_3d.json
+  # are both seeds, where one name each kept the first and cp warned of the others)
+  for f in scenes/*/*.json tests/scene/bad/*.json tests/fuzz/seeds/*.json; do cp "$f" "build-fuzz/corpus/${f//\//_}"; done
   local seeds
   seeds=$(ls build-fuzz/corpus | wc -l)
   "$fuzzer" -max_total_time="$fuzz_seconds" -max_len=8192 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \

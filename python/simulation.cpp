@@ -565,7 +565,8 @@ setting out of range.)doc")
       cls.def_property(
           plural(f.name).c_str(), get, [name](PySimulation& s, const py::object& v) { s.set_vectors(name, v); },
           (doc + ". Settable: an array of that shape, finite, of the scene's precision (float32 is accepted by double "
-                 "scenes); the next step rebuilds every neighbor list.")
+                 "scenes); the next step rebuilds every neighbor list, and the state set is where the run starts from "
+                 "now (densities and pressures measured again, the energy watch's reference its energy).")
               .c_str());
     else
       cls.def_property_readonly(plural(f.name).c_str(), get, doc.c_str());

@@ -165,7 +165,7 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
   SPH_CHECK(particles_.empty() || particles_.mass == static_cast<R>(params_.particle_mass),
             "the particles' mass differs from the scene's particle mass");
   particles_.mass = static_cast<R>(params_.particle_mass);
-  NeighborOptions opt;
+  NeighborOptions& opt = neighbor_options_;
   opt.radius = params_.kernel_radius;
   opt.full_rebuild_period = params_.full_rebuild_period;
   opt.verlet_skin = params_.verlet_skin;
@@ -206,6 +206,12 @@ Simulation<D, R>::Simulation(SimulationParams<D> params, ParticleSet<D, R> parti
   if (!neighbors_->visit_pairs_with(pair_density_.get())) pair_density_.reset();
   if (params_.audit) auditor_ = std::make_unique<ListAuditor<D, R>>();
   reserve_for_emitters();
+  measure_initial_state();
+}
+
+template <int D, std::floating_point R>
+void Simulation<D, R>::measure_initial_state() {
+  const NeighborOptions& opt = neighbor_options_;
   // Density and pressure of the initial state, so that frame 0 shows real values. Exact lists
   // from a throwaway standard strategy: the run's own strategy starts at step 0.
   if (!particles_.empty()) {

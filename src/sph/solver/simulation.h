@@ -112,8 +112,13 @@ class Simulation {
   ParticleSet<D, R>& edit_particles() { return particles_; }
   /// The positions or velocities were changed between steps: the next step rebuilds every
   /// neighbor list (the strategy's own state, such as the adaptive flags and the verlet
-  /// reference positions, starts again from those lists).
-  void particles_moved() { neighbors_->invalidate(); }
+  /// reference positions, starts again from those lists), and the state is measured again as at
+  /// the start (densities, pressures, and the energy the health monitor's energy watch compares
+  /// with: a state given by hand is where the run now starts from).
+  void particles_moved() {
+    neighbors_->invalidate();
+    measure_initial_state();
+  }
   const SimulationParams<D>& params() const { return params_; }
   const NeighborStrategy<D, R>& neighbors() const { return *neighbors_; }
   /// The boundary particles (empty with penalty walls).
@@ -170,6 +175,7 @@ class Simulation {
   void load_state(StateReader& in);
 
  private:
+  NeighborOptions neighbor_options_;  ///< the lists' radius, skins and step, set at construction
   bool cfl() const { return params_.time_stepping == TimeStepping::Cfl; }
   /// A step's time step: dt (shortened by a barrier), the CFL step before that, and whether the
   /// step ends on the barrier `end` (the time is then set to it exactly).
@@ -190,6 +196,9 @@ class Simulation {
   RigidPose<D> pose_now(std::size_t k) const;
   /// Sets up the floating bodies (constructor).
   void init_bodies();
+  /// The state's densities and pressures from exact lists, and its energy as the energy watch's
+  /// reference (the start of a run, or a state set by hand: particles_moved).
+  void measure_initial_state();
   /// The fluid's reaction on each body over a step of dt (from body_acceleration_ and
   /// body_velocity_change_, at the particles' positions before they move), plus the container's
   /// contact and the contacts between bodies and with the other obstacles; then each body takes

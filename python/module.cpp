@@ -55,8 +55,13 @@ std::vector<std::string> run_overrides(const py::object& neighbors, const py::ob
   return sets;
 }
 
+int& default_thread_count() {
+  static int threads = 0;
+  return threads;
+}
+
 int thread_count_arg(const py::handle& threads) {
-  if (threads.is_none()) return num_threads();
+  if (threads.is_none()) return default_thread_count();
   return static_cast<int>(whole_number_arg(threads, "threads", 1, 4096));
 }
 
@@ -128,6 +133,9 @@ PYBIND11_MODULE(sph, m) {
 
 See docs/python.md for the API and a tutorial.)doc";
   m.attr("__version__") = sph::kVersion;
+  // All the cores (or OMP_NUM_THREADS), read once: the parallel loops' thread count is the last
+  // call's afterwards, and a later call's default would be that.
+  sph::python::default_thread_count() = sph::num_threads();
 
   ErrorTypes& t = error_types();
   t.error = new_exception(m, "Error",

@@ -75,9 +75,11 @@ double real_arg(const py::handle& value, const char* name);
 /// otherwise) and `steps` (None or a whole number of steps).
 std::vector<std::string> run_overrides(const py::object& neighbors, const py::object& steps);
 
-/// The threads a call asks for: its `threads` argument (a whole number from 1 to 4096), or all
-/// the parallel loops' threads for None.
+/// The threads a call asks for: its `threads` argument (a whole number from 1 to 4096), or for
+/// None default_thread_count().
 int thread_count_arg(const py::handle& threads);
+/// The parallel loops' thread count when the module was loaded: all the cores, or OMP_NUM_THREADS.
+int& default_thread_count();
 
 /// A keyword argument's list of names (a list or tuple of str; a single str is refused, as
 /// iterating it would give its letters): TypeError naming `name` otherwise.

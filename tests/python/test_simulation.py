@@ -1,4 +1,6 @@
 """Simulation through the API against `sph run`: the same bits, the same counters, the same lists."""
+import json
+
 import numpy as np
 import pytest
 
@@ -46,6 +48,16 @@ def test_float_3d_equals_the_sph_run_frame_bit_for_bit(small_3d, tmp_path):
     assert np.array_equal(frame["position"], sim.positions.astype(np.float64))
     assert np.array_equal(frame["velocity"], sim.velocities.astype(np.float64))
     assert np.array_equal(frame["id"], sim.ids)
+
+
+def test_the_default_thread_count_is_the_cores_whatever_an_earlier_call_asked(small_2d, tmp_path):
+    # (it was the last call's: after one threads=1 call every later default, sph.run's too, got 1)
+    first = sph.Simulation(small_2d).threads
+    assert first >= 1  # (all the cores: 2 on the project's machine, where the check below can fail)
+    assert sph.Simulation(small_2d, threads=1).threads == 1
+    assert sph.Simulation(small_2d).threads == first
+    sph.run(small_2d, output=str(tmp_path / "r"), steps=2)
+    assert json.loads((tmp_path / "r" / "summary.json").read_text())["threads"] == first
 
 
 @pytest.mark.parametrize("neighbors", ["standard", "adaptive"])

@@ -5,6 +5,7 @@
 #include <string>
 
 #include <pybind11/stl.h>
+#include <nlohmann/json.hpp>
 
 #include <sph/core/parallel.h>
 #include <sph/core/particle_fields.h>
@@ -47,7 +48,8 @@ std::vector<std::string> run_overrides(const py::object& neighbors, const py::ob
     if (!py::isinstance<py::str>(neighbors))
       throw py::type_error("neighbors must be a mode name: " +
                            join_neighbor_mode_names(NeighborModeSet::All, ", ", " or "));
-    sets.push_back("Configuration.neighbors=\"" + py::cast<std::string>(neighbors) + "\"");
+    // (JSON-encoded, as the overrides are: a quote or backslash in the name stays part of it)
+    sets.push_back("Configuration.neighbors=" + nlohmann::json(py::cast<std::string>(neighbors)).dump());
   }
   if (!steps.is_none())
     sets.push_back("Configuration.numberOfSteps=" +

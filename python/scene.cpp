@@ -98,7 +98,9 @@ Raises sph.SceneError (key path in `where`) for anything the reader refuses.)doc
       .def_property_readonly(
           "name", [](const Scene& s) { return s.desc.name; }, "The scene's name.")
       .def_property_readonly(
-          "source", [](const Scene& s) { return s.desc.source; }, "The file it was read from, or \"<dict>\".")
+          "source", [](const Scene& s) { return s.desc.source; },
+          "Where it was read from: the file, \"<dict>\" (from_dict), or from_json's `source` (\"<string>\" by "
+          "default).")
       .def_property_readonly(
           "dimension", [](const Scene& s) { return s.desc.dimension; }, "2 or 3.")
       .def_property_readonly(

@@ -58,6 +58,9 @@ def test_bad_values_and_overrides(small_2d):
     with pytest.raises(sph.SceneError) as e:
         sph.Simulation(small_2d, neighbors="fastest")
     assert e.value.key == "Configuration.neighbors"
+    # The name as given, not read as JSON (a backslash escape made "verlet" of this one)
+    with pytest.raises(sph.SceneError, match="unknown value"):
+        sph.Simulation(small_2d, neighbors="ve\\u0072let")
     with pytest.raises(sph.SceneError, match="NaN or infinite"):
         sph.load_scene(DAM_BREAK, overrides={"Fluid.stiffness": float("nan")})
     with pytest.raises(TypeError, match="dict"):

@@ -25,21 +25,44 @@ ErrorTypes& error_types() {
 
 void use_threads(int threads) { set_num_threads(threads); }
 
+namespace {
+
+/// A bool: Python's, or NumPy's (which is no int subclass).
+bool is_bool(const py::handle& value) {
+  return py::isinstance<py::bool_>(value) ||
+         py::str(py::type::of(value).attr("__name__")).cast<std::string>() == "bool_";
+}
+
+/// `value`'s type's name, for a message that says why it was refused ("got 1.5 (float)").
+std::string value_and_type(const py::handle& value) {
+  return py::cast<std::string>(py::repr(value)) + " (" +
+         py::str(py::type::of(value).attr("__name__")).cast<std::string>() + ")";
+}
+
+}  // namespace
+
 std::int64_t whole_number_arg(const py::handle& value, const char* name, std::int64_t lo, std::int64_t hi) {
   const std::string expected =
       std::string(name) + " must be a whole number from " + std::to_string(lo) + " to " + std::to_string(hi) + ", got ";
-  if (!py::isinstance<py::int_>(value) || py::isinstance<py::bool_>(value))
-    throw py::type_error(expected + py::cast<std::string>(py::repr(value)));
+  // Anything with __index__ (int, numpy.int64, ...) but a bool.
+  if (is_bool(value) || !PyIndex_Check(value.ptr())) throw py::type_error(expected + value_and_type(value));
+  const py::int_ number = py::reinterpret_steal<py::int_>(PyNumber_Index(value.ptr()));
+  if (!number) throw py::error_already_set();
   // (a Python int of any size: compared as a Python object before any conversion)
-  if (value < py::int_(lo) || value > py::int_(hi))
+  if (number < py::int_(lo) || number > py::int_(hi))
     throw py::value_error(expected + py::cast<std::string>(py::repr(value)));
-  return py::cast<std::int64_t>(value);
+  return py::cast<std::int64_t>(number);
 }
 
 double real_arg(const py::handle& value, const char* name) {
-  if (py::isinstance<py::bool_>(value) || !(py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value)))
-    throw py::type_error(std::string(name) + " must be a number, got " + py::cast<std::string>(py::repr(value)));
-  return py::cast<double>(value);
+  // Python's and NumPy's numbers (anything with __float__ or __index__) but a bool.
+  const bool number = PyFloat_Check(value.ptr()) || PyIndex_Check(value.ptr()) ||
+                      (Py_TYPE(value.ptr())->tp_as_number && Py_TYPE(value.ptr())->tp_as_number->nb_float);
+  if (is_bool(value) || !number || PyUnicode_Check(value.ptr()))
+    throw py::type_error(std::string(name) + " must be a number, got " + value_and_type(value));
+  const double x = PyFloat_AsDouble(value.ptr());
+  if (x == -1.0 && PyErr_Occurred()) throw py::error_already_set();
+  return x;
 }
 
 std::vector<std::string> run_overrides(const py::object& neighbors, const py::object& steps) {

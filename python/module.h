@@ -61,13 +61,15 @@ std::vector<std::string> override_strings(const py::handle& overrides);
 /// that every value goes through the reader's checks. Throws SceneError.
 SceneDesc with_overrides(const SceneDesc& desc, const std::vector<std::string>& overrides);
 
-/// A keyword argument's whole number (a Python int, not a bool), from `lo` to `hi`: TypeError or
+/// A keyword argument's whole number (anything with __index__: an int, a NumPy integer; not a
+/// bool, Python's or NumPy's), from `lo` to `hi`: TypeError or
 /// ValueError naming `name` and what is expected otherwise (pybind11's own cast says only "Unable
 /// to cast Python instance to C++ type").
 std::int64_t whole_number_arg(const py::handle& value, const char* name, std::int64_t lo, std::int64_t hi);
 
-/// A keyword argument's real number (a Python int or float, not a bool: pybind11's double would
-/// take True as 1.0): TypeError naming `name` otherwise. The caller checks its range.
+/// A keyword argument's real number (an int or float, Python's or NumPy's; not a bool:
+/// pybind11's double would take True as 1.0): TypeError naming `name` and the type otherwise. The caller checks its
+/// range.
 double real_arg(const py::handle& value, const char* name);
 
 /// The overrides that run()'s, compare()'s and Simulation()'s keyword arguments stand for, as

@@ -185,3 +185,19 @@ def test_analysis_helpers_refuse_what_they_cannot_measure():
         sph.martin_moyce_time(0.1, -9.81)
     with pytest.raises(ValueError, match="a must be the column's positive base width"):
         sph.martin_moyce_time(0.1, 9.81, 0.0)
+
+
+def test_numpy_numbers_are_numbers_and_bools_are_not(small_2d, tmp_path):
+    # (NumPy's scalars were refused with "must be a whole number ..., got 1", which they are)
+    sim = sph.Simulation(small_2d, threads=np.int64(1))
+    assert sim.threads == 1
+    sim.step(np.int32(2))
+    assert len(sim.surface(iso=np.float32(0.5), resolution=np.int64(2))["vertices"]) > 0
+    r = sph.run(small_2d, output=str(tmp_path / "r"), steps=np.int64(3), threads=np.int16(1))
+    assert r["steps"] == 3
+    for bad in (True, np.bool_(True), 1.5, "2"):
+        with pytest.raises(TypeError, match=r"threads must be a whole number from 1 to 4096, got .* \("):
+            sph.Simulation(small_2d, threads=bad)
+    for bad in (np.bool_(False), "0.5", None):
+        with pytest.raises(TypeError, match=r"iso must be a number, got .* \("):
+            sim.surface(iso=bad)

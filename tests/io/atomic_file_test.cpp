@@ -111,6 +111,8 @@ TEST(AtomicFile, NonExistentDirectoryThrowsSphError) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find((dir / "no" / "such" / "dir").string()), std::string::npos)
         << "the message should name the directory: " << e.what();
+    // The cause, not a guess at permissions (it said "is it writable?").
+    EXPECT_EQ(e.message(), "the directory does not exist; create it first, or write the file into an existing one");
   }
   EXPECT_TRUE(entries(dir.path()).empty());
 }
@@ -119,6 +121,12 @@ TEST(AtomicFile, ParentThatIsARegularFileThrowsSphError) {
   TempDir dir;
   spit(dir / "file", "x");
   EXPECT_THROW({ AtomicFile f(dir / "file" / "f.txt"); }, Error);
+  try {
+    AtomicFile f(dir / "file" / "f.txt");
+  } catch (const Error& e) {
+    EXPECT_EQ(e.where(), (dir / "file").string());
+    EXPECT_EQ(e.message(), "is not a directory; expected a directory to hold the file");
+  }
 }
 
 TEST(AtomicFile, ReadOnlyDirectoryThrowsSphError) {

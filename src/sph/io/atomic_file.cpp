@@ -24,7 +24,17 @@ std::filesystem::path temporary_path(const std::filesystem::path& path) {
 
 AtomicFile::AtomicFile(std::filesystem::path path) : path_(std::move(path)), tmp_(temporary_path(path_)) {
   out_.open(tmp_, std::ios::binary | std::ios::trunc);
-  if (!out_) throw Error("cannot create a file in this directory (is it writable?)", tmp_.parent_path().string());
+  if (!out_) {
+    // (the cause a user can act on: a directory that is not there, or one that takes no files)
+    const std::filesystem::path dir = tmp_.parent_path().empty() ? std::filesystem::path(".") : tmp_.parent_path();
+    std::error_code ec;
+    if (!std::filesystem::exists(dir, ec))
+      throw Error("the directory does not exist; create it first, or write the file into an existing one",
+                  dir.string());
+    if (!std::filesystem::is_directory(dir, ec))
+      throw Error("is not a directory; expected a directory to hold the file", dir.string());
+    throw Error("cannot create a file in this directory (is it writable?)", dir.string());
+  }
 }
 
 AtomicFile::~AtomicFile() {

@@ -54,8 +54,9 @@ decltype(auto) reading_scene(F&& f) {
 }
 
 /// "KEY=VALUE" overrides (the --set flag's form) from a {key path: value} dict; each value is
-/// written as JSON. Raises TypeError for a key that is not a string or a value JSON cannot hold.
-std::vector<std::string> override_strings(const py::handle& overrides);
+/// written as JSON. Raises TypeError for a key that is not a string or a value of a type JSON
+/// cannot hold, SceneError naming the override (`source` the scene's) for NaN or an infinity.
+std::vector<std::string> override_strings(const py::handle& overrides, const std::string& source);
 
 /// `desc` read again with `overrides` applied (the way sph run applies --set and its flags), so
 /// that every value goes through the reader's checks. Throws SceneError.

@@ -15,9 +15,9 @@ namespace sph::python {
 
 namespace {
 
-/// Python's json.dumps of `value`, refusing NaN and infinities (JSON has none) and writing NumPy
-/// scalars and arrays as the numbers and lists they hold.
-std::string json_text(const py::handle& value) {
+/// Python's json.dumps of `value`, refusing NaN and infinities (JSON has none; the SceneError's
+/// location is `where`) and writing NumPy scalars and arrays as the numbers and lists they hold.
+std::string json_text(const py::handle& value, const std::string& where = {}) {
   const py::object json = py::module_::import("json");
   const py::cpp_function plain([](const py::object& o) -> py::object {
     if (py::hasattr(o, "tolist")) return o.attr("tolist")();
@@ -28,7 +28,7 @@ std::string json_text(const py::handle& value) {
     return py::cast<std::string>(json.attr("dumps")(value, py::arg("allow_nan") = false, py::arg("default") = plain));
   } catch (py::error_already_set& e) {
     if (!e.matches(PyExc_ValueError)) throw;
-    throw SceneError("a scene value is NaN or infinite, which JSON cannot hold; expected finite numbers");
+    throw SceneError(Error("a scene value is NaN or infinite, which JSON cannot hold; expected finite numbers", where));
   }
 }
 
@@ -41,7 +41,7 @@ py::object scene_dict(const SceneDesc& desc) { return py::module_::import("json"
 
 }  // namespace
 
-std::vector<std::string> override_strings(const py::handle& overrides) {
+std::vector<std::string> override_strings(const py::handle& overrides, const std::string& source) {
   std::vector<std::string> sets;
   if (overrides.is_none()) return sets;
   if (!py::isinstance<py::dict>(overrides))
@@ -49,7 +49,9 @@ std::vector<std::string> override_strings(const py::handle& overrides) {
   for (const auto& [key, value] : py::reinterpret_borrow<py::dict>(overrides)) {
     if (!py::isinstance<py::str>(key))
       throw py::type_error("an override's key must be a key path string such as \"Fluid.stiffness\"");
-    sets.push_back(py::cast<std::string>(key) + "=" + json_text(value));
+    const auto path = py::cast<std::string>(key);
+    // (a value JSON cannot hold is named as the reader names an override's: SOURCE (overrides["KEY"]): KEY)
+    sets.push_back(path + "=" + json_text(value, source + " (overrides[\"" + path + "\"]): " + path));
   }
   return sets;
 }
@@ -68,7 +70,7 @@ key or value with sph.SceneError, whose `where` names the key path, with the mes
       .def_static(
           "from_dict",
           [](const py::dict& d, const py::object& overrides) {
-            return Scene{parse(json_text(d), "<dict>", override_strings(overrides))};
+            return Scene{parse(json_text(d), "<dict>", override_strings(overrides, "<dict>"))};
           },
           py::arg("d"), py::arg("overrides") = py::none(),
           R"doc(The scene described by the dict `d` (the JSON of a scene file as Python values).
@@ -78,14 +80,14 @@ Raises sph.SceneError (key path in `where`) for anything the reader refuses.)doc
       .def_static(
           "from_json",
           [](const std::string& text, const std::string& source, const py::object& overrides) {
-            return Scene{parse(text, source, override_strings(overrides))};
+            return Scene{parse(text, source, override_strings(overrides, source))};
           },
           py::arg("text"), py::arg("source") = "<string>", py::arg("overrides") = py::none(),
           R"doc(The scene in the JSON text `text`; `source` names it in messages.)doc")
       .def(
           "with_overrides",
           [](const Scene& s, const py::dict& overrides) {
-            return Scene{with_overrides(s.desc, override_strings(overrides))};
+            return Scene{with_overrides(s.desc, override_strings(overrides, s.desc.source))};
           },
           py::arg("overrides"),
           R"doc(A new scene: this one with {"Key.path": value} overrides, read again by the strict reader.)doc")
@@ -130,7 +132,7 @@ Raises sph.SceneError (key path in `where`) for anything the reader refuses.)doc
       "load_scene",
       [](const py::object& path_obj, const py::object& overrides) {
         const std::string path = path_arg(path_obj, "path");
-        const std::vector<std::string> sets = override_strings(overrides);
+        const std::vector<std::string> sets = override_strings(overrides, path);
         return Scene{reading_scene([&] { return read_scene_file(path, sets, OverrideNaming::Python); })};
       },
       py::arg("path"), py::arg("overrides") = py::none(),

@@ -61,8 +61,10 @@ def test_bad_values_and_overrides(small_2d):
     # The name as given, not read as JSON (a backslash escape made "verlet" of this one)
     with pytest.raises(sph.SceneError, match="unknown value"):
         sph.Simulation(small_2d, neighbors="ve\\u0072let")
-    with pytest.raises(sph.SceneError, match="NaN or infinite"):
+    with pytest.raises(sph.SceneError, match="NaN or infinite") as e:
         sph.load_scene(DAM_BREAK, overrides={"Fluid.stiffness": float("nan")})
+    assert e.value.key == "Fluid.stiffness"  # (the override named, as the reader names one)
+    assert e.value.where.endswith('(overrides["Fluid.stiffness"]): Fluid.stiffness')
     with pytest.raises(TypeError, match="dict"):
         sph.load_scene(DAM_BREAK, overrides=["Fluid.stiffness=3"])
     with pytest.raises(TypeError, match="scene value"):

@@ -82,12 +82,21 @@ py::dict run_scene(const Scene& scene, const py::object& output_arg, const py::o
       std::int64_t shown = 0;
       callbacks.progress = [&](std::int64_t done, std::size_t particles) {
         if (progress.lines) {
-          const std::int64_t tenths = 10 * done / desc.steps;
+          // A run to stopAt (desc.end_time) counts in simulated time, as sph run does: its step
+          // count is then only a bound (CFL steps), and lines by steps would stop short of 10 %.
+          const double t = driver.simulation().time();
+          const std::int64_t tenths =
+              desc.end_time > 0 ? static_cast<std::int64_t>(10 * t / desc.end_time) : 10 * done / desc.steps;
           if (tenths > shown) {
             shown = tenths;
-            std::fprintf(stderr, "sph: %s: step %lld of %lld (%lld %%), %zu particles\n", desc.name.c_str(),
-                         static_cast<long long>(done), static_cast<long long>(desc.steps),
-                         static_cast<long long>(10 * tenths), particles);
+            if (desc.end_time > 0)
+              std::fprintf(stderr, "sph: %s: t = %.4g of %.4g s (%lld %%), step %lld, %zu particles\n",
+                           desc.name.c_str(), t, desc.end_time, static_cast<long long>(10 * tenths),
+                           static_cast<long long>(done), particles);
+            else
+              std::fprintf(stderr, "sph: %s: step %lld of %lld (%lld %%), %zu particles\n", desc.name.c_str(),
+                           static_cast<long long>(done), static_cast<long long>(desc.steps),
+                           static_cast<long long>(10 * tenths), particles);
           }
         } else if (progress.callable && !callback_error) {
           py::gil_scoped_acquire gil;

@@ -43,6 +43,15 @@ def test_run_progress_lines(small_2d, tmp_path, capfd):
     sph.run(small_2d, output=str(tmp_path / "p"), steps=10, progress=True)
     err = capfd.readouterr().err
     assert "step 10 of 10 (100 %)" in err and err.count("\n") == 10
+    # A run of CFL steps to stopAt counts in simulated time, as sph run does: its step count is only
+    # a bound (a DFSPH dam break to 0.05 s takes a few dozen of its 5,000), and lines by steps
+    # printed none at all.
+    dfsph = sph.load_scene(os.path.join(os.path.dirname(DAM_BREAK), "..", "dfsph", "dam_break_2d.json"),
+                           overrides={"Configuration.stopAt": 0.05})
+    r = sph.run(dfsph, output=str(tmp_path / "t"), threads=1, progress=True)
+    err = capfd.readouterr().err
+    assert r["steps"] < dfsph.steps
+    assert "t = 0.05 of 0.05 s (100 %)" in err and err.count("(") == 10, err
 
 
 def test_run_errors(small_2d, tmp_path):

@@ -71,6 +71,17 @@ std::pair<std::size_t, std::size_t> degenerate(const SurfaceMesh& m) {
   return {flat, static_cast<std::size_t>(std::count(used.begin(), used.end(), false))};
 }
 
+/// The vertices of the face on the wall x = 0 of block(20, 16, 12) (or its 2D slice), away from
+/// the face's edges (within half a spacing of the wall): {those exactly on it, the others}.
+std::pair<std::size_t, std::size_t> wall_face_vertices(const SurfaceMesh& m, int dim) {
+  std::size_t on = 0, off = 0;
+  for (const auto& v : m.vertices) {
+    if (!(v[0] < 0.5 * kS && v[1] > 0.3 && v[1] < 1.3 && (dim == 2 || (v[2] > 0.3 && v[2] < 0.9)))) continue;
+    (v[0] == 0.0f ? on : off) += 1;
+  }
+  return {on, off};
+}
+
 TEST(Surface, RestingBlockIsClosedAndEnclosesItsVolume) {
   // A resting tank's water: its edges and corners are rounded by about a spacing, so smaller
   // blocks lose more (a 10^3 block encloses 0.97 of its volume).
@@ -215,11 +226,7 @@ TEST(Surface, WaterAgainstAWallEndsInAFlatFaceOnIt) {
     EXPECT_EQ(flat, 0u) << "triangles with two vertices at one point";
     EXPECT_EQ(unused, 0u);
     // The face on x = 0, away from its edges: every vertex within half a spacing of the wall is on it.
-    std::size_t on = 0, off = 0;
-    for (const auto& v : m.vertices) {
-      if (!(v[0] < 0.5 * kS && v[1] > 0.3 && v[1] < 1.3 && (dim == 2 || (v[2] > 0.3 && v[2] < 0.9)))) continue;
-      (v[0] == 0.0f ? on : off) += 1;
-    }
+    const auto [on, off] = wall_face_vertices(m, dim);
     EXPECT_GT(on, 0u);
     EXPECT_EQ(off, 0u) << "vertices of the wall face off the wall: a face bumpy at the particles' scale";
     if (dim == 3) expect_closed_and_oriented(m);
@@ -246,11 +253,7 @@ TEST(Surface, ParticlesPastAWallLeaveItsFaceFlat) {
     s.clip_lo = {0, 0, 0};
     s.clip_hi = {10, 10, 10};
     const SurfaceMesh m = extract_surface(p, dim, s);
-    std::size_t on = 0, off = 0;
-    for (const auto& v : m.vertices) {
-      if (!(v[0] < 0.5 * kS && v[1] > 0.3 && v[1] < 1.3 && (dim == 2 || (v[2] > 0.3 && v[2] < 0.9)))) continue;
-      (v[0] == 0.0f ? on : off) += 1;
-    }
+    const auto [on, off] = wall_face_vertices(m, dim);
     EXPECT_GT(on, 0u);
     EXPECT_EQ(off, 0u) << "the wall face dips where particles crossed the wall";
     if (dim == 3) expect_closed_and_oriented(m);
